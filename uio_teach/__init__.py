@@ -1,0 +1,59 @@
+"""uio_teach: unknown input observers for linear systems, for teaching.
+
+The companion package of the course *Unknown Input Observers*. It holds the
+algorithms; the book tells the story.
+
+Examples
+--------
+>>> import uio_teach as ut
+>>> plant = ut.examples.pa9()
+>>> ut.check_existence(plant).ok
+True
+>>> ut.design_uio(plant, poles=[-1, -2, -3]).poles().real.round(6).tolist()
+[-3.0, -2.0, -1.0]
+"""
+
+from . import examples, linalg, signals
+from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
+from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
+from .observers import (
+    PMO,
+    UIO,
+    GInverseObserver,
+    LuenbergerObserver,
+    Observer,
+    ObserverRealization,
+    UnstableObserverWarning,
+    design_ginverse,
+    design_luenberger,
+    design_pmo,
+    design_uio,
+)
+from .plant import Plant
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Plant",
+    "examples",
+    "linalg",
+    "signals",
+    "check_existence",
+    "Condition",
+    "ExistenceReport",
+    "UIOExistenceError",
+    "lmi_gain",
+    "LMIResult",
+    "LMIInfeasibleError",
+    "design_uio",
+    "design_pmo",
+    "design_ginverse",
+    "design_luenberger",
+    "Observer",
+    "ObserverRealization",
+    "UIO",
+    "PMO",
+    "GInverseObserver",
+    "LuenbergerObserver",
+    "UnstableObserverWarning",
+]

@@ -1,0 +1,77 @@
+"""Plain-text and HTML display of named matrices (used by plants, observers and reports)."""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Iterable
+
+import numpy as np
+
+__all__ = ["format_matrix", "matrices_text", "matrices_html", "format_complex"]
+
+
+def format_complex(z: complex, digits: int = 4) -> str:
+    """Format a number, dropping a negligible imaginary part."""
+    z = complex(z)
+    scale = max(1.0, abs(z))
+    if abs(z.imag) <= 1e-12 * scale:
+        return f"{z.real:.{digits}g}"
+    sign = "+" if z.imag >= 0 else "-"
+    return f"{z.real:.{digits}g} {sign} {abs(z.imag):.{digits}g}j"
+
+
+def _clean(M: np.ndarray) -> np.ndarray:
+    """Real part if negligible imaginary, and round-off below 1e-12 of the largest entry to 0."""
+    M = np.real_if_close(np.asarray(M))
+    scale = np.max(np.abs(M)) if M.size else 0.0
+    return np.where(np.abs(M) <= 1e-12 * scale, 0.0, M)
+
+
+def format_matrix(M: np.ndarray, digits: int = 4) -> list[str]:
+    """Return the rows of ``M`` as aligned strings."""
+    M = np.asarray(M)
+    if M.size == 0:
+        return [f"(empty {M.shape[0]}x{M.shape[1]})"]
+    M = _clean(M)
+    cells = [[f"{v:.{digits}g}" if v != 0 else "0" for v in row] for row in M]
+    width = max(len(c) for row in cells for c in row)
+    return ["[" + "  ".join(c.rjust(width) for c in row) + "]" for row in cells]
+
+
+def matrices_text(title: str, items: Iterable[tuple[str, np.ndarray]], digits: int = 4) -> str:
+    """Stack named matrices under a title, one block each."""
+    lines = [title]
+    for name, M in items:
+        rows = format_matrix(M, digits)
+        pad = " " * (len(name) + 3)
+        for i, row in enumerate(rows):
+            lines.append((f"{name} = " if i == 0 else pad) + row)
+    return "\n".join(lines)
+
+
+def _html_matrix(M: np.ndarray, digits: int) -> str:
+    M = np.asarray(M)
+    if M.size == 0:
+        return f"<i>empty {M.shape[0]}&times;{M.shape[1]}</i>"
+    body = "".join(
+        "<tr>"
+        + "".join(f'<td style="text-align:right;padding:0 0.4em">{v:.{digits}g}</td>' for v in row)
+        + "</tr>"
+        for row in _clean(M)
+    )
+    return (
+        '<table style="display:inline-table;border-left:1px solid;border-right:1px solid;'
+        f'border-collapse:collapse;margin:0.2em">{body}</table>'
+    )
+
+
+def matrices_html(title: str, items: Iterable[tuple[str, np.ndarray]], digits: int = 4) -> str:
+    """HTML version of :func:`matrices_text` for notebooks."""
+    parts = [f"<div><b>{html.escape(title)}</b><br>"]
+    for name, M in items:
+        parts.append(
+            f'<span style="display:inline-block;margin-right:1em"><i>{html.escape(name)}</i> = '
+            f"{_html_matrix(M, digits)}</span>"
+        )
+    parts.append("</div>")
+    return "".join(parts)

@@ -1,0 +1,293 @@
+"""When does an unknown input observer exist? The conditions, checked and explained."""
+
+from __future__ import annotations
+
+import html
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._display import format_complex
+from .linalg import (
+    ObservabilitySplit,
+    invariant_zeros,
+    is_stable,
+    left_null,
+    observability_decomposition,
+    pinv,
+    rank,
+)
+from .plant import Plant
+
+__all__ = ["Condition", "ExistenceReport", "UIOExistenceError", "check_existence"]
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One existence condition: its name, whether it holds and why.
+
+    ``holds`` is ``None`` when the condition could not be evaluated because an
+    earlier one failed. ``required=False`` marks information that does not
+    decide existence (e.g. full observability).
+    """
+
+    name: str
+    holds: bool | None
+    reason: str
+    required: bool = True
+
+    @property
+    def symbol(self) -> str:
+        """A one-character verdict: ✓, ✗ or – (not evaluated)."""
+        return {True: "✓", False: "✗", None: "–"}[self.holds]
+
+
+@dataclass(frozen=True)
+class Decoupling:
+    """The decoupling step shared by every projection-type design (internal).
+
+    ``M = [E 0][CE D]^+ + Mv (I - [CE D][CE D]^+)``, ``A1 = (I - M C) A``,
+    ``N`` annihilates ``D`` so that gains of the form ``L = L' N`` satisfy
+    ``L D = 0``; ``split`` is the observability decomposition of ``(A1, N C)``.
+    """
+
+    M: np.ndarray
+    A1: np.ndarray
+    N: np.ndarray
+    split: ObservabilitySplit
+
+
+def decoupling(plant: Plant, Mv: np.ndarray | None = None) -> Decoupling:
+    """Compute ``M``, ``A1`` and the observability split (rank condition assumed)."""
+    n, p, r = plant.n, plant.p, plant.r
+    G = np.hstack([plant.C @ plant.E, plant.D])
+    Eb = np.hstack([plant.E, np.zeros((n, r))])
+    Gp = pinv(G)
+    M = Eb @ Gp
+    if Mv is not None:
+        M = M + Mv @ (np.eye(p) - G @ Gp)
+    A1 = (np.eye(n) - M @ plant.C) @ plant.A
+    N = left_null(plant.D)
+    split = observability_decomposition(A1, N @ plant.C)
+    return Decoupling(M=M, A1=A1, N=N, split=split)
+
+
+@dataclass(frozen=True)
+class ExistenceReport:
+    """Which conditions for an unknown input observer hold, and why.
+
+    Attributes
+    ----------
+    plant : Plant
+        The plant checked.
+    conditions : tuple of Condition
+        Every condition with its verdict and a one-line reason.
+    invariant_zeros : numpy.ndarray
+        Invariant zeros from the unknown inputs ``(d, v)`` to ``y``.
+    fixed_modes : numpy.ndarray
+        Error modes no observer gain can move: the unobservable modes of the
+        pair the designs use, ``(TA, C)`` (``(A1, N C)`` with a measurement
+        disturbance). Empty when the rank condition fails.
+    ok : bool
+        True when every required condition holds: a UIO with stable error
+        dynamics exists.
+    """
+
+    plant: Plant
+    conditions: tuple[Condition, ...]
+    invariant_zeros: np.ndarray
+    fixed_modes: np.ndarray
+    movable: int = field(default=0)
+
+    @property
+    def ok(self) -> bool:
+        """True when every required condition holds."""
+        return all(c.holds for c in self.conditions if c.required)
+
+    @property
+    def failed(self) -> tuple[Condition, ...]:
+        """The required conditions that do not hold."""
+        return tuple(c for c in self.conditions if c.required and c.holds is False)
+
+    def __getitem__(self, name: str) -> Condition:
+        for c in self.conditions:
+            if c.name == name:
+                return c
+        raise KeyError(f"no condition named {name!r}; have {[c.name for c in self.conditions]}")
+
+    def __str__(self) -> str:
+        head = f"Existence of an unknown input observer for {self.plant!r}"
+        width = max(len(c.name) for c in self.conditions)
+        lines = [head]
+        for c in self.conditions:
+            tag = "" if c.required else " (info)"
+            lines.append(f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}")
+        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
+        lines.append(f"  => {verdict}")
+        return "\n".join(lines)
+
+    __repr__ = __str__
+
+    def _repr_html_(self) -> str:
+        rows = "".join(
+            f"<tr><td>{c.symbol}</td><td>{html.escape(c.name)}</td>"
+            f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
+            for c in self.conditions
+        )
+        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
+        return (
+            f"<div><b>Existence of an unknown input observer</b> for "
+            f"{html.escape(repr(self.plant))}<table>"
+            f"<tr><th></th><th>condition</th><th>why</th></tr>{rows}</table>"
+            f"<b>&rArr; {verdict}</b></div>"
+        )
+
+
+class UIOExistenceError(ValueError):
+    """No unknown input observer exists; ``.report`` says which condition failed."""
+
+    def __init__(self, report: ExistenceReport, what: str = "an unknown input observer") -> None:
+        self.report = report
+        failed = report.failed
+        reasons = "; ".join(f"{c.name}: {c.reason}" for c in failed)
+        super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
+
+
+def _fmt(values: np.ndarray) -> str:
+    return "{" + ", ".join(format_complex(v) for v in values) + "}" if len(values) else "none"
+
+
+def _pair_name(plant: Plant) -> str:
+    return "(A1, N C)" if plant.r else "(TA, C)"
+
+
+def check_existence(plant: Plant) -> ExistenceReport:
+    """Check the conditions under which an unknown input observer exists.
+
+    The conditions, in order:
+
+    1. **rank condition** ``rank(CE) = rank(E)`` (with a measurement
+       disturbance, ``rank([CE D]) = rank(E) + rank(D)``): the unknown inputs
+       can be decoupled from the estimation error.
+    2. **invariant zeros stable**: every invariant zero of the plant from the
+       unknown inputs to ``y`` lies in the open left half-plane (continuous)
+       or the open unit disk (discrete).
+    3. **detectability** of the pair the designs use, ``(TA, C)`` with
+       ``T = I - HC`` (``(A1, N C)`` when ``D`` is present, ``N D = 0``): its
+       unobservable modes are the fixed observer poles; they are exactly the
+       invariant zeros of 2.
+    4. **observability** of that pair (information): every pole can be placed.
+    5. **E full column rank** (information): the unknown input can be
+       reconstructed uniquely from the state estimate.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant to check.
+
+    Returns
+    -------
+    ExistenceReport
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> report = ut.check_existence(ut.examples.dt_case_study())
+    >>> report.ok
+    True
+    >>> report.fixed_modes.real.round(6).tolist()
+    [0.5, 0.5]
+    """
+    if not isinstance(plant, Plant):
+        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+    discrete = plant.is_discrete
+    region = "the open unit disk" if discrete else "the open left half-plane"
+    C, E, D = plant.C, plant.E, plant.D
+    rE, rD, rG = rank(E), rank(D), rank(np.hstack([C @ E, D]))
+    conds: list[Condition] = []
+
+    if plant.r:
+        lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
+    else:
+        lhs, rhs = f"rank(CE) = {rG}", f"rank(E) = {rE}"
+    rank_ok = rG == rE + rD
+    if rank_ok:
+        reason = f"{lhs} = {rhs.split(' = ')[0]}: the unknown inputs can be decoupled"
+    else:
+        reason = (
+            f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
+            "at once, so it cannot be cancelled"
+        )
+    conds.append(Condition("rank condition", rank_ok, reason))
+
+    Bz = np.hstack([E, np.zeros((plant.n, plant.r))])
+    Dz = np.hstack([np.zeros((plant.p, plant.q)), D])
+    zeros = invariant_zeros(plant.A, Bz, C, Dz)
+    bad = zeros[~is_stable(zeros, discrete)]
+    if not len(zeros):
+        conds.append(Condition("invariant zeros stable", True, "no invariant zeros"))
+    elif not len(bad):
+        conds.append(
+            Condition("invariant zeros stable", True, f"zeros {_fmt(zeros)} all lie in {region}")
+        )
+    else:
+        conds.append(
+            Condition(
+                "invariant zeros stable",
+                False,
+                f"invariant zero(s) {_fmt(bad)} outside {region}: they are observer poles "
+                "no gain can move, so the error would not decay",
+            )
+        )
+
+    pair = _pair_name(plant)
+    fixed = np.zeros(0, complex)
+    movable = 0
+    if rank_ok:
+        dec = decoupling(plant)
+        fixed = dec.split.unobservable_modes
+        movable = dec.split.Ao.shape[0]
+        unstable = fixed[~is_stable(fixed, discrete)]
+        if not len(unstable):
+            reason = (
+                f"unobservable modes {_fmt(fixed)} lie in {region}"
+                if len(fixed)
+                else "observable, hence detectable"
+            )
+            conds.append(Condition(f"detectable {pair}", True, reason))
+        else:
+            conds.append(
+                Condition(
+                    f"detectable {pair}",
+                    False,
+                    f"unobservable mode(s) {_fmt(unstable)} outside {region}",
+                )
+            )
+        if len(fixed):
+            reason = (
+                f"{movable} of {plant.n} poles can be placed; {_fmt(fixed)} are fixed "
+                "(they are the invariant zeros)"
+            )
+        else:
+            reason = f"all {plant.n} observer poles can be placed"
+        conds.append(Condition(f"observable {pair}", not len(fixed), reason, required=False))
+    else:
+        why = "not evaluated: the rank condition fails"
+        conds.append(Condition(f"detectable {pair}", None, why))
+        conds.append(Condition(f"observable {pair}", None, why, required=False))
+
+    if plant.q:
+        full = rE == plant.q
+        reason = (
+            f"rank(E) = {rE} = q: the unknown input can be reconstructed as E^+ (x' - A x - B u)"
+            if full
+            else f"rank(E) = {rE} < q = {plant.q}: only E d, not d itself, can be reconstructed"
+        )
+        conds.append(Condition("E full column rank", full, reason, required=False))
+    return ExistenceReport(
+        plant=plant,
+        conditions=tuple(conds),
+        invariant_zeros=zeros,
+        fixed_modes=fixed,
+        movable=movable,
+    )

@@ -1,0 +1,304 @@
+"""Linear-algebra building blocks: ranks, projections, observability and invariant zeros.
+
+Everything here works on plain arrays and is shared by the existence check and
+the observer designs. Rank decisions use the singular values with the tolerance
+``max(shape) * eps * sigma_max`` (the one of :func:`numpy.linalg.matrix_rank`).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import scipy.linalg as sla
+
+__all__ = [
+    "rank",
+    "pinv",
+    "left_null",
+    "observability_matrix",
+    "observability_decomposition",
+    "invariant_zeros",
+    "is_stable",
+    "ObservabilitySplit",
+]
+
+
+def _tol(M: np.ndarray, s: np.ndarray) -> float:
+    return max(M.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0)
+
+
+def rank(M: np.ndarray) -> int:
+    """Numerical rank of ``M`` (0 for an empty matrix).
+
+    Examples
+    --------
+    >>> from uio_teach.linalg import rank
+    >>> rank([[1, 2], [2, 4]])
+    1
+    """
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    if M.size == 0:
+        return 0
+    s = np.linalg.svd(M, compute_uv=False)
+    return int(np.sum(s > _tol(M, s)))
+
+
+def pinv(M: np.ndarray) -> np.ndarray:
+    """Moore-Penrose inverse ``M^+`` (MATLAB's ``pinv``), also for empty matrices.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import pinv
+    >>> np.round(pinv([[2.0], [1.0]]), 3)
+    array([[0.4, 0.2]])
+    """
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    if M.size == 0:
+        return np.zeros((M.shape[1], M.shape[0]))
+    return np.linalg.pinv(M)
+
+
+def left_null(M: np.ndarray) -> np.ndarray:
+    """Orthonormal rows ``N`` spanning the left null space of ``M`` (``N @ M = 0``).
+
+    For a matrix with no columns this is the identity.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import left_null
+    >>> D = np.array([[1.0], [0.2]])
+    >>> N = left_null(D)
+    >>> N.shape, bool(np.allclose(N @ D, 0))
+    ((1, 2), True)
+    """
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    p = M.shape[0]
+    if M.shape[1] == 0:
+        return np.eye(p)
+    U, s, _ = np.linalg.svd(M, full_matrices=True)
+    k = int(np.sum(s > _tol(M, s))) if s.size else 0
+    return U[:, k:].T.copy()
+
+
+def observability_matrix(A: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """Stacked ``[C; C A; ...; C A^(n-1)]``."""
+    A = np.asarray(A, float)
+    C = np.atleast_2d(np.asarray(C, float))
+    blocks = [C]
+    for _ in range(A.shape[0] - 1):
+        blocks.append(blocks[-1] @ A)
+    return np.vstack(blocks)
+
+
+class ObservabilitySplit(NamedTuple):
+    """Orthogonal observability decomposition of a pair ``(A, C)``.
+
+    With ``V = [Vo, Vu]`` orthogonal, ``V.T @ A @ V = [[Ao, 0], [*, Au]]`` and
+    ``C @ V = [Co, 0]``: the modes ``eig(Au)`` are unobservable (no output
+    injection can move them), the pair ``(Ao, Co)`` is observable.
+    """
+
+    Vo: np.ndarray
+    Vu: np.ndarray
+    Ao: np.ndarray
+    Co: np.ndarray
+    Au: np.ndarray
+
+    @property
+    def unobservable_modes(self) -> np.ndarray:
+        """Eigenvalues of ``Au``, sorted."""
+        return _sort(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
+
+
+def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySplit:
+    """Split ``(A, C)`` into its observable and unobservable parts.
+
+    The unobservable subspace is computed by a staircase of orthogonal
+    compressions (no powers of ``A``), so it is reliable for stiff plants
+    such as the missile autopilot.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import observability_decomposition
+    >>> split = observability_decomposition(np.diag([1.0, 2.0]), [[1.0, 0.0]])
+    >>> split.unobservable_modes
+    array([2.+0.j])
+    """
+    A = np.asarray(A, float)
+    C = np.atleast_2d(np.asarray(C, float))
+    n = A.shape[0]
+    # Staircase: W spans the current candidate unobservable subspace (start: ker C).
+    W = _null(C) if C.shape[0] else np.eye(n)
+    while W.shape[1]:
+        # keep the part of W that A maps back into W: ker((I - W W^T) A W)
+        R = A @ W - W @ (W.T @ A @ W)
+        K = _null(R, ref=max(np.linalg.norm(A, 2), 1.0))
+        if K.shape[1] == W.shape[1]:
+            break
+        W = W @ K
+    Vu = W
+    Vo = _complement(Vu, n)
+    return ObservabilitySplit(
+        Vo=Vo,
+        Vu=Vu,
+        Ao=Vo.T @ A @ Vo,
+        Co=C @ Vo,
+        Au=Vu.T @ A @ Vu,
+    )
+
+
+def _null(M: np.ndarray, ref: float | None = None) -> np.ndarray:
+    """Orthonormal basis of the right null space of ``M`` (columns)."""
+    M = np.atleast_2d(M)
+    n = M.shape[1]
+    if M.shape[0] == 0 or n == 0:
+        return np.eye(n)
+    _, s, Vt = np.linalg.svd(M, full_matrices=True)
+    scale = ref if ref is not None else (s[0] if s.size else 0.0)
+    tol = max(M.shape) * 1e3 * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
+    k = int(np.sum(s > tol))
+    return Vt[k:].T.copy()
+
+
+def _complement(V: np.ndarray, n: int) -> np.ndarray:
+    """Orthonormal basis of the orthogonal complement of range(V) in R^n."""
+    if V.shape[1] == 0:
+        return np.eye(n)
+    Q, _ = np.linalg.qr(V, mode="complete")
+    return Q[:, V.shape[1] :].copy()
+
+
+def _sort(z: np.ndarray) -> np.ndarray:
+    z = np.asarray(z, complex)
+    # clean tiny imaginary parts of real values
+    z = np.where(np.abs(z.imag) <= 1e-10 * np.maximum(1.0, np.abs(z)), z.real + 0j, z)
+    return z[np.lexsort((z.imag, z.real))]
+
+
+def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.ndarray:
+    """Elementwise: inside the stability region (open left half-plane or unit disk).
+
+    A value within ``margin`` (relative) of the boundary counts as *not* stable.
+
+    Examples
+    --------
+    >>> from uio_teach.linalg import is_stable
+    >>> is_stable([-1.0, 0.0, 0.5], discrete=False).tolist()
+    [True, False, False]
+    >>> is_stable([-1.0, 0.0, 0.5], discrete=True).tolist()
+    [False, True, True]
+    """
+    z = np.asarray(values, complex)
+    if discrete:
+        return np.abs(z) < 1.0 - margin
+    return z.real < -margin * np.maximum(1.0, np.abs(z))
+
+
+def invariant_zeros(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray | None = None
+) -> np.ndarray:
+    """Invariant zeros of ``(A, B, C, D)``, square or not.
+
+    The zeros are the finite values ``s`` at which the Rosenbrock matrix
+    ``[[s I - A, -B], [C, D]]`` loses rank below its normal rank. The system
+    is first reduced with the orthogonal staircase of Emami-Naeini and Van
+    Dooren (1982), applied to the system and to its dual, until the
+    feedthrough is square and invertible; the zeros are then the finite
+    generalized eigenvalues of a regular pencil.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+    B : array_like, shape (n, m)
+    C : array_like, shape (p, n)
+    D : array_like, shape (p, m), optional
+        Zero when omitted.
+
+    Returns
+    -------
+    numpy.ndarray of complex
+        The zeros, sorted by real then imaginary part (with multiplicity).
+
+    Examples
+    --------
+    A non-square system (one input, two outputs) has generically no zero:
+
+    >>> import numpy as np
+    >>> from uio_teach.linalg import invariant_zeros
+    >>> invariant_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], np.eye(2))
+    array([], dtype=complex128)
+
+    and a square one has its transmission zero:
+
+    >>> invariant_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]])
+    array([-1.5+0.j])
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    n = A.shape[0]
+    B = np.asarray(B, float).reshape(n, -1)
+    C = np.asarray(C, float).reshape(-1, n)
+    D = np.zeros((C.shape[0], B.shape[1])) if D is None else np.asarray(D, float)
+    D = D.reshape(C.shape[0], B.shape[1])
+    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
+    A1, B1, C1, D1 = _reduce(A, B, C, D, scale)
+    A2, B2, C2, D2 = _reduce(A1.T, C1.T, B1.T, D1.T, scale)
+    A2, B2, C2, D2 = A2.T, C2.T, B2.T, D2.T
+    nr, mr = A2.shape[0], B2.shape[1]
+    if nr == 0:
+        return np.zeros(0, complex)
+    if D2.shape[0] != D2.shape[1]:  # normal-rank deficient: fall back on what remains
+        return np.zeros(0, complex)
+    if mr == 0:
+        return _sort(np.linalg.eigvals(A2))
+    # compress the columns of [C D] onto D: [C D] W = [0 Df]
+    CD = np.hstack([C2, D2])
+    Q, _ = np.linalg.qr(CD.T[:, ::-1], mode="complete")
+    W = Q[:, ::-1]  # last mr columns span the row space of [C D]
+    AB = np.hstack([A2, B2]) @ W
+    IB = np.hstack([np.eye(nr), np.zeros((nr, mr))]) @ W
+    Af, Ef = AB[:, :nr], IB[:, :nr]
+    w = sla.eigvals(Af, Ef)
+    w = w[np.isfinite(w) & (np.abs(w) < 1e12 * scale)]
+    return _sort(w)
+
+
+def _reduce(A, B, C, D, scale):
+    """One Emami-Naeini/Van Dooren reduction until ``D`` has full row rank."""
+    A, B, C, D = (np.array(X, dtype=float) for X in (A, B, C, D))
+    tol = max(A.shape[0] + C.shape[0], 1) * 1e3 * np.finfo(float).eps * scale
+    while True:
+        n, m, p = A.shape[0], B.shape[1], C.shape[0]
+        if p == 0:
+            return A, B, C, D
+        # compress the rows of D: U D = [[0], [D+]]
+        if m:
+            U, s, _ = np.linalg.svd(D, full_matrices=True)
+            rho = int(np.sum(s > tol))
+        else:
+            U, rho = np.eye(p), 0
+        U = U[:, ::-1].T  # rows: null part first, range part last
+        Cu, Du = U @ C, U @ D
+        C1, C2, Dplus = Cu[: p - rho], Cu[p - rho :], Du[p - rho :]
+        if p - rho == 0:
+            return A, B, C, D
+        if n == 0:
+            return A, B, C2, Dplus
+        # compress the columns of C1: C1 V = [0, Cbar] with Cbar of full column rank mu
+        _, s, Vt = np.linalg.svd(C1, full_matrices=True)
+        mu = int(np.sum(s > tol))
+        if mu == 0:  # those outputs are identically zero: drop them
+            C, D = C2, Dplus
+            continue
+        V = Vt[::-1].T  # last mu columns: the directions C1 sees
+        At, Bt, Ct = V.T @ A @ V, V.T @ B, C2 @ V
+        k = n - mu
+        A11, A21 = At[:k, :k], At[k:, :k]
+        B1, B2 = Bt[:k], Bt[k:]
+        A = A11
+        B = B1
+        C = np.vstack([A21, Ct[:, :k]])
+        D = np.vstack([B2, Dplus])
