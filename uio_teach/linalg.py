@@ -37,7 +37,8 @@ def rank(M: np.ndarray) -> int:
     >>> rank([[1, 2], [2, 4]])
     1
     """
-    M = np.atleast_2d(np.asarray(M, dtype=float))
+    M = np.atleast_2d(np.asarray(M))
+    M = M.astype(complex if np.iscomplexobj(M) else float)
     if M.size == 0:
         return 0
     s = np.linalg.svd(M, compute_uv=False)
