@@ -1,0 +1,283 @@
+"""The book builds without warnings, loads nothing from the internet and renders in a browser.
+
+The book is built once per test run into the repository's ``_build/html`` with the command of
+``make book``. The browser test serves that folder on 127.0.0.1, opens every page of ``_toc.yml``
+in headless Chromium (Debian's ``/usr/bin/chromium``, driven by Playwright), blocks every request
+that leaves the local server, and checks that the mathematics is typeset, every image loaded, no
+output cell shows an error and the console stays clean. A screenshot of each page is saved in
+``_build/screenshots/``.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import subprocess
+import sys
+import threading
+from collections.abc import Iterator
+from html.parser import HTMLParser
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from urllib.parse import urlsplit
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+HTML = ROOT / "_build" / "html"
+SCREENSHOTS = ROOT / "_build" / "screenshots"
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+]
+BUILD_TIMEOUT = 1800  # seconds, for a clean build that executes every chapter
+
+pytestmark = [pytest.mark.book, pytest.mark.timeout(BUILD_TIMEOUT)]
+
+
+def toc_pages(toc_file: Path = ROOT / "_toc.yml") -> list[str]:
+    """Every document of the table of contents, in reading order, without suffix."""
+    toc = yaml.safe_load(toc_file.read_text(encoding="utf-8"))
+    pages: list[str] = [toc["root"]]
+
+    def walk(node: object) -> None:
+        if isinstance(node, dict):
+            if "file" in node:
+                pages.append(node["file"])
+            for key in ("parts", "chapters", "sections"):
+                for child in node.get(key, []):
+                    walk(child)
+        elif isinstance(node, list):
+            for child in node:
+                walk(child)
+
+    walk({key: toc[key] for key in ("parts", "chapters", "sections") if key in toc})
+    return [re.sub(r"\.(md|ipynb)$", "", page) for page in pages]
+
+
+PAGES = toc_pages()
+
+
+def _jupyter_book() -> str:
+    local = Path(sys.executable).parent / "jupyter-book"
+    return str(local) if local.exists() else "jupyter-book"
+
+
+@pytest.fixture(scope="session")
+def built_book() -> Path:
+    """Build the book once per test run, exactly as ``make book`` does."""
+    command = [_jupyter_book(), "build", ".", "-W", "-n", "--keep-going"]
+    proc = subprocess.run(
+        command,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=BUILD_TIMEOUT,
+    )
+    if proc.returncode != 0:
+        log = (proc.stdout + proc.stderr)[-8000:]
+        pytest.fail(
+            f"`{' '.join(command)}` exited with {proc.returncode}; tracebacks of failed chapters"
+            f" are in {HTML / 'reports'}.\n{log}",
+            pytrace=False,
+        )
+    return HTML
+
+
+def test_book_builds(built_book: Path) -> None:
+    missing = [page for page in PAGES if not (built_book / f"{page}.html").is_file()]
+    assert not missing, f"pages of _toc.yml missing from the build: {missing}"
+
+
+class _ExternalResources(HTMLParser):
+    """Collect the URLs of scripts, stylesheets, images and frames loaded from other hosts."""
+
+    ATTRIBUTES = {"script": "src", "link": "href", "img": "src", "iframe": "src"}
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.found: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        name = self.ATTRIBUTES.get(tag)
+        if name is None:
+            return
+        url = dict(attrs).get(name) or ""
+        if re.match(r"^(https?:)?//", url.strip(), flags=re.IGNORECASE):
+            self.found.append(f"<{tag} {name}={url!r}>")
+
+
+def test_no_external_resources(built_book: Path) -> None:
+    offenders: dict[str, list[str]] = {}
+    pages = sorted(built_book.rglob("*.html"))
+    assert pages
+    for page in pages:
+        if "_static" in page.relative_to(built_book).parts:
+            continue
+        parser = _ExternalResources()
+        parser.feed(page.read_text(encoding="utf-8"))
+        if parser.found:
+            offenders[str(page.relative_to(built_book))] = parser.found
+    assert not offenders, f"pages that load resources from the internet: {offenders}"
+
+
+# --- the browser test -----------------------------------------------------------------------
+
+
+class _QuietHandler(SimpleHTTPRequestHandler):
+    def log_message(self, format: str, *args: object) -> None:
+        pass
+
+
+@pytest.fixture(scope="session")
+def book_server(built_book: Path) -> Iterator[str]:
+    """Serve the built book on 127.0.0.1 at a free port; yield its base URL."""
+    handler = functools.partial(_QuietHandler, directory=str(built_book))
+    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[object]:
+    if not CHROMIUM.exists():
+        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
+        if os.environ.get("CI") == "true":
+            pytest.fail(message, pytrace=False)
+        pytest.skip(message)
+    from playwright.sync_api import sync_playwright
+
+    # Playwright gives the browser a fresh temporary profile of its own.
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(
+            executable_path=str(CHROMIUM), args=CHROMIUM_ARGS, headless=True
+        )
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+# Text nodes outside code, in visible elements: raw TeX left there means MathJax did not run.
+_VISIBLE_PROSE_JS = """
+() => {
+  const skip = new Set(["PRE", "CODE", "SCRIPT", "STYLE", "TEXTAREA", "NOSCRIPT"]);
+  const root = document.querySelector("main") || document.body;
+  const walker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  const parts = [];
+  for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+    let el = node.parentElement, hidden = false;
+    for (let e = el; e; e = e.parentElement) {
+      if (skip.has(e.tagName)) { hidden = true; break; }
+    }
+    if (hidden || !el.checkVisibility()) continue;
+    parts.push(node.textContent);
+  }
+  return parts.join("");
+}
+"""
+
+_WAIT_FOR_IMAGES_JS = """
+async () => {
+  const images = Array.from(document.images);
+  for (const img of images) { if (img.loading === "lazy") img.loading = "eager"; }
+  await Promise.all(images.map((img) => img.complete ? null : new Promise((resolve) => {
+    img.addEventListener("load", resolve, {once: true});
+    img.addEventListener("error", resolve, {once: true});
+  })));
+  return images.filter((img) => !(img.complete && img.naturalWidth > 0))
+               .map((img) => img.getAttribute("src"));
+}
+"""
+
+_WAIT_FOR_MATHJAX_JS = """
+async () => {
+  if (!window.MathJax || !window.MathJax.startup) return false;
+  await window.MathJax.startup.promise;
+  return true;
+}
+"""
+
+_ERROR_OUTPUTS = ".output.error, .output.traceback, .output.stderr"
+_EXCEPTION_LINE = re.compile(
+    r"Traceback \(most recent call last\)|^[A-Z]\w*(Error|Exception): ", re.M
+)
+
+
+def _screenshot_name(page: str) -> str:
+    relative = Path(page)
+    if relative.parts and relative.parts[0] == "book":
+        relative = Path(*relative.parts[1:])
+    return "-".join(relative.parts) + ".png"
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_page_in_browser(page: str, book_server: str, browser) -> None:
+    host = urlsplit(book_server).hostname
+    blocked: list[str] = []
+    console_errors: list[str] = []
+    failed: list[str] = []
+
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    tab = context.new_page()
+
+    def route(route) -> None:
+        if urlsplit(route.request.url).hostname == host:
+            route.continue_()
+        else:
+            blocked.append(route.request.url)
+            route.abort()
+
+    tab.route("**/*", route)
+    tab.on(
+        "console",
+        lambda msg: console_errors.append(f"console: {msg.text}") if msg.type == "error" else None,
+    )
+    tab.on("pageerror", lambda exc: console_errors.append(f"page error: {exc}"))
+    tab.on(
+        "response",
+        lambda r: failed.append(f"{r.status} {r.url}") if r.status >= 400 else None,
+    )
+    try:
+        response = tab.goto(f"{book_server}/{page}.html", wait_until="load")
+        assert response is not None and response.ok, f"{page}.html did not load"
+
+        broken_images = tab.evaluate(_WAIT_FOR_IMAGES_JS)
+        typeset = tab.evaluate(_WAIT_FOR_MATHJAX_JS)
+        has_math = tab.locator("main .math").count() > 0
+        rendered_math = tab.locator("mjx-container").count()
+        prose = tab.evaluate(_VISIBLE_PROSE_JS)
+        error_outputs = tab.locator(_ERROR_OUTPUTS).all_inner_texts()
+        cell_outputs = "\n".join(tab.locator(".cell_output").all_inner_texts())
+
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        tab.screenshot(path=str(SCREENSHOTS / _screenshot_name(page)), full_page=True)
+    finally:
+        context.close()
+
+    assert not blocked, f"{page}: requests that leave the local server: {blocked}"
+    assert not failed, f"{page}: failed requests: {failed}"
+    if has_math:
+        assert typeset, f"{page}: has math but MathJax did not start"
+        assert rendered_math > 0, f"{page}: has math but no mjx-container was rendered"
+    raw = [delimiter for delimiter in ("\\(", "\\[", "$$") if delimiter in prose]
+    assert not raw, f"{page}: raw TeX delimiters {raw} left in the visible text"
+    assert not broken_images, f"{page}: images that did not load: {broken_images}"
+    assert not error_outputs, f"{page}: error or stderr output cells: {error_outputs}"
+    match = _EXCEPTION_LINE.search(cell_outputs)
+    assert match is None, f"{page}: an output cell shows an exception: {match.group(0)!r}"
+    assert not console_errors, f"{page}: browser console errors: {console_errors}"
