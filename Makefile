@@ -5,7 +5,8 @@
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
-# Reinstall when the pins or the package metadata change.
+# Reinstall when the pins or the package metadata change, or when the package's __init__.py
+# appears (an editable install made before it existed maps `uio_teach` as a namespace package).
 STAMP  := $(VENV)/.installed
 
 # Tools started by pytest (jupyter-book, the kernel) come from the environment.
@@ -21,7 +22,7 @@ help:
 	@echo "make lint   ruff check and ruff format --check"
 	@echo "make clean  remove build outputs and caches (keeps $(VENV))"
 
-$(STAMP): requirements.txt pyproject.toml
+$(STAMP): requirements.txt pyproject.toml $(wildcard uio_teach/__init__.py)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --disable-pip-version-check -q -r requirements.txt
 	$(BIN)/python -m pip install --disable-pip-version-check -q -e . --no-deps
