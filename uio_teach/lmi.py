@@ -68,7 +68,8 @@ def lmi_gain(
         Discrete: the poles' radius bound (0 < decay <= 1). Continuous: the
         minimum decay rate (decay >= 0).
     solver : str, optional
-        A cvxpy solver name (default ``"CLARABEL"``; ``"SCS"`` works too).
+        A cvxpy solver name. By default Clarabel, then SCS if Clarabel
+        fails numerically (as it may on an infeasible LMI).
 
     Returns
     -------
@@ -118,20 +119,27 @@ def lmi_gain(
     if D is not None and D.shape[1]:
         cons.append(Y @ D == 0)
     prob = cp.Problem(cp.Minimize(0), cons)
-    try:
-        prob.solve(solver=solver or "CLARABEL")
-    except cp.error.SolverError as exc:
-        raise LMIInfeasibleError(f"the LMI solver failed: {exc}", "solver_error") from None
+    # Clarabel is the default; on infeasible LMIs it sometimes stops with a numerical
+    # failure instead of a certificate, so SCS is asked next to classify the problem.
+    errors = []
+    for name in [solver] if solver else ["CLARABEL", "SCS"]:
+        try:
+            prob.solve(solver=name)
+        except cp.error.SolverError as exc:
+            errors.append(f"{name}: {exc}")
+            continue
+        break
+    else:
+        raise LMIInfeasibleError("the LMI solver failed: " + "; ".join(errors), "solver_error")
     if prob.status not in ("optimal", "optimal_inaccurate"):
+        bound = (
+            f"poles inside radius {decay if decay is not None else 1}"
+            if discrete
+            else f"poles left of {-(decay or 0.0)}"
+        )
+        with_d = " with L D = 0" if D is not None and D.shape[1] else ""
         raise LMIInfeasibleError(
-            f"the LMI is {prob.status}: no observer gain achieves "
-            + (
-                f"poles inside radius {decay if decay is not None else 1}"
-                if discrete
-                else f"poles left of {-(decay or 0.0)}"
-            )
-            + (" with L D = 0" if D is not None and D.shape[1] else ""),
-            prob.status,
+            f"the LMI is {prob.status}: no observer gain achieves {bound}{with_d}", prob.status
         )
     Pv = 0.5 * (P.value + P.value.T)
     L = np.linalg.solve(Pv, Y.value)

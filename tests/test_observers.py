@@ -1,0 +1,187 @@
+"""Observer designs: argument checks, pole counts, warnings, LMI options, python-control views."""
+
+import warnings
+
+import control as ct
+import numpy as np
+import pytest
+
+import uio_teach as ut
+
+
+def test_pole_count_error_says_what_can_be_placed():
+    plant = ut.examples.dt_case_study()
+    with pytest.raises(
+        ValueError, match=r"1 pole\(s\) can be placed, got 2.*\{0.5, 0.5\} are fixed"
+    ):
+        ut.design_pmo(plant, poles=[0.1, 0.2])
+    with pytest.raises(ValueError, match=r"2 pole\(s\) can be placed, got 4.*fixed \(invariant"):
+        ut.design_uio(ut.examples.missile_autopilot(), poles=[-1, -2, -3, -4])
+
+
+def test_all_poles_including_fixed_ones_are_accepted():
+    plant = ut.examples.dt_case_study()
+    a = ut.design_pmo(plant, poles=[0.2])
+    b = ut.design_pmo(plant, poles=[0.5, 0.2, 0.5])  # the full list with the fixed modes
+    np.testing.assert_allclose(a.L, b.L)
+
+
+def test_moving_the_one_movable_pole_of_the_case_study():
+    plant = ut.examples.dt_case_study()
+    pmo = ut.design_pmo(plant, poles=[-0.3])
+    np.testing.assert_allclose(pmo.poles().real, [-0.3, 0.5, 0.5], atol=1e-7)
+    np.testing.assert_allclose(pmo.L @ plant.D, 0, atol=1e-14)
+    np.testing.assert_allclose(pmo.M @ plant.D, 0, atol=1e-14)
+
+
+def test_complex_poles_need_conjugates():
+    with pytest.raises(ValueError, match="no conjugate partner"):
+        ut.design_uio(ut.examples.pa9(), poles=[-1 + 1j, -1 + 1j, -3])
+    obs = ut.design_uio(ut.examples.pa9(), poles=[-1 + 1j, -1 - 1j, -3])
+    np.testing.assert_allclose(np.sort_complex(obs.poles()), [-3, -1 - 1j, -1 + 1j], atol=1e-9)
+    assert np.isrealobj(obs.K1)
+
+
+def test_repeated_poles_beyond_output_count():
+    with pytest.raises(ValueError, match="repeated 3 times but only 2 independent outputs"):
+        ut.design_uio(ut.examples.pa9(), poles=[-2, -2, -2])
+    # a multiplicity the two outputs can produce is fine
+    obs = ut.design_uio(ut.examples.pa9(), poles=[-2, -2, -3])
+    np.testing.assert_allclose(np.sort(obs.poles().real), [-3, -2, -2], atol=1e-6)
+
+
+def test_single_output_repeated_poles_use_ackermann():
+    plant = ut.Plant([[0, 1], [-2, -3]], [[1, 0]])
+    obs = ut.design_luenberger(plant, poles=[-4, -4])
+    np.testing.assert_allclose(obs.poles().real, [-4, -4], atol=1e-6)
+
+
+def test_argument_combinations():
+    plant = ut.examples.pa9()
+    with pytest.raises(ValueError, match="exactly one of poles= .* or K1="):
+        ut.design_uio(plant)
+    with pytest.raises(ValueError, match="exactly one of poles= .* or K1="):
+        ut.design_uio(plant, poles=[-1, -2, -3], K1=np.zeros((3, 2)))
+    with pytest.raises(ValueError, match=r"K1 has shape \(2, 3\), expected \(3, 2\)"):
+        ut.design_uio(plant, K1=np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="method must be"):
+        ut.design_pmo(plant, poles=[-1, -2, -3], method="magic")
+    with pytest.raises(ValueError, match="method='lmi' computes L itself"):
+        ut.design_pmo(plant, poles=[-1, -2, -3], method="lmi")
+    with pytest.raises(ValueError, match="decay= is the LMI's bound"):
+        ut.design_pmo(plant, poles=[-1, -2, -3], decay=0.5)
+    with pytest.raises(ValueError, match="plant must be a uio_teach.Plant"):
+        ut.design_uio(np.eye(3), poles=[-1, -2, -3])
+
+
+def test_gain_must_respect_the_measurement_disturbance():
+    plant = ut.examples.dt_case_study()
+    with pytest.raises(ValueError, match="L D must be 0"):
+        ut.design_pmo(plant, L=np.ones((3, 2)))
+
+
+def test_unstable_design_warns_but_is_built():
+    plant = ut.examples.pa9()
+    with pytest.warns(ut.UnstableObserverWarning, match=r"pole\(s\) 1 outside the open left"):
+        obs = ut.design_uio(plant, poles=[1, -2, -3])
+    assert not obs.is_stable
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert ut.design_uio(plant, poles=[-1, -2, -3]).is_stable
+
+
+def test_lmi_infeasible_bound():
+    # the fixed modes at 0.5 cannot be pushed inside radius 0.4
+    with pytest.raises(ut.LMIInfeasibleError, match="infeasible.*radius 0.4 with L D = 0") as info:
+        ut.design_pmo(ut.examples.dt_case_study(), method="lmi", decay=0.4)
+    assert "infeasible" in info.value.status
+    assert isinstance(info.value, ValueError)
+
+
+def test_lmi_decay_bound_is_met():
+    pmo = ut.design_pmo(ut.examples.dt_case_study(), method="lmi", decay=0.6)
+    assert np.max(np.abs(pmo.poles())) <= 0.6 + 1e-6
+    obs = ut.design_pmo(ut.examples.pa9(), method="lmi", decay=2.0)
+    assert np.max(obs.poles().real) <= -2.0 + 1e-6
+
+
+def test_lmi_continuous_unstable_system():
+    A1 = np.array([[1.0, 1.0], [0.0, 2.0]])
+    C = np.array([[1.0, 0.0]])
+    L, P = ut.lmi_gain(A1, C)
+    assert np.all(np.linalg.eigvals(A1 - L @ C).real < 0)
+    # the Lyapunov certificate really certifies it
+    Q = (A1 - L @ C).T @ P + P @ (A1 - L @ C)
+    assert np.max(np.linalg.eigvalsh(Q)) < 0
+
+
+def test_lmi_infeasible_when_unobservable_unstable():
+    A1 = np.diag([1.0, -1.0])
+    with pytest.raises(ut.LMIInfeasibleError):
+        ut.lmi_gain(A1, [[0.0, 1.0]])
+
+
+def test_lmi_argument_checks():
+    with pytest.raises(ValueError, match="decay must satisfy 0 < decay <= 1"):
+        ut.lmi_gain(np.eye(2), np.eye(2), dt=True, decay=1.5)
+    with pytest.raises(ValueError, match=r"C has shape \(1, 3\), expected \(\?, 2\)"):
+        ut.lmi_gain(np.eye(2), np.ones((1, 3)))
+
+
+@pytest.mark.parametrize(
+    "design",
+    [
+        lambda: ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3]),
+        lambda: ut.design_pmo(ut.examples.dt_case_study(), method="lmi"),
+        lambda: ut.design_pmo(ut.examples.missile_autopilot(), poles=[-100, -150]),
+        lambda: ut.design_ginverse(ut.examples.missile_autopilot()),
+        lambda: ut.design_luenberger(ut.examples.pa9(), poles=[-1, -2, -3]),
+    ],
+)
+def test_as_statespace_reproduces_the_realization(design):
+    obs = design()
+    sys = obs.as_statespace()
+    pl = obs.plant
+    assert sys.ninputs == pl.m + pl.p and sys.noutputs == pl.n
+    assert (sys.dt not in (0, None)) == pl.is_discrete
+    real = obs.realization()
+    np.testing.assert_array_equal(sys.A, real.A)
+    np.testing.assert_array_equal(sys.C, real.C)
+    assert "xhat[0]" in sys.output_labels
+    assert "poles" in repr(obs)
+    assert "<table" in obs._repr_html_()
+
+
+def test_uio_and_pmo_are_the_same_observer():
+    """With H = M and K1 = L, the decoupling observer of PA9 is the PMO of eq. (13)."""
+    plant = ut.examples.pa9()
+    uio = ut.design_uio(plant, poles=[-1, -2, -3])
+    pmo = ut.design_pmo(plant, L=uio.K1)
+    np.testing.assert_allclose(uio.H, pmo.M)
+    np.testing.assert_allclose(uio.F, pmo.F)
+    np.testing.assert_allclose(uio.K, pmo.G, atol=1e-12)
+
+
+def test_closed_loop_with_python_control():
+    """The observer is an ordinary python-control system: its DC gain from y is sane."""
+    plant = ut.examples.pa9()
+    obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    sys = obs.as_statespace()
+    # at steady state with a constant output y and u = 0, xhat is consistent with y
+    y0 = np.array([1.0, 0.5])
+    xhat = ct.dcgain(sys) @ np.concatenate([np.zeros(plant.m), y0])
+    assert xhat.shape == (3,)
+    assert np.all(np.isfinite(xhat))
+
+
+def test_ginverse_refuses_measurement_disturbance_and_redundant_outputs():
+    with pytest.raises(ValueError, match="does not handle measurement disturbances"):
+        ut.design_ginverse(ut.examples.dt_case_study())
+    plant = ut.Plant(np.diag([-1.0, -2.0, -3.0]), [[1, 0, 0], [2, 0, 0]], E=[1, 0, 0])
+    with pytest.raises(ValueError, match="C has rank 1 < p = 2"):
+        ut.design_ginverse(plant)
+
+
+def test_luenberger_does_not_decouple():
+    assert not ut.design_luenberger(ut.examples.pa9(), poles=[-1, -2, -3]).decouples
+    assert ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3]).decouples
