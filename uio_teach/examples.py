@@ -43,7 +43,16 @@ def _ro(a) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Published:
-    """Values printed in a source document (``decimals``: as printed)."""
+    """Values printed in a source document (``decimals``: as printed).
+
+    Examples
+    --------
+    >>> from uio_teach import examples
+    >>> examples.PA9_PUBLISHED.H
+    array([[0.94, 0.23],
+           [0.  , 0.  ],
+           [0.23, 0.05]])
+    """
 
     source: str
     decimals: int

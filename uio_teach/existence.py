@@ -29,6 +29,13 @@ class Condition:
     ``holds`` is ``None`` when the condition could not be evaluated because an
     earlier one failed. ``required=False`` marks information that does not
     decide existence (e.g. full observability).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> cond = ut.check_existence(ut.examples.pa9())["rank condition"]
+    >>> cond.holds, cond.symbol
+    (True, '✓')
     """
 
     name: str
@@ -91,6 +98,15 @@ class ExistenceReport:
     ok : bool
         True when every required condition holds: a UIO with stable error
         dynamics exists.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> report = ut.check_existence(ut.examples.missile_autopilot())
+    >>> report.ok, report.movable
+    (True, 2)
+    >>> [c.name for c in report.failed]
+    []
     """
 
     plant: Plant

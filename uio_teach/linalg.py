@@ -31,6 +31,11 @@ def _tol(M: np.ndarray, s: np.ndarray) -> float:
 def rank(M: np.ndarray) -> int:
     """Numerical rank of ``M`` (0 for an empty matrix).
 
+    Parameters
+    ----------
+    M : array_like
+        The matrix (real or complex).
+
     Examples
     --------
     >>> from uio_teach.linalg import rank
@@ -47,6 +52,15 @@ def rank(M: np.ndarray) -> int:
 
 def pinv(M: np.ndarray) -> np.ndarray:
     """Moore-Penrose inverse ``M^+`` (MATLAB's ``pinv``), also for empty matrices.
+
+    Parameters
+    ----------
+    M : array_like, shape (a, b)
+        The matrix.
+
+    Returns
+    -------
+    numpy.ndarray, shape (b, a)
 
     Examples
     --------
@@ -65,6 +79,12 @@ def left_null(M: np.ndarray) -> np.ndarray:
     """Orthonormal rows ``N`` spanning the left null space of ``M`` (``N @ M = 0``).
 
     For a matrix with no columns this is the identity.
+
+    Parameters
+    ----------
+    M : array_like, shape (p, r)
+        The matrix to annihilate from the left (e.g. a measurement-disturbance
+        matrix ``D``).
 
     Examples
     --------
@@ -85,7 +105,20 @@ def left_null(M: np.ndarray) -> np.ndarray:
 
 
 def observability_matrix(A: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Stacked ``[C; C A; ...; C A^(n-1)]``."""
+    """Stacked ``[C; C A; ...; C A^(n-1)]`` (MATLAB's ``obsv``).
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+    C : array_like, shape (p, n)
+
+    Examples
+    --------
+    >>> from uio_teach.linalg import observability_matrix
+    >>> observability_matrix([[0.0, 1.0], [0.0, 0.0]], [[1.0, 0.0]])
+    array([[1., 0.],
+           [0., 1.]])
+    """
     A = np.asarray(A, float)
     C = np.atleast_2d(np.asarray(C, float))
     blocks = [C]
@@ -100,6 +133,14 @@ class ObservabilitySplit(NamedTuple):
     With ``V = [Vo, Vu]`` orthogonal, ``V.T @ A @ V = [[Ao, 0], [*, Au]]`` and
     ``C @ V = [Co, 0]``: the modes ``eig(Au)`` are unobservable (no output
     injection can move them), the pair ``(Ao, Co)`` is observable.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import observability_decomposition
+    >>> split = observability_decomposition(np.diag([-1.0, -2.0]), [[1.0, 0.0]])
+    >>> split.Ao.shape, split.Au.shape
+    ((1, 1), (1, 1))
     """
 
     Vo: np.ndarray
@@ -120,6 +161,15 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     The unobservable subspace is computed by a staircase of orthogonal
     compressions (no powers of ``A``), so it is reliable for stiff plants
     such as the missile autopilot.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+    C : array_like, shape (p, n)
+
+    Returns
+    -------
+    ObservabilitySplit
 
     Examples
     --------
@@ -184,6 +234,15 @@ def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.nd
     """Elementwise: inside the stability region (open left half-plane or unit disk).
 
     A value within ``margin`` (relative) of the boundary counts as *not* stable.
+
+    Parameters
+    ----------
+    values : array_like of complex
+        Poles or zeros.
+    discrete : bool
+        Judge against the unit disk (True) or the left half-plane (False).
+    margin : float
+        Relative distance from the boundary still counted as unstable.
 
     Examples
     --------

@@ -22,7 +22,15 @@ class LMIInfeasibleError(ValueError):
 
 
 class LMIResult(NamedTuple):
-    """Gain ``L`` and Lyapunov certificate ``P`` (unpacks as ``L, P``)."""
+    """Gain ``L`` and Lyapunov certificate ``P`` (unpacks as ``L, P``).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> res = ut.lmi_gain([[0.5]], [[1.0]], dt=True)
+    >>> res.L.shape, res.P.shape
+    ((1, 1), (1, 1))
+    """
 
     L: np.ndarray
     P: np.ndarray

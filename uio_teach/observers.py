@@ -47,7 +47,15 @@ class UnstableObserverWarning(UserWarning):
 
 
 class ObserverRealization(NamedTuple):
-    """``w' = A w + B_u u + B_y y``, ``xhat = C w + D_y y`` (no direct ``u`` term)."""
+    """``w' = A w + B_u u + B_y y``, ``xhat = C w + D_y y`` (no direct ``u`` term).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> real = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3]).realization()
+    >>> real.A.shape, real.B_y.shape, real.D_y.shape
+    ((3, 3), (3, 2), (3, 2))
+    """
 
     A: np.ndarray
     B_u: np.ndarray
@@ -66,6 +74,13 @@ class Observer:
     error_matrix : numpy.ndarray
         ``Ae`` in the error dynamics ``e' = Ae e`` (``e[k+1] = Ae e[k]``),
         which hold whatever the unknown input is for the UIO families.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> obs = ut.design_pmo(ut.examples.dt_case_study(), method="lmi")
+    >>> isinstance(obs, ut.Observer), obs.decouples, obs.is_stable
+    (True, True, True)
     """
 
     family = "observer"
@@ -199,6 +214,14 @@ class UIO(_ProjectionObserver):
     ``z' = F z + T B u + K y``, ``xhat = z + H y`` with ``H = E (CE)^+``,
     ``T = I - H C``, ``F = T A - K1 C``, ``K2 = F H``, ``K = K1 + K2``.
     Built by :func:`design_uio`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> uio = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3])
+    >>> bool(np.allclose(uio.T @ uio.plant.E, 0))
+    True
     """
 
     family = "UIO"
@@ -241,6 +264,14 @@ class PMO(_ProjectionObserver):
     ``q' = F q + G y + (I - MC) B u``, ``xhat = q + M y`` with
     ``A1 = (I - MC) A``, ``F = A1 - L C`` and ``G = (I - MC) A M + L - L C M``
     (eq. (13) of the missile paper). Built by :func:`design_pmo`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> pmo = ut.design_pmo(ut.examples.missile_autopilot(), poles=[-100, -120])
+    >>> bool(np.allclose(pmo.projection @ pmo.plant.E, 0))
+    True
     """
 
     family = "PMO"
@@ -300,6 +331,14 @@ class GInverseObserver(Observer):
         xhat = Pc q + (Cg + Pc K) y
 
     Built by :func:`design_ginverse`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> g = ut.design_ginverse(ut.examples.missile_autopilot())
+    >>> bool(np.allclose(g.projection @ g.projection, g.projection))
+    True
     """
 
     family = "g-inverse observer"
@@ -364,6 +403,12 @@ class LuenbergerObserver(Observer):
 
     It ignores the unknown inputs, so its error is driven by them:
     ``e' = (A - L C) e + E d - L D v``. Built by :func:`design_luenberger`.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.design_luenberger(ut.examples.pa9(), poles=[-1, -2, -3]).decouples
+    False
     """
 
     family = "Luenberger observer"

@@ -13,6 +13,15 @@ class Signal:
     """A vectorized scalar signal ``s(t)``; ``repr`` reads like the formula.
 
     Calling it with an array of times returns an array of the same shape.
+
+    Examples
+    --------
+    >>> from uio_teach import signals
+    >>> s = signals.sinusoid(1.0, 2.0) + signals.step(0.5)
+    >>> s
+    1 sin(2 t) + 0.5 step(t - 0)
+    >>> s([0.0, 1.0]).shape
+    (2,)
     """
 
     def __init__(self, func: Callable[[np.ndarray], np.ndarray], text: str) -> None:
@@ -47,6 +56,16 @@ def sinusoid(
 ) -> Signal:
     """``offset + amplitude * sin(frequency * t + phase)`` (frequency in rad/s).
 
+    Parameters
+    ----------
+    amplitude : float
+    frequency : float
+        Angular frequency in rad/s.
+    phase : float
+        Phase in rad.
+    offset : float
+        Constant added to the sinusoid.
+
     Examples
     --------
     >>> from uio_teach import signals
@@ -78,6 +97,15 @@ def damped_sinusoid(
 
     The missile paper's unknown inputs are ``damped_sinusoid(10, 2, 10, "cos")``
     and ``damped_sinusoid(50, 5, 100, "sin")``.
+
+    Parameters
+    ----------
+    amplitude : float
+    decay : float
+        Exponential decay rate in 1/s.
+    frequency : float
+        Angular frequency in rad/s.
+    kind : {"sin", "cos"}
 
     Examples
     --------
@@ -134,6 +162,12 @@ def piecewise_constant(times: Sequence[float], values: Sequence[float]) -> Signa
 def step(amplitude: float = 1.0, time: float = 0.0) -> Signal:
     """``amplitude`` from ``time`` on, 0 before.
 
+    Parameters
+    ----------
+    amplitude : float
+    time : float
+        Switching time.
+
     Examples
     --------
     >>> from uio_teach import signals
@@ -158,6 +192,11 @@ class _Stack:
 
 def stack(*signals: Callable) -> Callable:
     """Stack scalar signals into one vector signal (one row per channel).
+
+    Parameters
+    ----------
+    *signals : callable
+        Scalar signals of time, one per channel.
 
     Examples
     --------
