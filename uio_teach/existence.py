@@ -45,7 +45,7 @@ class Condition:
 
     @property
     def symbol(self) -> str:
-        """A one-character verdict: ✓, ✗ or – (not evaluated)."""
+        """The verdict in one character; ✓, ✗ or – (not evaluated)."""
         return {True: "✓", False: "✗", None: "–"}[self.holds]
 
 

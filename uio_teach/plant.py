@@ -161,7 +161,7 @@ class Plant:
 
     @property
     def dt(self) -> float | bool | None:
-        """Sampling period: None (continuous), True (unspecified) or a float."""
+        """The sampling period; None (continuous), True (unspecified) or a float."""
         return self._dt
 
     @property
