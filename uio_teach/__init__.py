@@ -30,6 +30,7 @@ from .observers import (
     design_uio,
 )
 from .plant import Plant
+from .simulation import UIOResponse, simulate
 
 __version__ = "0.1.0"
 
@@ -56,4 +57,6 @@ __all__ = [
     "GInverseObserver",
     "LuenbergerObserver",
     "UnstableObserverWarning",
+    "simulate",
+    "UIOResponse",
 ]
