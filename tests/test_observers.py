@@ -185,3 +185,19 @@ def test_ginverse_refuses_measurement_disturbance_and_redundant_outputs():
 def test_luenberger_does_not_decouple():
     assert not ut.design_luenberger(ut.examples.pa9(), poles=[-1, -2, -3]).decouples
     assert ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3]).decouples
+
+
+def test_printed_rounded_gain_is_projected_with_a_warning():
+    plant = ut.examples.dt_case_study()
+    printed_L = ut.examples.DT_CASE_STUDY_PUBLISHED.L
+    with pytest.warns(UserWarning, match="not exactly 0 .*nearest gain with L D = 0"):
+        pmo = ut.design_pmo(plant, L=printed_L)
+    np.testing.assert_allclose(pmo.L @ plant.D, 0, atol=1e-14)
+    np.testing.assert_allclose(pmo.L, printed_L, atol=1e-4)
+    np.testing.assert_allclose(pmo.poles().real, [0, 0.5, 0.5], atol=1e-4)
+
+
+def test_conjugate_pairs_sort_consistently():
+    report = ut.check_existence(ut.examples.missile_autopilot())
+    np.testing.assert_allclose(report.invariant_zeros, report.fixed_modes, rtol=1e-9)
+    assert report.invariant_zeros[0].imag < 0

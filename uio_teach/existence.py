@@ -45,7 +45,9 @@ class Condition:
 
     @property
     def symbol(self) -> str:
-        """The verdict in one character; ✓, ✗ or – (not evaluated)."""
+        """The verdict in one character; ✓, ✗, – (not evaluated) or ○ (info, not met)."""
+        if not self.required and self.holds is False:
+            return "○"
         return {True: "✓", False: "✗", None: "–"}[self.holds]
 
 

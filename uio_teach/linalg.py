@@ -227,7 +227,11 @@ def _sort(z: np.ndarray) -> np.ndarray:
     z = np.asarray(z, complex)
     # clean tiny imaginary parts of real values
     z = np.where(np.abs(z.imag) <= 1e-10 * np.maximum(1.0, np.abs(z)), z.real + 0j, z)
-    return z[np.lexsort((z.imag, z.real))]
+    # sort on rounded keys so that a conjugate pair whose real parts differ by round-off
+    # always comes out in the same order (negative imaginary part first)
+    scale = max(1.0, float(np.max(np.abs(z)))) if z.size else 1.0
+    key_re = np.round(z.real / scale, 9)
+    return z[np.lexsort((z.imag, key_re))]
 
 
 def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.ndarray:

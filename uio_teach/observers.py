@@ -444,13 +444,28 @@ def _check_plant(plant: Any) -> Plant:
 
 
 def _decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
+    """Check an explicit gain; one that meets ``gain D = 0`` only to printed precision
+    (a gain copied from a document, rounded to 4 decimals) is projected onto it."""
     G = as_matrix(name, gain, plant.n, plant.p, what="n x p")
-    if plant.r and not np.allclose(G @ plant.D, 0, atol=1e-9 * max(1.0, np.abs(G).max())):
-        raise ValueError(
-            f"{name} D must be 0 so that the measurement disturbance does not enter the "
-            f"error; got {name} D = {np.array2string(G @ plant.D, precision=4)}"
+    if not plant.r:
+        return G
+    scale = max(1.0, float(np.abs(G).max()))
+    GD = G @ plant.D
+    residual = float(np.abs(GD).max())
+    if residual <= 1e-9 * scale:
+        return G
+    if residual <= 1e-3 * scale:
+        warnings.warn(
+            f"{name} D = {np.array2string(GD.ravel(), precision=2)} is not exactly 0 (a rounded "
+            f"gain?); using the nearest gain with {name} D = 0",
+            UserWarning,
+            stacklevel=3,
         )
-    return G
+        return G - GD @ pinv(plant.D)
+    raise ValueError(
+        f"{name} D must be 0 so that the measurement disturbance does not enter the "
+        f"error; got {name} D = {np.array2string(GD, precision=4)}"
+    )
 
 
 def _require(plant: Plant, what: str):
