@@ -13,7 +13,7 @@ True
 [-3.0, -2.0, -1.0]
 """
 
-from . import examples, linalg, signals
+from . import checks, examples, linalg, signals
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
 from .observers import (
@@ -39,6 +39,7 @@ __all__ = [
     "examples",
     "linalg",
     "signals",
+    "checks",
     "check_existence",
     "Condition",
     "ExistenceReport",
