@@ -30,7 +30,7 @@ from .observers import (
     design_uio,
 )
 from .plant import Plant
-from .simulation import UIOResponse, simulate
+from .simulation import SimulationInputs, UIOResponse, simulate
 
 __version__ = "0.1.0"
 
@@ -60,4 +60,5 @@ __all__ = [
     "UnstableObserverWarning",
     "simulate",
     "UIOResponse",
+    "SimulationInputs",
 ]

@@ -2,7 +2,7 @@
 
 Drawing code only; the numbers come from :func:`uio_teach.simulate` and
 :func:`uio_teach.reconstruct_input`. Every function returns the
-:class:`matplotlib.figure.Figure` and accepts an existing figure or axes.
+``matplotlib.figure.Figure`` and accepts an existing figure or axes.
 """
 
 from __future__ import annotations

@@ -24,13 +24,17 @@ involved: the only approximation is the straight line drawn between input
 samples, so smooth inputs converge like ``h**2`` and piecewise-linear inputs
 are simulated exactly (to rounding).
 
-**Fast recursion.** The forcing ``G0 s[k] + G1 s[k+1]`` is computed for all
-samples with one matrix product. The recursion ``z[k+1] = Phi z[k] + f[k]``
-is then run in the complex Schur coordinates of ``Phi = Z T Z^H``: ``T`` is
-upper triangular, so the last coordinate is a scalar first-order recursion,
-which :func:`scipy.signal.lfilter` runs in compiled code; the coordinate
-above it is again a scalar recursion once the ones below are known, and so on
-(back substitution). There is no Python loop over the samples.
+**Fast recursion.** The forcing of every step is computed with one matrix
+product over all samples. The recursion ``z[k+1] = Phi z[k] + f[k]`` is then
+run in the Schur coordinates of ``Phi = Z T Z^H`` (complex Schur form; real
+when every eigenvalue is real): ``T`` is upper triangular, so the last
+coordinate is a scalar first-order recursion, which
+:func:`scipy.signal.lfilter` runs in compiled code; the coordinate above it is
+again a scalar recursion once the ones below are known, and so on (back
+substitution). There is no Python loop over the samples. While it runs, BLAS
+is limited to one thread (with threadpoolctl, when installed): the products
+are small or thin, and on a 2-core machine OpenBLAS's worker threads made the
+whole simulation about three to ten times slower.
 """
 
 from __future__ import annotations
@@ -56,14 +60,14 @@ class SimulationInputs(NamedTuple):
 
     Attributes
     ----------
-    u : numpy.ndarray, shape (m, N)
-        Known inputs.
-    d : numpy.ndarray, shape (q, N)
-        Unknown inputs acting on the state.
-    v : numpy.ndarray, shape (r, N)
-        Measurement disturbances (through ``D``).
-    noise : numpy.ndarray, shape (p, N)
-        Measurement noise added to each output.
+    u : numpy.ndarray
+        Shape (m, N): known inputs.
+    d : numpy.ndarray
+        Shape (q, N): unknown inputs acting on the state.
+    v : numpy.ndarray
+        Shape (r, N): measurement disturbances (through ``D``).
+    noise : numpy.ndarray
+        Shape (p, N): measurement noise added to each output.
     """
 
     u: np.ndarray
@@ -80,22 +84,22 @@ class UIOResponse:
 
     Attributes
     ----------
-    time : numpy.ndarray, shape (N,)
-        The time points.
-    states : numpy.ndarray, shape (n, N)
-        Plant state ``x``.
-    outputs : numpy.ndarray, shape (p, N)
-        Measurement ``y = C x + D v + noise``.
-    estimates : numpy.ndarray, shape (n, N)
-        Observer estimate ``xhat``.
-    error : numpy.ndarray, shape (n, N)
-        Estimation error ``x - xhat``.
-    residual : numpy.ndarray, shape (p, N)
-        Output residual ``y - C xhat``.
+    time : numpy.ndarray
+        Shape (N,): the time points.
+    states : numpy.ndarray
+        Shape (n, N): plant state ``x``.
+    outputs : numpy.ndarray
+        Shape (p, N): measurement ``y = C x + D v + noise``.
+    estimates : numpy.ndarray
+        Shape (n, N): observer estimate ``xhat``.
+    error : numpy.ndarray
+        Shape (n, N): estimation error ``x - xhat``.
+    residual : numpy.ndarray
+        Shape (p, N): output residual ``y - C xhat``.
     inputs : SimulationInputs
         The samples of ``u``, ``d``, ``v`` and ``noise`` that were applied.
-    observer_states : numpy.ndarray, shape (n_w, N)
-        The observer's internal state ``w`` (``z`` of the UIO, ``q`` of the
+    observer_states : numpy.ndarray
+        Shape (n_w, N): the observer's internal state ``w`` (``z`` of the UIO, ``q`` of the
         PMO and g-inverse observer, ``xhat`` of the Luenberger observer).
     plant : Plant
         The simulated plant.
@@ -150,7 +154,7 @@ class UIOResponse:
         Parameters
         ----------
         **kwargs
-            Passed to :func:`uio_teach.plotting.plot_response` (``fig``,
+            Passed to ``uio_teach.plotting.plot_response`` (``fig``,
             ``axes``, ``title``).
 
         Returns
@@ -235,7 +239,8 @@ def _check_discrete_grid(plant: Plant, t: np.ndarray) -> float:
     return h
 
 
-def _finite_real(name: str, arr: Any, t: np.ndarray) -> np.ndarray:
+def _finite_real(name: str, arr: Any) -> np.ndarray:
+    """``arr`` as a float array; complex or non-numeric values raise a ValueError naming it."""
     if np.iscomplexobj(arr):
         raise ValueError(f"{name} must be real, got complex values")
     try:
@@ -253,7 +258,7 @@ def _call(name: str, func: Callable, t: np.ndarray, k: int) -> np.ndarray:
             f"calling {name} with the array of {t.size} time points failed ({exc}); a signal "
             "must be vectorized: it receives all the time points at once"
         ) from exc
-    arr = _finite_real(f"{name}(t)", raw, t)
+    arr = _finite_real(f"{name}(t)", raw)
     if k == 1 and arr.shape == (t.size,):
         arr = arr.reshape(1, -1)
     if arr.shape != (k, t.size):
@@ -292,7 +297,7 @@ def _signal(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
     elif callable(value):
         arr = _call(name, value, t, k)
     else:
-        arr = _finite_real(name, value, t)
+        arr = _finite_real(name, value)
         if arr.ndim == 1 and k == 1:
             arr = arr.reshape(1, -1)
         if arr.shape != (k, N):
@@ -313,7 +318,7 @@ def _signal(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
 def _vector(name: str, value: Any, size: int, what: str) -> np.ndarray:
     if value is None:
         return np.zeros(size)
-    arr = _finite_real(name, value, np.zeros(0))
+    arr = _finite_real(name, value)
     if arr.size != size or arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
         raise ValueError(f"{name} must have length {size} ({what}), got shape {arr.shape}")
     arr = arr.ravel()
@@ -325,7 +330,7 @@ def _vector(name: str, value: Any, size: int, what: str) -> np.ndarray:
 def _noise(noise: Any, seed: Any, p: int, N: int) -> np.ndarray:
     if noise is None:
         return np.zeros((p, N))
-    sd = _finite_real("noise", noise, np.zeros(0))
+    sd = _finite_real("noise", noise)
     if sd.ndim == 0:
         sd = np.full(p, float(sd))
     if sd.shape != (p,):
