@@ -30,6 +30,7 @@ from .observers import (
     design_uio,
 )
 from .plant import Plant
+from .reconstruction import InputEstimate, catch_time, reconstruct_input
 from .simulation import SimulationInputs, UIOResponse, simulate
 
 __version__ = "0.1.0"
@@ -61,4 +62,7 @@ __all__ = [
     "simulate",
     "UIOResponse",
     "SimulationInputs",
+    "reconstruct_input",
+    "InputEstimate",
+    "catch_time",
 ]
