@@ -13,7 +13,7 @@ True
 [-3.0, -2.0, -1.0]
 """
 
-from . import checks, examples, linalg, signals
+from . import checks, examples, linalg, plotting, signals
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
 from .observers import (
@@ -40,6 +40,7 @@ __all__ = [
     "examples",
     "linalg",
     "signals",
+    "plotting",
     "checks",
     "check_existence",
     "Condition",

@@ -115,7 +115,7 @@ class CheckResult:
 
     @property
     def messages(self) -> list[str]:
-        """Every message with its mark: ``"✓ ..."``, ``"✗ ..."`` or ``"• ..."``."""
+        """Every message with its mark (``"✓ ..."``, ``"✗ ..."`` or ``"• ..."``)."""
         return [f"{_SYMBOL[ok]} {msg}" for ok, msg in self.items]
 
     @property
