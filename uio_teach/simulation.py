@@ -68,6 +68,16 @@ class SimulationInputs(NamedTuple):
         Shape (r, N): measurement disturbances (through ``D``).
     noise : numpy.ndarray
         Shape (p, N): measurement noise added to each output.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> plant = ut.examples.pa9()
+    >>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    >>> res = ut.simulate(plant, obs, np.linspace(0, 1, 11), d=ut.signals.step(1.0))
+    >>> res.inputs.d.shape, res.inputs.u.shape
+    ((1, 11), (2, 11))
     """
 
     u: np.ndarray
