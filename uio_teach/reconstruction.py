@@ -194,8 +194,10 @@ def reconstruct_input(
       since ``(xhat - xf) / tau`` is the filtered derivative
       ``s / (tau s + 1) xhat``. Both filters are solved exactly on the grid
       for signals linear between samples. The trade-off: noise above about
-      ``1 / tau`` rad/s is attenuated (the noise on ``dhat`` drops roughly
-      by ``sqrt(tau / h)``), but ``dhat`` lags ``d`` by about ``tau`` and a
+      ``1 / tau`` rad/s is attenuated (for white sample noise the noise on
+      the derivative falls from about ``sigma / (sqrt(2) h)`` to about
+      ``sigma / tau``, i.e. by ``tau / (sqrt(2) h)``), but ``dhat`` lags ``d``
+      by about ``tau`` and a
       component of frequency ``w`` is scaled by ``1 / sqrt(1 + (w tau)**2)``.
       Choose ``tau`` well above ``h`` and well below the time scale of ``d``.
 
