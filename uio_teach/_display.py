@@ -20,19 +20,25 @@ def format_complex(z: complex, digits: int = 4) -> str:
     return f"{z.real:.{digits}g} {sign} {abs(z.imag):.{digits}g}j"
 
 
-def _clean(M: np.ndarray) -> np.ndarray:
-    """Real part if negligible imaginary, and round-off below 1e-12 of the largest entry to 0."""
+def _clean(M: np.ndarray, ref: float = 0.0) -> np.ndarray:
+    """Real part if negligible imaginary; round-off below 1e-12 of the largest entry (of this
+    matrix, or of ``ref``, the largest entry of the matrices shown together) set to 0."""
     M = np.real_if_close(np.asarray(M))
-    scale = np.max(np.abs(M)) if M.size else 0.0
+    scale = max(float(np.max(np.abs(M))) if M.size else 0.0, ref)
     return np.where(np.abs(M) <= 1e-12 * scale, 0.0, M)
 
 
-def format_matrix(M: np.ndarray, digits: int = 4) -> list[str]:
+def _ref(items: list[tuple[str, np.ndarray]]) -> float:
+    sizes = [float(np.max(np.abs(M))) for _, M in items if np.asarray(M).size]
+    return max(sizes, default=0.0)
+
+
+def format_matrix(M: np.ndarray, digits: int = 4, ref: float = 0.0) -> list[str]:
     """Return the rows of ``M`` as aligned strings."""
     M = np.asarray(M)
     if M.size == 0:
         return [f"(empty {M.shape[0]}x{M.shape[1]})"]
-    M = _clean(M)
+    M = _clean(M, ref)
     cells = [[f"{v:.{digits}g}" if v != 0 else "0" for v in row] for row in M]
     width = max(len(c) for row in cells for c in row)
     return ["[" + "  ".join(c.rjust(width) for c in row) + "]" for row in cells]
@@ -41,15 +47,17 @@ def format_matrix(M: np.ndarray, digits: int = 4) -> list[str]:
 def matrices_text(title: str, items: Iterable[tuple[str, np.ndarray]], digits: int = 4) -> str:
     """Stack named matrices under a title, one block each."""
     lines = [title]
+    items = list(items)
+    ref = _ref(items)
     for name, M in items:
-        rows = format_matrix(M, digits)
+        rows = format_matrix(M, digits, ref)
         pad = " " * (len(name) + 3)
         for i, row in enumerate(rows):
             lines.append((f"{name} = " if i == 0 else pad) + row)
     return "\n".join(lines)
 
 
-def _html_matrix(M: np.ndarray, digits: int) -> str:
+def _html_matrix(M: np.ndarray, digits: int, ref: float = 0.0) -> str:
     M = np.asarray(M)
     if M.size == 0:
         return f"<i>empty {M.shape[0]}&times;{M.shape[1]}</i>"
@@ -57,7 +65,7 @@ def _html_matrix(M: np.ndarray, digits: int) -> str:
         "<tr>"
         + "".join(f'<td style="text-align:right;padding:0 0.4em">{v:.{digits}g}</td>' for v in row)
         + "</tr>"
-        for row in _clean(M)
+        for row in _clean(M, ref)
     )
     return (
         '<table style="display:inline-table;border-left:1px solid;border-right:1px solid;'
@@ -68,10 +76,12 @@ def _html_matrix(M: np.ndarray, digits: int) -> str:
 def matrices_html(title: str, items: Iterable[tuple[str, np.ndarray]], digits: int = 4) -> str:
     """HTML version of :func:`matrices_text` for notebooks."""
     parts = [f"<div><b>{html.escape(title)}</b><br>"]
+    items = list(items)
+    ref = _ref(items)
     for name, M in items:
         parts.append(
             f'<span style="display:inline-block;margin-right:1em"><i>{html.escape(name)}</i> = '
-            f"{_html_matrix(M, digits)}</span>"
+            f"{_html_matrix(M, digits, ref)}</span>"
         )
     parts.append("</div>")
     return "".join(parts)
