@@ -1724,7 +1724,9 @@ class ExplorerFigure:
         legends = [ax.get_legend() for ax in self.axes.values() if ax.get_legend() is not None]
         return [*out, *legends, *self.notes.values(), self.title, self.footer]
 
-    def to_png(self, *, colors: int | None = None, draw: bool = True) -> bytes:
+    def to_png(
+        self, *, colors: int | None = None, draw: bool = True, compress_level: int | None = None
+    ) -> bytes:
         """The figure as PNG bytes, optionally with a reduced palette (much smaller files).
 
         Parameters
@@ -1735,6 +1737,8 @@ class ExplorerFigure:
             fast (for the live widget).
         draw : bool
             Render first; ``False`` reuses the last :meth:`draw`.
+        compress_level : int, optional
+            zlib level of the PNG (default 6 with ``colors``, 1 without).
 
         Returns
         -------
@@ -1760,9 +1764,9 @@ class ExplorerFigure:
         buf = io.BytesIO()
         if colors:
             img = img.quantize(colors=colors, method=Image.Quantize.FASTOCTREE, dither=0)
-            img.save(buf, format="png", compress_level=6)
+            img.save(buf, format="png", compress_level=compress_level or 6)
         else:
-            img.save(buf, format="png", compress_level=1)
+            img.save(buf, format="png", compress_level=compress_level or 1)
         return buf.getvalue()
 
 
