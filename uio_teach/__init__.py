@@ -35,6 +35,30 @@ from .simulation import SimulationInputs, UIOResponse, simulate
 
 __version__ = "0.1.0"
 
+# The explorers need ipywidgets and matplotlib: loaded on first use, not by `import uio_teach`.
+_LAZY = {
+    "widgets": None,
+    "explorer": None,
+    "static_explorer": None,
+    "pa9_explorer": "widgets",
+    "case_study_explorer": "widgets",
+    "missile_explorer": "widgets",
+}
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    module = importlib.import_module(f".{_LAZY[name] or name}", __name__)
+    return module if _LAZY[name] is None else getattr(module, name)
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])
+
+
 __all__ = [
     "Plant",
     "examples",
@@ -66,4 +90,10 @@ __all__ = [
     "reconstruct_input",
     "InputEstimate",
     "catch_time",
+    "widgets",
+    "explorer",
+    "static_explorer",
+    "pa9_explorer",
+    "case_study_explorer",
+    "missile_explorer",
 ]

@@ -1,0 +1,352 @@
+"""The live explorers (ipywidgets) and their static fallback (pre-computed frames in plain HTML).
+
+Live: each explorer builds, a control set programmatically redraws the figure with exactly what
+``ut.simulate`` returns for those settings, and any control value gives a picture or a message.
+Static: the expected number of frames, no external URL, and -- in headless Chromium -- moving
+the slider swaps the displayed frame.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import uio_teach as ut
+from uio_teach import widgets
+from uio_teach.explorer import DISTURBANCES, case_study_scenario, missile_scenario, pa9_scenario
+from uio_teach.static_explorer import static_explorer
+
+EXPLORERS = {
+    "pa9": widgets.pa9_explorer,
+    "case": widgets.case_study_explorer,
+    "missile": widgets.missile_explorer,
+    "own plant": lambda static=False: widgets.explorer(
+        ut.Plant(
+            [[0, 1], [-2, -1]], [[1, 0], [0, 1]], E=[[0], [1]], D=[[0.5], [1]], name="my plant"
+        ),
+        "pmo",
+        static=static,
+    ),
+    "missile g-inverse": lambda static=False: widgets.missile_explorer(
+        observer_family="ginverse", static=static
+    ),
+}
+WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+
+
+def ydata(ex, name):
+    return np.array([line.get_ydata() for line in ex.figure.lines[name]])
+
+
+def assert_same(actual, expected):
+    np.testing.assert_allclose(actual, expected, rtol=1e-12, atol=1e-12)
+
+
+# live: each explorer builds and its controls act -----------------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(EXPLORERS))
+def test_explorer_builds(name):
+    ex = EXPLORERS[name](static=False)
+    assert bytes(ex.image.value[:4]) == b"\x89PNG"
+    assert ex.frame is not None
+    assert ex.figure.lines["lb.error"][0].get_xdata().size == ex.scenario.timepts.size
+    for control in ex.controls.values():
+        if hasattr(control, "continuous_update"):
+            assert control.continuous_update is False
+
+
+def test_pa9_pole_slider_redraws_with_what_simulate_returns():
+    ex = widgets.pa9_explorer(static=False)
+    before = ydata(ex, "uio.error")
+    ex.controls["pole 1"].value = -4.0  # as a student's slider does
+    after = ydata(ex, "uio.error")
+    assert not np.allclose(before, after)
+    plant = ut.examples.pa9()
+    t = np.linspace(0, 10, 1001)
+    kwargs = dict(
+        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
+        d=ut.signals.sinusoid(1.0, 2.0),
+        initial_state=[1.0, -1.0, 0.5],
+    )
+    uio = ut.simulate(plant, ut.design_uio(plant, poles=[-4, -2, -3]), t, **kwargs)
+    lb = ut.simulate(plant, ut.design_luenberger(plant, poles=[-4, -2, -3]), t, **kwargs)
+    assert_same(after, uio.error)
+    assert_same(ydata(ex, "uio.residual"), uio.residual)
+    assert_same(ydata(ex, "lb.error"), lb.error)
+
+
+def test_pa9_complex_pair_and_disturbance_controls():
+    ex = widgets.pa9_explorer(static=False)
+    ex.set(pattern=1)
+    ex.set(**{"pole 1": -3.0, "pole 2 real part": -1.0, "pole 2 frequency": 2.0})
+    ex.set(disturbance="random steps", amplitude=2.0, period=1.5)
+    assert ex.controls["frequency"].layout.display == "none"
+    assert ex.controls["period"].layout.display is None
+    assert ex.settings.poles == (-3.0, -1 + 2j)
+    plant = ut.examples.pa9()
+    t = np.linspace(0, 10, 1001)
+    rng = np.random.default_rng([0, 0])
+    times = 1.5 * np.arange(8)
+    d = ut.signals.piecewise_constant(times, 2.0 * rng.uniform(-1, 1, 8))
+    uio = ut.simulate(
+        plant,
+        ut.design_uio(plant, poles=[-3, -1 + 2j, -1 - 2j]),
+        t,
+        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
+        d=d,
+        initial_state=[1.0, -1.0, 0.5],
+    )
+    assert_same(ex.figure.lines["d"][0].get_ydata(), d(t))
+    assert_same(ydata(ex, "uio.error"), uio.error)
+    # a zero imaginary part is a double real pole
+    ex.set(**{"pole 2 frequency": 0.0})
+    assert ex.settings.poles == (-3.0, -1.0, -1.0)
+    assert ex.frame.observer is not None
+
+
+def test_case_study_pole_and_lmi_mode():
+    ex = widgets.case_study_explorer(static=False)
+    ex.controls["pole 1"].value = 0.4
+    plant = ut.examples.dt_case_study()
+    steps = np.arange(41)
+    pmo = ut.simulate(
+        plant,
+        ut.design_pmo(plant, poles=[0.4]),
+        steps,
+        d=ut.signals.sinusoid(2.0, 0.6),
+        v=ut.signals.sinusoid(1.0, 1.2),
+        initial_state=[1.0, -2.0, 3.0],
+    )
+    assert_same(ydata(ex, "uio.error"), pmo.error)
+    ex.controls["mode"].value = "lmi"
+    assert ex._pole_box.layout.display == "none"
+    assert ex.controls["decay"].layout.display is None
+    ex.controls["decay"].value = 0.8
+    lmi = ut.design_pmo(plant, method="lmi", decay=0.8)
+    np.testing.assert_allclose(np.sort(ex.frame.poles.real), np.sort(lmi.poles().real), atol=1e-9)
+    ex.controls["decay"].value = 0.4
+    assert "infeasible" in ex.message.value
+    assert ex.figure.lines["uio.error"][0].get_xdata().size == 0
+
+
+def test_missile_filter_slider_redraws_the_reconstruction():
+    ex = widgets.missile_explorer(static=False)
+    before = ydata(ex, "uio.input")
+    ex.controls["tau"].value = 0.01
+    after = ydata(ex, "uio.input")
+    assert not np.allclose(before, after)
+    plant = ut.examples.missile_autopilot()
+    resp = ut.simulate(
+        plant,
+        ut.design_pmo(plant, poles=[-100, -120]),
+        np.linspace(0, 0.5, 1001),
+        d=ut.examples.missile_inputs(),
+        initial_state=ut.examples.MISSILE_PUBLISHED.x0,
+    )
+    est = ut.reconstruct_input(plant, resp, method="filtered", tau=0.01)
+    assert_same(after, est.estimates)
+    ex.controls["tau"].value = 0.0  # plain derivative
+    assert_same(ydata(ex, "uio.input"), ut.reconstruct_input(plant, resp).estimates)
+
+
+def test_unstable_pole_message_in_the_widget():
+    ex = widgets.pa9_explorer(static=False)
+    ex.controls["pole 1"].value = 1.0
+    assert "this pole makes the UIO unstable: the error grows" in ex.message.value
+    assert ex.figure.notes["uio"].get_visible()
+    assert np.abs(ydata(ex, "uio.error")).max() <= ex.frame.limits["error"]
+
+
+def test_mimebundle_has_the_widget_and_the_static_frames():
+    ex = widgets.case_study_explorer()
+    bundle = ex._repr_mimebundle_()
+    assert set(bundle) == {"text/plain", "text/html", WIDGET_VIEW}
+    assert bundle[WIDGET_VIEW]["model_id"] == ex.widget.model_id
+    assert bundle["text/html"].count('data-k="') == 6 * len(DISTURBANCES)
+    assert "kernel" in bundle["text/plain"]
+    assert "text/html" not in widgets.case_study_explorer(static=False)._repr_mimebundle_()
+
+
+def test_lazy_import():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, uio_teach as ut; assert 'ipywidgets' not in sys.modules; "
+        "ut.pa9_explorer; assert 'ipywidgets' in sys.modules; "
+        "assert ut.widgets.explorer is not None and ut.explorer.compute_frame"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# live: every control value gives a picture or a message ----------------------------------
+
+
+def _choices(control):
+    """Extremes and random values of a slider, or the options of a dropdown."""
+    if hasattr(control, "options"):
+        values = [o[1] if isinstance(o, tuple) else o for o in control.options]
+        return st.sampled_from(values)
+    lo, hi = control.min, control.max
+    return st.one_of(st.sampled_from([lo, hi]), st.floats(lo, hi))
+
+
+@pytest.mark.parametrize("name", sorted(EXPLORERS))
+def test_every_control_value_gives_a_picture_or_a_message(name):
+    ex = EXPLORERS[name](static=False)
+
+    @st.composite
+    def changes(draw):
+        out = []
+        for _ in range(draw(st.integers(1, 4))):
+            key = draw(st.sampled_from(sorted(ex.controls)))
+            out.append((key, draw(_choices(ex.controls[key]))))
+        return out
+
+    @settings(
+        max_examples=20,
+        derandomize=True,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow],
+    )
+    @given(changes())
+    def check(steps):
+        for key, value in steps:
+            if key in ex.controls:  # the pattern control replaces the pole controls
+                ex.controls[key].value = value
+        frame = ex.frame
+        assert "could not update" not in ex.message.value
+        assert bytes(ex.image.value[:4]) == b"\x89PNG"
+        assert frame.curves.get("uio.error") is not None or frame.observer_message
+        assert frame.curves.get("lb.error") is not None or frame.luenberger_message
+        assert frame.settings == ex.settings
+
+    check()
+
+
+# static fallback --------------------------------------------------------------------------
+
+
+class _Links(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.urls: list[str] = []
+        self.tags: list[str] = []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        for key, value in attrs:
+            if key in ("src", "href", "data-src", "action"):
+                self.urls.append(value or "")
+
+
+@pytest.fixture(scope="module")
+def pa9_static():
+    return static_explorer(pa9_scenario())
+
+
+def test_static_frames_count_size_and_no_external_url(pa9_static):
+    page = pa9_static
+    assert page.count == len(pa9_scenario().static_values) * len(DISTURBANCES) == 24
+    parser = _Links()
+    parser.feed(page.html)
+    assert "script" not in parser.tags and "link" not in parser.tags
+    assert parser.urls and all(u.startswith("data:image/png;base64,") for u in parser.urls)
+    assert "http" not in page.html.lower()  # not even by chance inside the base64 text
+    assert len(page.html) < 1_000_000
+    assert len(re.findall(r'data-k="\d+-\d+"', page.html)) == 24
+
+
+def test_static_ids_are_unique_and_frames_differ():
+    a = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
+    b = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
+    assert a.element_id != b.element_id
+    assert a.frames[0].png != a.frames[1].png
+    assert a.frames[0].settings.poles == (0.0,) and a.frames[1].settings.poles == (0.9,)
+
+
+def test_static_missile_page_is_light():
+    page = static_explorer(missile_scenario())
+    assert page.count == 24
+    assert len(page.html) < 1_000_000
+    assert any("clipped" in f.caption for f in page.frames)
+    assert any("unstable" in f.caption for f in page.frames)
+
+
+def test_static_rejects_bad_grids():
+    with pytest.raises(ValueError, match="unknown disturbance"):
+        static_explorer(pa9_scenario(), disturbances=("hail",))
+    with pytest.raises(ValueError, match="at least one value"):
+        static_explorer(pa9_scenario(), values=())
+
+
+CHROMIUM = Path("/usr/bin/chromium")
+
+
+@pytest.mark.browser
+def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
+    if not CHROMIUM.exists():
+        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
+        if os.environ.get("CI") == "true":
+            pytest.fail(message, pytrace=False)
+        pytest.skip(message)
+    from playwright.sync_api import sync_playwright
+
+    page_file = tmp_path / "explorer.html"
+    page_file.write_text(
+        f"<!doctype html><html><body>{pa9_static.html}</body></html>", encoding="utf-8"
+    )
+    frames = {f.index: f for f in pa9_static.frames}
+    eid = pa9_static.element_id
+    requests: list[str] = []
+    errors: list[str] = []
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(
+            executable_path=str(CHROMIUM),
+            args=["--headless", "--no-sandbox", "--disable-gpu"],
+            headless=True,
+        )
+        try:
+            tab = browser.new_page()
+            tab.on("request", lambda r: requests.append(r.url))
+            tab.on("pageerror", lambda exc: errors.append(str(exc)))
+            tab.goto(page_file.as_uri())
+            img = f"#{eid} img.uio-frame"
+            start = tab.get_attribute(img, "src")
+            assert start == frames[(2, 0)].data_url  # the default pole -1, sinusoid
+
+            tab.eval_on_selector(
+                f"#{eid} input[type=range]",
+                "el => { el.value = '4'; el.dispatchEvent(new Event('input', {bubbles: true})); }",
+            )
+            moved = tab.get_attribute(img, "src")
+            assert moved != start and moved == frames[(4, 0)].data_url
+            assert tab.inner_text(f"#{eid} output") == "-4"
+            assert tab.inner_text(f"#{eid} .uio-caption") == frames[(4, 0)].caption
+
+            tab.select_option(f"#{eid} select", "3")  # random steps
+            assert tab.get_attribute(img, "src") == frames[(4, 3)].data_url
+
+            tab.eval_on_selector(
+                f"#{eid} input[type=range]",
+                "el => { el.value = '0'; el.dispatchEvent(new Event('input', {bubbles: true})); }",
+            )
+            assert "unstable" in tab.inner_text(f"#{eid} .uio-caption")
+            natural = tab.eval_on_selector(img, "el => el.naturalWidth")
+            assert natural > 300
+        finally:
+            browser.close()
+    assert not errors, errors
+    assert all(u.startswith(("file:", "data:")) for u in requests), requests
