@@ -1,0 +1,380 @@
+"""`uio-teach labs`: student and solution notebooks from one MyST lab chapter.
+
+The student notebook runs from top to bottom, and each check cell says what is still
+missing; the solution notebook runs and every check passes. Both are valid nbformat 4
+notebooks with empty outputs and no MyST syntax left that Jupyter would show raw.
+"""
+
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+
+import jupytext
+import nbclient
+import nbformat
+import pytest
+
+from uio_teach import cli, labs
+
+BOOK = Path(__file__).resolve().parents[1] / "book"
+LABS = labs.find_labs(BOOK)
+CELL_TIMEOUT = 300
+
+pytestmark = pytest.mark.skipif(not LABS, reason="no lab chapter (book/*lab*.md) yet")
+
+
+def tags(cell) -> list[str]:
+    return list(cell.metadata.get("tags", []))
+
+
+def text_output(cell) -> str:
+    parts = []
+    for out in cell.get("outputs", []):
+        if out.output_type == "stream":
+            parts.append(out.text)
+        elif out.output_type in ("execute_result", "display_data"):
+            parts.append(out.data.get("text/plain", ""))
+        elif out.output_type == "error":
+            parts.append("\n".join(out.traceback))
+    return "\n".join(parts)
+
+
+def execute(nb, folder: Path):
+    client = nbclient.NotebookClient(
+        nb,
+        timeout=CELL_TIMEOUT,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(folder)}},
+    )
+    client.execute()  # raises CellExecutionError on the first failing cell
+    return nb
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory) -> dict:
+    out = tmp_path_factory.mktemp("labs")
+    results = labs.write_labs(out, book_dir=BOOK)
+    return {"out": out, "results": results}
+
+
+def read(path: Path):
+    return nbformat.read(path, as_version=4)
+
+
+@pytest.fixture(scope="module", params=[p.name for p in LABS])
+def lab(request, written) -> dict:
+    result = next(r for r in written["results"] if r.source.name == request.param)
+    return {
+        "source": result.source,
+        "myst": jupytext.read(result.source),
+        "student": read(result.student),
+        "solution": read(result.solution),
+        "result": result,
+    }
+
+
+# structure --------------------------------------------------------------------------------------
+
+
+def test_every_lab_gets_a_student_and_a_solution_notebook(written):
+    out = written["out"]
+    assert {r.source for r in written["results"]} == set(LABS)
+    for path in LABS:
+        for version in labs.VERSIONS:
+            assert (out / version / f"{path.stem}.ipynb").is_file()
+
+
+@pytest.mark.parametrize("version", labs.VERSIONS)
+def test_notebooks_are_valid_nbformat_4_with_empty_outputs(lab, version):
+    nb = lab[version]
+    nbformat.validate(nb)
+    assert nb.nbformat == 4
+    assert nb.metadata.kernelspec.name == "python3"
+    assert nb.metadata.uio_teach == {"source": lab["source"].name, "version": version}
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            assert cell.outputs == [] and cell.execution_count is None
+    assert len({cell.id for cell in nb.cells}) == len(nb.cells)
+
+
+def solution_cells(myst) -> list[str]:
+    """Sources of the code cells that are solutions (inside a block, or tagged)."""
+    out, inside = [], False
+    for cell in myst.cells:
+        if cell.cell_type == "markdown":
+            for line in cell.source.splitlines():
+                if "{solution-start}" in line:
+                    inside = True
+                elif "{solution-end}" in line:
+                    inside = False
+        elif inside or "solution" in tags(cell):
+            out.append(cell.source)
+    return out
+
+
+def test_the_student_version_has_no_solution(lab):
+    student = lab["student"]
+    code = "\n".join(c.source for c in student.cells if c.cell_type == "code")
+    solutions = solution_cells(lab["myst"])
+    assert solutions, "the lab chapter has no solution cells"
+    for source in solutions:
+        assert source.strip() not in code
+    assert not any("solution" in tags(c) or "instructor" in tags(c) for c in student.cells)
+    text = "\n".join(c.source for c in student.cells)
+    assert "Solution of Exercise" not in text and "Instructor notes" not in text
+
+
+def test_each_solution_becomes_one_todo_cell_with_its_exercise_label(lab):
+    myst_text = lab["source"].read_text(encoding="utf-8")
+    blocks = re.findall(r"\{solution-start\}\s*(\S+)", myst_text)
+    todo = [c for c in lab["student"].cells if "todo" in tags(c)]
+    assert len(todo) == len(blocks) == lab["result"].todo_cells
+    for cell, label in zip(todo, blocks, strict=True):
+        first = cell.source.splitlines()[0]
+        assert first.startswith("# TODO: Exercise ") and f"({label})" in first
+
+
+def test_the_check_cells_are_kept_in_both_versions(lab):
+    solutions = solution_cells(lab["myst"])
+    source_checks = [
+        c.source
+        for c in lab["myst"].cells
+        if c.cell_type == "code"
+        and re.search(r"\bchecks\.\w+\(", c.source)
+        and c.source not in solutions
+    ]
+    assert source_checks, "the lab has no check cells"
+    solution = [c for c in lab["solution"].cells if "check" in tags(c)]
+    assert [c.source for c in solution] == source_checks
+    for_students = [c.source for c in solution if "instructor" not in tags(c)]
+    assert for_students  # the checks that follow the exercises, not the instructor's demos
+    assert [c.source for c in lab["student"].cells if "check" in tags(c)] == for_students
+
+
+def test_the_solution_version_is_complete(lab):
+    source_code = [c.source for c in lab["myst"].cells if c.cell_type == "code"]
+    solution_code = [c.source for c in lab["solution"].cells if c.cell_type == "code"]
+    assert solution_code == source_code
+    for source in solution_cells(lab["myst"]):
+        cell = next(c for c in lab["solution"].cells if c.source == source)
+        assert "solution" in tags(cell)
+
+
+@pytest.mark.parametrize("version", labs.VERSIONS)
+def test_no_raw_myst_is_left_in_the_markdown(lab, version):
+    for cell in lab[version].cells:
+        if cell.cell_type != "markdown":
+            continue
+        assert not re.search(r"^(```|:::)\{", cell.source, re.M), cell.source[:200]
+        assert not re.search(r"\{[\w:.-]+\}`", cell.source), cell.source[:200]
+        assert not re.search(r"^\([\w:.-]+\)=\s*$", cell.source, re.M), cell.source[:200]
+    text = "\n".join(c.source for c in lab[version].cells)
+    assert re.search(r"\*\*Exercise \d+(\.\d+)?\*\*", text)
+
+
+# execution --------------------------------------------------------------------------------------
+
+
+@pytest.mark.book
+def test_the_student_version_runs_and_its_checks_say_what_is_missing(lab, tmp_path):
+    nb = execute(lab["student"], tmp_path)  # no cell may fail: TODO cells define placeholders
+    checks = [c for c in nb.cells if "check" in tags(c)]
+    assert checks
+    for cell in checks:
+        out = text_output(cell)
+        assert "Traceback" not in out and "Error" not in out.split("\n")[0]
+        assert "✗" in out and "checks failed" in out, out
+        assert "missing" in out or "got None" in out or "got NoneType" in out, out
+
+
+@pytest.mark.book
+def test_the_solution_version_runs_and_every_check_passes(lab, tmp_path):
+    nb = execute(lab["solution"], tmp_path)
+    checks = [c for c in nb.cells if "check" in tags(c) and "instructor" not in tags(c)]
+    assert checks
+    for cell in checks:
+        out = text_output(cell)
+        assert re.search(r"All \d+ checks passed\.", out), f"{cell.source}\n{out}"
+        assert "✗" not in out
+
+
+# the conversion, on a small made-up lab ---------------------------------------------------------
+
+SMALL_LAB = textwrap.dedent(
+    """\
+    ---
+    jupytext:
+      text_representation:
+        extension: .md
+        format_name: myst
+    kernelspec:
+      display_name: Python 3
+      language: python
+      name: python3
+    ---
+
+    (sec-small)=
+    # A small lab
+
+    See {cite:p}`smith` and {ref}`sec-small-two`; equation {eq}`eq-small-one`:
+
+    $$
+    y = 2x
+    $$ (eq-small-one)
+
+    ```python
+    # not a heading: inside a fenced code block
+    ```
+
+    ```{code-cell} ipython3
+    import math
+    ```
+
+    ```{exercise}
+    :label: ex-small-1
+    Compute `y` for $x = 21$.
+    ```
+
+    ```{solution-start} ex-small-1
+    :class: dropdown
+    ```
+
+    ```{code-cell} ipython3
+    x = 21
+    y = 2 * x
+    helper = math.pi
+    ```
+
+    Because $y = 2x$.
+
+    ```{solution-end}
+    ```
+
+    ```{code-cell} ipython3
+    assert y == 42
+    ```
+
+    (sec-small-two)=
+    ## Part two
+
+    :::{exercise}
+    :label: ex-small-2
+    Why?
+    :::
+
+    ```{solution-start} ex-small-2
+    ```
+    Because.
+    ```{solution-end}
+    ```
+
+    ```{code-cell} ipython3
+    :tags: [solution]
+
+    z = y + 1
+    ```
+
+    ```{code-cell} ipython3
+    print(z)
+    ```
+
+    (sec-small-instructor)=
+    ## Notes for the marker
+
+    ```{code-cell} ipython3
+    print("only for instructors", y)
+    ```
+
+    ## After the notes
+
+    ```{note}
+    Kept for everyone.
+    ```
+    """
+)
+
+SMALL_BIB = "@article{smith,\n  author = {Smith, Ann and Jones, Bo},\n  year = {2001},\n}\n"
+
+
+@pytest.fixture()
+def small_lab(tmp_path) -> Path:
+    book = tmp_path / "book"
+    book.mkdir()
+    (tmp_path / "references.bib").write_text(SMALL_BIB)
+    path = book / "lab_small.md"
+    path.write_text(SMALL_LAB)
+    return path
+
+
+def test_small_lab_student_version(small_lab, tmp_path):
+    nb = labs.make_notebook(small_lab, "student")
+    nbformat.validate(nb)
+    sources = [c.source for c in nb.cells]
+    text = "\n".join(sources)
+    todo = [c.source for c in nb.cells if "todo" in tags(c)]
+    assert todo[0].splitlines() == [
+        "# TODO: Exercise 1 (ex-small-1). Write your code here.",
+        "# The cells below use these names; replace None by your answer:",
+        "y = None",
+    ]  # x and helper are not used later: no placeholder for them
+    assert todo[1].startswith("**Your answer to Exercise 2 (ex-small-2):**")  # prose only
+    assert todo[2].splitlines()[0] == "# TODO: Exercise 2 (ex-small-2). Write your code here."
+    assert "z = None" in todo[2]
+    assert "Because" not in text and "only for instructors" not in text
+    assert "Notes for the marker" not in text
+    assert "After the notes" in text and "> **Note.** Kept for everyone." in text
+    assert "(Smith and Jones, 2001)" in text
+    assert "See (Smith and Jones, 2001) and *Part two*; equation (1):" in text
+    assert "$$\ny = 2x \\tag{1}$$" in text
+    assert "# not a heading" in text  # fenced code is left alone
+    assert "> **Exercise 1**" in text and "> **Exercise 2**" in text
+    # it runs up to the end: the check cell fails on the placeholder, as a student would see
+    with pytest.raises(nbclient.exceptions.CellExecutionError, match="assert y == 42"):
+        execute(nb, tmp_path)
+
+
+def test_small_lab_solution_version(small_lab, tmp_path):
+    nb = labs.make_notebook(small_lab, "solution")
+    text = "\n".join(c.source for c in nb.cells)
+    assert "Because $y = 2x$." in text and "Notes for the marker" in text
+    marker = [c for c in nb.cells if "instructor" in tags(c)]
+    assert any("only for instructors" in c.source for c in marker)
+    assert not any("After the notes" in c.source for c in marker)
+    assert [c.source for c in nb.cells if "solution" in tags(c) and c.cell_type == "code"] == [
+        "x = 21\ny = 2 * x\nhelper = math.pi",
+        "z = y + 1",
+    ]
+    execute(nb, tmp_path)
+
+
+def test_an_unclosed_solution_block_is_an_error(tmp_path):
+    path = tmp_path / "lab_broken.md"
+    path.write_text("# Lab\n\n```{solution-start} ex-1\n```\n\nforever\n")
+    with pytest.raises(labs.LabError, match="lab_broken.md: solution block 'ex-1' is never closed"):
+        labs.make_notebook(path, "student")
+
+
+# the command ------------------------------------------------------------------------------------
+
+
+def test_labs_command_writes_both_versions_with_a_summary(tmp_path, capsys):
+    code = cli.main(["labs", "--out", str(tmp_path)])
+    out = capsys.readouterr().out.strip().splitlines()
+    assert code == 0
+    assert len(out) == len(LABS) + 1
+    assert out[-1].startswith(f"{len(LABS)} lab")
+    assert f"written to {tmp_path}" in out[-1]
+    for path in LABS:
+        for version in labs.VERSIONS:
+            nbformat.validate(read(tmp_path / version / f"{path.stem}.ipynb"))
+
+
+def test_labs_command_fails_clearly_on_a_missing_source(tmp_path, capsys):
+    code = cli.main(["labs", "--out", str(tmp_path), "--source", "no_such_lab.md"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert err == "uio-teach labs: error: no_such_lab.md: no such file\n"
+    code = cli.main(["labs", "--out", str(tmp_path), "--book", str(tmp_path)])
+    assert code == 1 and "no lab chapter" in capsys.readouterr().err
