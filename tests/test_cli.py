@@ -213,8 +213,15 @@ def test_table_ii_holds_catch_times_computed_with_catch_time(two_runs):
     plant = ut.examples.missile_autopilot()
     cfg = figures.FigureConfig()
     t = np.linspace(0, cfg["missile.duration"], cfg["missile.samples"])
+    # both observers start from q(0) = -M y(0), as the figures command documents
+    q0 = -ut.design_pmo(plant, poles=cfg["missile.pmo_poles"]).M @ plant.C @ pub.x0
     resp = ut.simulate(
-        plant, ut.design_ginverse(plant), t, d=ut.examples.missile_inputs(), initial_state=pub.x0
+        plant,
+        ut.design_ginverse(plant),
+        t,
+        d=ut.examples.missile_inputs(),
+        initial_state=pub.x0,
+        observer_state=q0,
     )
     est = ut.reconstruct_input(plant, resp)
     expected = list(ut.catch_time(t, resp.states, resp.estimates, tol=0.02)) + list(

@@ -133,7 +133,9 @@ _SCHEMA: dict[str, _Option] = {
         "float", 1.0, "v: a random staircase, levels uniform in [-amplitude, amplitude]", minimum=0
     ),
     "case_study.v.hold": _Option("int", 5, "steps each level of v is held", minimum=1),
-    "missile.pmo_poles": _Option("poles", [-80.0, -120.0], "PMO poles (the paper's are not given)"),
+    "missile.pmo_poles": _Option(
+        "poles", [-100.0, -120.0], "PMO poles (the paper's are not given; see chapter 5)"
+    ),
     "missile.duration": _Option("float", 0.3, "simulated time in s", positive=True),
     "missile.samples": _Option("int", 6001, "number of time points", minimum=2),
 }
@@ -605,9 +607,14 @@ class _Runs:
         v = ut.examples.missile_inputs()
         out: dict[str, Any] = {"plant": plant, "time": t}
         out["free"] = ut.simulate(plant, ut.design_ginverse(plant), t, initial_state=x0)
-        for name, obs in (("pmo", _design(c, "missile.pmo_poles")), ("ginverse", None)):
-            obs = obs if obs is not None else ut.design_ginverse(plant)
-            resp = ut.simulate(plant, obs, t, d=v, initial_state=x0)
+        pmo = _design(c, "missile.pmo_poles")
+        # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
+        # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
+        # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles
+        # (chapter 5 explains both starts and Table II).
+        q0 = -pmo.M @ plant.C @ x0
+        for name, obs in (("pmo", pmo), ("ginverse", ut.design_ginverse(plant))):
+            resp = ut.simulate(plant, obs, t, d=v, initial_state=x0, observer_state=q0)
             est = ut.reconstruct_input(plant, resp)
             out[name] = {
                 "observer": obs,
