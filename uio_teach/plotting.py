@@ -75,6 +75,26 @@ def _line(ax: Axes, t: np.ndarray, values: np.ndarray, discrete: bool, **kwargs:
         ax.plot(t, values, **kwargs)
 
 
+def _actual_and_estimate(
+    ax: Axes,
+    t: np.ndarray,
+    actual: np.ndarray | None,
+    estimate: np.ndarray,
+    discrete: bool,
+    symbol: str,
+    i: int,
+) -> None:
+    """One panel: a signal (coloured) and its estimate (black, dashed), labelled."""
+    name = f"{symbol}_{{{i + 1}}}"
+    if actual is not None:
+        _line(ax, t, actual, discrete, label=f"${name}$", color=f"C{i}")
+    hat = f"$\\hat{{{symbol}}}_{{{i + 1}}}$"
+    _line(ax, t, estimate, discrete, label=hat, color="k", linestyle="--", linewidth=1.0)
+    ax.set_ylabel(f"${name}$")
+    ax.legend(loc="upper right", fontsize="small")
+    ax.grid(True, alpha=0.3)
+
+
 def plot_response(
     response: UIOResponse,
     *,
@@ -130,20 +150,7 @@ def plot_response(
     state_axes, ax_err, ax_res = ax[:n], ax[n], ax[n + 1]
     xlabel = time_label(plant.dt)
     for i, a in enumerate(state_axes):
-        _line(a, t, response.states[i], discrete, label=f"$x_{{{i + 1}}}$", color=f"C{i}")
-        _line(
-            a,
-            t,
-            response.estimates[i],
-            discrete,
-            label=f"$\\hat{{x}}_{{{i + 1}}}$",
-            color="k",
-            linestyle="--",
-            linewidth=1.0,
-        )
-        a.set_ylabel(f"$x_{{{i + 1}}}$")
-        a.legend(loc="upper right", fontsize="small")
-        a.grid(True, alpha=0.3)
+        _actual_and_estimate(a, t, response.states[i], response.estimates[i], discrete, "x", i)
     state_axes[-1].set_xlabel(xlabel)
     for i in range(n):
         _line(ax_err, t, response.error[i], discrete, label=f"$e_{{{i + 1}}}$", color=f"C{i}")
@@ -168,6 +175,7 @@ def plot_input_estimate(
     fig: Figure | None = None,
     axes: Sequence[Axes] | None = None,
     title: str | None = None,
+    symbol: str = "d",
 ) -> Figure:
     """One panel per unknown input: the true ``d_i`` and its reconstruction.
 
@@ -181,6 +189,9 @@ def plot_input_estimate(
         ``q`` axes to draw into instead.
     title : str, optional
         Figure title; by default the method (and ``tau``).
+    symbol : str, optional
+        Letter of the unknown input in the labels (``"v"`` for the missile
+        paper's ``v1``, ``v2``).
 
     Returns
     -------
@@ -201,24 +212,11 @@ def plot_input_estimate(
     q = estimate.estimates.shape[0]
     t = estimate.time
     discrete = estimate.dt is not None
-    names = [f"d{i}" for i in range(q)]
+    names = [f"{symbol}{i}" for i in range(q)]
     fig, ax = _figure_and_axes(fig, axes, names, [[name] for name in names], 1.2 + 2.2 * q)
     for i, a in enumerate(ax):
-        if estimate.actual is not None:
-            _line(a, t, estimate.actual[i], discrete, label=f"$d_{{{i + 1}}}$", color=f"C{i}")
-        _line(
-            a,
-            t,
-            estimate.estimates[i],
-            discrete,
-            label=f"$\\hat{{d}}_{{{i + 1}}}$",
-            color="k",
-            linestyle="--",
-            linewidth=1.0,
-        )
-        a.set_ylabel(f"$d_{{{i + 1}}}$")
-        a.legend(loc="upper right", fontsize="small")
-        a.grid(True, alpha=0.3)
+        actual = None if estimate.actual is None else estimate.actual[i]
+        _actual_and_estimate(a, t, actual, estimate.estimates[i], discrete, symbol, i)
     ax[-1].set_xlabel(time_label(estimate.dt))
     if title is None:
         title = f"unknown input reconstruction ({estimate.method}"
