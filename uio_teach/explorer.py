@@ -109,6 +109,16 @@ FAMILIES = {"uio": "UIO", "pmo": "PMO", "ginverse": "g-inverse observer"}
 """Observer families (argument value: display name)."""
 
 _WRAP = 34  # characters per line of a message drawn inside a panel
+# Legends inside the panels are opaque and square: drawn over the curves, they hide exactly
+# their box, which lets the fast redraw paint them back from the stored background.
+_LEGEND = {
+    "loc": "upper right",
+    "fontsize": 7,
+    "ncol": 2,
+    "handlelength": 1.2,
+    "framealpha": 1.0,
+    "fancybox": False,
+}
 
 
 # settings --------------------------------------------------------------------------------
@@ -1426,7 +1436,7 @@ class ExplorerFigure:
                 if who == "uio":
                     ax.set_ylabel(ylabels[r], fontsize=8)
                     if counts[r]:
-                        ax.legend(loc="upper right", fontsize=7, ncol=2, handlelength=1.2)
+                        ax.legend(**_LEGEND)
             axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8)
         axes["uio.error"].set_title(
             f"{scenario.observer_name} (decouples {sym})", fontsize=9, fontweight="bold"
@@ -1502,7 +1512,7 @@ class ExplorerFigure:
             for i in range(plant.r)
         ]
         if plant.q + plant.r:
-            sig.legend(loc="upper right", fontsize=7, handlelength=1.2)
+            sig.legend(**_LEGEND)
         sig.set_xlabel(xlabel, fontsize=8)
         sig.grid(True, alpha=0.3)
         sig.yaxis.set_major_locator(MaxNLocator(5))
@@ -1518,6 +1528,7 @@ class ExplorerFigure:
         self._keys: dict[str, tuple] = {}
         self._cells: dict | None = None
         self._fresh = True
+        self._legend_boxes: list[tuple[int, int, int, int]] = []
 
     def update(self, frame: Frame) -> None:
         """Show a frame: new data in the existing lines and texts, axes rescaled.
@@ -1612,13 +1623,15 @@ class ExplorerFigure:
     def draw(self) -> None:
         """Render the figure with Agg, redrawing only what changed.
 
-        The lines, markers and texts that change from frame to frame are
-        drawn on a stored copy of the rest of the figure (blitting). When an
-        axis range changes, only that panel is redrawn into the copy (it
-        owns a fixed cell of the figure); the first call, or a panel that
-        would not fit its cell, renders everything (``fig.canvas.draw()``).
-        The figure stays an ordinary figure: ``fig.savefig`` draws
-        everything.
+        A copy of the figure without its curves, markers and messages (axes,
+        ticks, legends, titles) is kept. Each call paints the copy back,
+        draws the curves, markers and messages on it, and paints the legends
+        back over the curves (blitting). When an axis range changes, only that
+        panel is redrawn into the copy (each panel owns a fixed cell of the
+        figure), and a changed title or footer only its band. The first call,
+        or a panel or text that would not fit its place, renders everything
+        (``fig.canvas.draw()``). The figure stays an ordinary figure:
+        ``fig.savefig`` draws everything.
 
         Examples
         --------
@@ -1634,6 +1647,8 @@ class ExplorerFigure:
         """
         canvas = self.fig.canvas
         keys = {name: (*ax.get_xlim(), *ax.get_ylim()) for name, ax in self.axes.items()}
+        keys["title"] = (self.title.get_text(),)
+        keys["footer"] = (self.footer.get_text(),)
         changed = [name for name, key in keys.items() if self._keys.get(name) != key]
         if self._background is None or changed:
             dynamic = self._dynamic_artists()
@@ -1647,18 +1662,43 @@ class ExplorerFigure:
                         self._cells = self._find_cells()
                 self._background = canvas.copy_from_bbox(self.fig.bbox)
                 self._keys = keys
+                self._legend_boxes = self._legend_regions()
             finally:
                 for artist in dynamic:
                     artist.set_animated(False)
         else:
             canvas.restore_region(self._background)
         renderer = canvas.get_renderer()
+        notes = list(self.notes.values())
         for artist in self._dynamic_artists():
-            if artist.get_visible():
+            if artist.get_visible() and artist not in notes:
                 artist.draw(renderer)
+        for box in self._legend_boxes:  # the legends cover the curves, as in a full draw
+            # xy: where the stored region's corner goes (the whole figure: no shift)
+            canvas.restore_region(self._background, bbox=box, xy=(0, 0))
+        for note in notes:
+            if note.get_visible():
+                note.draw(renderer)
+
+    def _legend_regions(self) -> list[tuple[int, int, int, int]]:
+        """The boxes of the legends inside panels, in Agg pixels (origin top left)."""
+        renderer = self.fig.canvas.get_renderer()
+        H = int(round(self.fig.bbox.height))
+        out = []
+        for ax in self.axes.values():
+            legend = ax.get_legend()
+            if legend is None or not legend.get_visible():
+                continue
+            box = legend.get_frame().get_window_extent(renderer)
+            if not ax.bbox.contains(box.x0 + 1, box.y0 + 1):
+                continue  # outside the panel: no curve crosses it
+            x0, x1 = math.floor(box.x0), math.ceil(box.x1)
+            y0, y1 = H - math.ceil(box.y1), H - math.floor(box.y0)
+            out.append((x0, y0, x1, y1))
+        return out
 
     def _redraw(self, names: list[str]) -> bool:
-        """Redraw some panels into the stored background; False if one leaves its cell."""
+        """Redraw some panels or texts into the stored background; False if one leaves its place."""
         from matplotlib.patches import Rectangle
         from matplotlib.transforms import IdentityTransform
 
@@ -1678,21 +1718,36 @@ class ExplorerFigure:
                 antialiased=False,
             )
             blank.draw(renderer)
-            ax = self.axes[name]
-            ax.draw(renderer)
-            tight = ax.get_tightbbox(renderer)
+            artist = {"title": self.title, "footer": self.footer}.get(name) or self.axes[name]
+            artist.draw(renderer)
+            if not artist.get_visible() or (
+                isinstance(artist, type(self.title)) and not artist.get_text()
+            ):
+                continue
+            tight = (
+                artist.get_tightbbox(renderer)
+                if name in self.axes
+                else artist.get_window_extent(renderer)
+            )
             if tight is None or not _inside(tight, box):
-                return False  # a wider tick label: render everything this time
+                return False  # a wider tick label or a longer text: render everything
         self.partial_draws += 1
         return True
 
     def _find_cells(self) -> dict:
-        """Each panel's cell (pixels): boundaries halfway between neighbouring panels."""
+        """Each panel's cell and the title and footer bands (pixels), or {} if they overlap."""
         from matplotlib.transforms import Bbox
 
         renderer = self.fig.canvas.get_renderer()
         W, H = self.fig.bbox.width, self.fig.bbox.height
         tight = {name: ax.get_tightbbox(renderer) for name, ax in self.axes.items()}
+        top = max(t.y1 for t in tight.values())
+        bottom = min(t.y0 for t in tight.values())
+        title = self.title.get_window_extent(renderer)
+        if title.y0 <= top + 2:
+            return {}
+        title_cut = (top + title.y0) / 2
+        footer_cut = bottom - 1
         pos = {name: ax.get_position() for name, ax in self.axes.items()}
         lefts = sorted({round(p.x0, 6) for p in pos.values()})
         columns = [[n for n, p in pos.items() if round(p.x0, 6) == x] for x in lefts]
@@ -1702,27 +1757,29 @@ class ExplorerFigure:
             b = min(tight[n].x0 for n in right)
             cuts.append((a + b) / 2)
         cuts.append(W)
-        cells = {}
+        cells = {
+            "title": Bbox.from_extents(0, title_cut, W, H),
+            "footer": Bbox.from_extents(0, 0, W, footer_cut),
+        }
         for c, names in enumerate(columns):
             for name in names:
                 p = tight[name]
                 above = [tight[n].y0 for n in names if tight[n].y0 >= p.y1 - 1e-6 and n != name]
                 below = [tight[n].y1 for n in names if tight[n].y1 <= p.y0 + 1e-6 and n != name]
-                y1 = (p.y1 + min(above)) / 2 if above else H
-                y0 = (p.y0 + max(below)) / 2 if below else 0.0
+                y1 = (p.y1 + min(above)) / 2 if above else title_cut
+                y0 = (p.y0 + max(below)) / 2 if below else footer_cut
                 cells[name] = Bbox.from_extents(cuts[c], y0, cuts[c + 1], y1)
-        if any(not _inside(tight[n], cells[n]) for n in cells):
+        if any(not _inside(tight[n], cells[n]) for n in self.axes):
             return {}
         return cells
 
     def _dynamic_artists(self) -> list:
-        """What changes between frames, in drawing order: lines, legends (drawn over the
-        lines, as in a full draw), messages, title and footer."""
+        """What changes between frames and is drawn on the stored background: curves,
+        markers and messages (legends, titles and the footer belong to the background)."""
         out: list = []
         for lines in self.lines.values():
             out += lines
-        legends = [ax.get_legend() for ax in self.axes.values() if ax.get_legend() is not None]
-        return [*out, *legends, *self.notes.values(), self.title, self.footer]
+        return [*out, *self.notes.values()]
 
     def to_png(
         self, *, colors: int | None = None, draw: bool = True, compress_level: int | None = None

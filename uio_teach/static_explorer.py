@@ -173,7 +173,7 @@ def _caption(frame: Frame) -> str:
     if frame.poles.size:
         parts.append(f"{name} poles: " + ", ".join(format_complex(p, 3) for p in frame.poles))
     parts += frame.all_messages
-    return ". ".join(parts) + "." if parts else ""
+    return " ".join(p[:1].upper() + p[1:] + "." for p in parts)
 
 
 def static_explorer(

@@ -434,7 +434,7 @@ class Explorer:
         try:
             frame = compute_frame(self.scenario, self.settings)
             self.figure.update(frame)
-            self.image.value = self.figure.to_png()
+            self.image.value = self.figure.to_png(colors=128)
         except Exception as exc:  # pragma: no cover - compute_frame already turns errors into text
             self.message.value = (
                 f'<span style="color:#c0392b">could not update the picture: '
