@@ -96,6 +96,7 @@ __all__ = [
     "missile_scenario",
     "make_scenario",
     "expand_poles",
+    "format_poles",
     "disturbance_signals",
     "luenberger_poles",
     "compute_frame",
@@ -959,8 +960,32 @@ class Frame:
         return (*out, *self.messages)
 
 
-def _fmt_poles(poles: np.ndarray) -> str:
-    return ", ".join(format_complex(p, 3) for p in poles)
+def format_poles(poles: Sequence[complex]) -> str:
+    """Poles as short text, round-off (below 1e-9 of the largest modulus) shown as 0.
+
+    Parameters
+    ----------
+    poles : sequence of complex
+        The poles.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorer import format_poles
+    >>> format_poles([8.9e-16, 0.5, -1 + 2j])
+    '0, 0.5, -1 + 2j'
+    """
+    z = np.asarray(poles, dtype=complex)
+    if not z.size:
+        return ""
+    tiny = 1e-9 * max(1.0, float(np.abs(z).max()))
+    z = np.where(np.abs(z.real) < tiny, 0.0, z.real) + 1j * np.where(
+        np.abs(z.imag) < tiny, 0.0, z.imag
+    )
+    return ", ".join(format_complex(p, 3) for p in z)
 
 
 def _stability_message(name: str, poles: np.ndarray, discrete: bool) -> str:
@@ -976,9 +1001,9 @@ def _stability_message(name: str, poles: np.ndarray, discrete: bool) -> str:
         grow = bad[growing]
         word = "pole" if grow.size == 1 else "poles"
         this = "this pole makes" if grow.size == 1 else "these poles make"
-        return f"{this} the {name} unstable: the error grows ({word} {_fmt_poles(grow)} {where})"
+        return f"{this} the {name} unstable: the error grows ({word} {format_poles(grow)} {where})"
     word = "pole" if bad.size == 1 else "poles"
-    return f"{word} {_fmt_poles(bad)} {edge}: the {name} error does not decay"
+    return f"{word} {format_poles(bad)} {edge}: the {name} error does not decay"
 
 
 def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str]:
@@ -1337,6 +1362,10 @@ class ExplorerFigure:
         Resolution.
     figsize : tuple of float, optional
         Size in inches; (9, 4.8), or (9, 6.2) with the reconstruction row.
+    sticky : bool
+        Keep an axis range while the new data fit it and fill at least a
+        third of it (fewer redraws, for live use); ``False`` gives every frame
+        its own range (for pictures that must not depend on the previous one).
 
     Attributes
     ----------
@@ -1370,6 +1399,7 @@ class ExplorerFigure:
         *,
         dpi: float = 90,
         figsize: tuple[float, float] | None = None,
+        sticky: bool = True,
     ) -> None:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -1528,6 +1558,7 @@ class ExplorerFigure:
         self._keys: dict[str, tuple] = {}
         self._cells: dict | None = None
         self._fresh = True
+        self.sticky = sticky
         self._legend_boxes: list[tuple[int, int, int, int]] = []
 
     def update(self, frame: Frame) -> None:
@@ -1586,9 +1617,12 @@ class ExplorerFigure:
             if row == "input":
                 data.append(frame.d)
             ax = self.axes[f"uio.{row}"]
-            ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), self._fresh))
+            ax.set_ylim(
+                *_keep_range(ax.get_ylim(), _nice_range(data), self._fresh or not self.sticky)
+            )
         sig = self.axes["signals"]
-        sig.set_ylim(*_keep_range(sig.get_ylim(), _nice_range([frame.d, frame.v]), self._fresh))
+        wanted = _nice_range([frame.d, frame.v])
+        sig.set_ylim(*_keep_range(sig.get_ylim(), wanted, self._fresh or not self.sticky))
         self._fresh = False
         if len(t) > 1:
             for name, ax in self.axes.items():

@@ -41,6 +41,7 @@ from .explorer import (
     Scenario,
     Settings,
     compute_frame,
+    format_poles,
 )
 
 __all__ = ["StaticFrame", "StaticExplorer", "frame_settings", "static_explorer", "static_html"]
@@ -171,7 +172,7 @@ def _caption(frame: Frame) -> str:
     name = frame.scenario.observer_name
     parts = []
     if frame.poles.size:
-        parts.append(f"{name} poles: " + ", ".join(format_complex(p, 3) for p in frame.poles))
+        parts.append(f"{name} poles: {format_poles(frame.poles)}")
     parts += frame.all_messages
     return " ".join(p[:1].upper() + p[1:] + "." for p in parts)
 
@@ -240,7 +241,7 @@ def static_explorer(
     i0 = int(np.argmin([abs(v - current) for v in values]))
     j0 = disturbances.index(base.disturbance) if base.disturbance in disturbances else 0
 
-    figure = ExplorerFigure(scenario, dpi=dpi)
+    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False)
     frames = []
     for j, kind in enumerate(disturbances):
         for i, value in enumerate(values):

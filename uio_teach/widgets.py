@@ -44,7 +44,6 @@ from typing import Any
 import ipywidgets as W
 import numpy as np
 
-from ._display import format_complex
 from .explorer import (
     DISTURBANCES,
     ExplorerFigure,
@@ -53,6 +52,7 @@ from .explorer import (
     Settings,
     case_study_scenario,
     compute_frame,
+    format_poles,
     make_scenario,
     missile_scenario,
     pa9_scenario,
@@ -203,7 +203,7 @@ class Explorer:
         else:
             text = ""
         if fixed.size:
-            zeros = ", ".join(format_complex(p, 3) for p in fixed)
+            zeros = format_poles(fixed)
             text += ("; " if text else "") + f"fixed: {zeros} (invariant zeros)"
         observer.append(W.HTML(f"<small>{html.escape(text)}</small>"))
         if sc.decay_limits is not None:
@@ -483,11 +483,9 @@ def _message_html(frame: Frame) -> str:
     name = html.escape(frame.scenario.observer_name)
     lines = []
     if frame.poles.size:
-        lines.append(f"{name} poles: " + ", ".join(format_complex(p, 3) for p in frame.poles))
+        lines.append(f"{name} poles: {format_poles(frame.poles)}")
     if frame.luenberger_poles.size:
-        lines.append(
-            "Luenberger poles: " + ", ".join(format_complex(p, 3) for p in frame.luenberger_poles)
-        )
+        lines.append(f"Luenberger poles: {format_poles(frame.luenberger_poles)}")
     text = "<br>".join(html.escape(line) for line in lines)
     notes = "".join(f"<li>{html.escape(m)}</li>" for m in frame.all_messages)
     if notes:
