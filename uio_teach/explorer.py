@@ -27,7 +27,7 @@ book.
 L (y - C xhat)`` gets the same error poles as the unknown input observer: the
 poles you set *and* the fixed poles (the invariant zeros), so that the only
 difference between the two columns of the figure is the decoupling. The rule,
-in :func:`luenberger_poles`: modes that no gain moves in the Luenberger
+in :func:`uio_teach.explorer.luenberger_poles`: modes that no gain moves in the Luenberger
 observer (unobservable modes of ``(A, C)``) are taken out of the list; if
 the list is then longer than the number of poles ``(A, C)`` lets us place,
 the fastest poles are dropped; if it is shorter (the g-inverse observer has
@@ -1099,7 +1099,7 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
 
     The unknown input observer of ``scenario.family`` is designed with the
     settings' poles (or the LMI bound), the Luenberger observer with the poles
-    of :func:`luenberger_poles`; both are simulated with
+    of :func:`uio_teach.explorer.luenberger_poles`; both are simulated with
     :func:`uio_teach.simulate` on the same plant, inputs, noise (same seed)
     and initial state, with observer states starting at zero. Errors,
     residuals (and reconstructed inputs) are clipped for display at ten times
