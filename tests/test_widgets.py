@@ -8,6 +8,7 @@ the slider swaps the displayed frame.
 
 from __future__ import annotations
 
+import concurrent.futures
 import os
 import re
 from html.parser import HTMLParser
@@ -295,6 +296,9 @@ def test_static_rejects_bad_grids():
 CHROMIUM = Path("/usr/bin/chromium")
 
 
+SET_RANGE = "el => { el.value = 'VALUE'; el.dispatchEvent(new Event('input', {bubbles: true})); }"
+
+
 @pytest.mark.browser
 def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
     if not CHROMIUM.exists():
@@ -312,41 +316,48 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
     eid = pa9_static.element_id
     requests: list[str] = []
     errors: list[str] = []
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(
-            executable_path=str(CHROMIUM),
-            args=["--headless", "--no-sandbox", "--disable-gpu"],
-            headless=True,
-        )
-        try:
-            tab = browser.new_page()
-            tab.on("request", lambda r: requests.append(r.url))
-            tab.on("pageerror", lambda exc: errors.append(str(exc)))
-            tab.goto(page_file.as_uri())
-            img = f"#{eid} img.uio-frame"
-            start = tab.get_attribute(img, "src")
-            assert start == frames[(2, 0)].data_url  # the default pole -1, sinusoid
 
-            tab.eval_on_selector(
-                f"#{eid} input[type=range]",
-                "el => { el.value = '4'; el.dispatchEvent(new Event('input', {bubbles: true})); }",
+    def drive() -> None:
+        # a thread of its own: earlier tests (notebook execution) may leave an asyncio
+        # loop running in the main thread, where playwright's sync API refuses to start
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(
+                executable_path=str(CHROMIUM),
+                args=["--headless", "--no-sandbox", "--disable-gpu"],
+                headless=True,
             )
-            moved = tab.get_attribute(img, "src")
-            assert moved != start and moved == frames[(4, 0)].data_url
-            assert tab.inner_text(f"#{eid} output") == "-4"
-            assert tab.inner_text(f"#{eid} .uio-caption") == frames[(4, 0)].caption
+            try:
+                tab = browser.new_page()
+                tab.on("request", lambda r: requests.append(r.url))
+                tab.on("pageerror", lambda exc: errors.append(str(exc)))
+                tab.goto(page_file.as_uri())
+                img = f"#{eid} img.uio-frame"
+                start = tab.get_attribute(img, "src")
+                assert start == frames[(2, 0)].data_url  # the default pole -1, sinusoid
 
-            tab.select_option(f"#{eid} select", "3")  # random steps
-            assert tab.get_attribute(img, "src") == frames[(4, 3)].data_url
+                tab.eval_on_selector(
+                    f"#{eid} input[type=range]",
+                    SET_RANGE.replace("VALUE", "4"),
+                )
+                moved = tab.get_attribute(img, "src")
+                assert moved != start and moved == frames[(4, 0)].data_url
+                assert tab.inner_text(f"#{eid} output") == "-4"
+                assert tab.inner_text(f"#{eid} .uio-caption") == frames[(4, 0)].caption
 
-            tab.eval_on_selector(
-                f"#{eid} input[type=range]",
-                "el => { el.value = '0'; el.dispatchEvent(new Event('input', {bubbles: true})); }",
-            )
-            assert "unstable" in tab.inner_text(f"#{eid} .uio-caption")
-            natural = tab.eval_on_selector(img, "el => el.naturalWidth")
-            assert natural > 300
-        finally:
-            browser.close()
+                tab.select_option(f"#{eid} select", "3")  # random steps
+                assert tab.get_attribute(img, "src") == frames[(4, 3)].data_url
+
+                tab.eval_on_selector(
+                    f"#{eid} input[type=range]",
+                    SET_RANGE.replace("VALUE", "0"),
+                )
+                assert "unstable" in tab.inner_text(f"#{eid} .uio-caption")
+                natural = tab.eval_on_selector(img, "el => el.naturalWidth")
+                assert natural > 300
+            finally:
+                browser.close()
+
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        pool.submit(drive).result()
     assert not errors, errors
     assert all(u.startswith(("file:", "data:")) for u in requests), requests
