@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -135,11 +136,16 @@ class ExistenceReport:
 
     def __str__(self) -> str:
         head = f"Existence of an unknown input observer for {self.plant!r}"
+        if len(head) > 88:
+            head = f"Existence of an unknown input observer for\n  {self.plant!r}"
         width = max(len(c.name) for c in self.conditions)
         lines = [head]
+        indent = " " * (width + 6)
         for c in self.conditions:
             tag = "" if c.required else " (info)"
-            lines.append(f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}")
+            text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
+            # wrap long reasons under their column so the table fits a notebook page
+            lines.extend(textwrap.wrap(text, 88, subsequent_indent=indent) or [text])
         verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
         lines.append(f"  => {verdict}")
         return "\n".join(lines)
