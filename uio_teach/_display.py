@@ -7,7 +7,13 @@ from collections.abc import Iterable
 
 import numpy as np
 
-__all__ = ["format_matrix", "matrices_text", "matrices_html", "format_complex"]
+__all__ = [
+    "format_matrix",
+    "matrices_text",
+    "matrices_html",
+    "format_complex",
+    "format_poles",
+]
 
 
 def format_complex(z: complex, digits: int = 4) -> str:
@@ -18,6 +24,48 @@ def format_complex(z: complex, digits: int = 4) -> str:
         return f"{z.real:.{digits}g}"
     sign = "+" if z.imag >= 0 else "-"
     return f"{z.real:.{digits}g} {sign} {abs(z.imag):.{digits}g}j"
+
+
+def format_poles(
+    poles: Iterable[complex], digits: int = 4, *, braces: bool = False, empty: str = ""
+) -> str:
+    """The one formatter of poles (and eigenvalues, zeros) used throughout the package.
+
+    Round-off below 1e-9 of the largest modulus is shown as 0, in the real and in the
+    imaginary part, so ``8.9e-16`` prints as ``0`` and a real pole carries no ``+ 0j``.
+
+    Parameters
+    ----------
+    poles : iterable of complex
+        The values.
+    digits : int, optional
+        Significant digits (default 4).
+    braces : bool, optional
+        Write the values as a set, ``{-1, -2}``.
+    empty : str, optional
+        What to return for no values (default ``""``; with ``braces``, ``"none"`` reads well).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach._display import format_poles
+    >>> format_poles([8.9e-16, 0.5, -1 + 2j])
+    '0, 0.5, -1 + 2j'
+    >>> format_poles([-1, -2], braces=True)
+    '{-1, -2}'
+    """
+    z = np.asarray(list(poles), dtype=complex)
+    if not z.size:
+        return empty
+    tiny = 1e-9 * max(1.0, float(np.abs(z).max()))
+    z = np.where(np.abs(z.real) < tiny, 0.0, z.real) + 1j * np.where(
+        np.abs(z.imag) < tiny, 0.0, z.imag
+    )
+    text = ", ".join(format_complex(p, digits) for p in z)
+    return "{" + text + "}" if braces else text
 
 
 def _clean(M: np.ndarray, ref: float = 0.0) -> np.ndarray:

@@ -21,6 +21,7 @@ __all__ = [
     "invariant_zeros",
     "is_stable",
     "ObservabilitySplit",
+    "sort_poles",
 ]
 
 
@@ -223,7 +224,18 @@ def _complement(V: np.ndarray, n: int) -> np.ndarray:
     return Q[:, V.shape[1] :].copy()
 
 
-def _sort(z: np.ndarray) -> np.ndarray:
+def sort_poles(z: np.ndarray) -> np.ndarray:
+    """Values (poles, eigenvalues, zeros) in a reproducible order: by real part, then imaginary.
+
+    Imaginary parts that are round-off of a real value are dropped, and a conjugate pair always
+    comes out negative imaginary part first.
+
+    Examples
+    --------
+    >>> from uio_teach.linalg import sort_poles
+    >>> sort_poles([-1 + 2j, -3, -1 - 2j]).tolist()
+    [(-3+0j), (-1-2j), (-1+2j)]
+    """
     z = np.asarray(z, complex)
     # clean tiny imaginary parts of real values
     z = np.where(np.abs(z.imag) <= 1e-10 * np.maximum(1.0, np.abs(z)), z.real + 0j, z)
@@ -232,6 +244,9 @@ def _sort(z: np.ndarray) -> np.ndarray:
     scale = max(1.0, float(np.max(np.abs(z)))) if z.size else 1.0
     key_re = np.round(z.real / scale, 9)
     return z[np.lexsort((z.imag, key_re))]
+
+
+_sort = sort_poles  # former private name
 
 
 def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.ndarray:
