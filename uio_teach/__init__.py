@@ -14,7 +14,23 @@ True
 """
 
 from . import checks, examples, linalg, plotting, signals
+from .detection import (
+    Detection,
+    Fault,
+    Threshold,
+    actuator_fault,
+    detect,
+    detection_time,
+    false_alarm_rate,
+    observer_residual,
+    process_fault,
+    residual_rms,
+    residual_threshold,
+    sensor_fault,
+    simulate_fault,
+)
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
+from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
 from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
 from .observers import (
     PMO,
@@ -90,6 +106,23 @@ __all__ = [
     "reconstruct_input",
     "InputEstimate",
     "catch_time",
+    "Fault",
+    "actuator_fault",
+    "sensor_fault",
+    "process_fault",
+    "simulate_fault",
+    "observer_residual",
+    "residual_rms",
+    "Threshold",
+    "residual_threshold",
+    "Detection",
+    "detect",
+    "false_alarm_rate",
+    "detection_time",
+    "design_uio_bank",
+    "UIOBank",
+    "BankMember",
+    "Isolation",
     "widgets",
     "explorer",
     "static_explorer",
