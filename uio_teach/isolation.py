@@ -230,6 +230,7 @@ class UIOBank:
         false_alarm_rate: float,
         window: float,
         start: float | None = None,
+        per: str = "run",
     ) -> list[Threshold | None]:
         """One threshold per usable member, from fault-free simulations.
 
@@ -244,6 +245,9 @@ class UIOBank:
             Window of :func:`uio_teach.residual_rms`.
         start : float, optional
             Monitoring starts here.
+        per : {"run", "sample"}
+            What the rate counts (see :func:`uio_teach.residual_threshold`);
+            by default whole runs, so that a fault-free run rarely names a fault.
 
         Returns
         -------
@@ -281,7 +285,7 @@ class UIOBank:
             R = np.stack([res[i] for res in per_run])
             out.append(
                 residual_threshold(
-                    t, R, false_alarm_rate=false_alarm_rate, window=window, start=start
+                    t, R, false_alarm_rate=false_alarm_rate, window=window, start=start, per=per
                 )
             )
         return out
@@ -309,8 +313,8 @@ class UIOBank:
         >>> bank = ut.design_uio_bank(plant, "actuator", poles=[-2, -3, -4])
         >>> t = np.linspace(0, 10, 1001)
         >>> obs = ut.design_uio(plant, poles=[-2, -3, -4])  # the detector; the bank reads its data
-        >>> healthy = [ut.simulate_fault(plant, obs, t, noise=0.01, seed=k) for k in range(5)]
-        >>> ths = bank.thresholds(healthy, false_alarm_rate=0.001, window=0.5)
+        >>> healthy = [ut.simulate_fault(plant, obs, t, noise=0.01, seed=k) for k in range(20)]
+        >>> ths = bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5)
         >>> fault = ut.actuator_fault(plant, 1, ut.signals.step(0.5, 5.0))
         >>> bank.isolate(ut.simulate_fault(plant, obs, t, fault, noise=0.01, seed=7), ths).suspect
         'actuator 2'
