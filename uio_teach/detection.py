@@ -80,7 +80,7 @@ class Fault:
         Shape (n,): ``R1``.
     output_direction : numpy.ndarray
         Shape (p,): ``R2``.
-    signal : callable
+    signal : collections.abc.Callable
         The fault's size against time, a vectorized callable (see
         :mod:`uio_teach.signals`).
 

@@ -76,7 +76,7 @@ class BankMember:
 
     @property
     def residual_size(self) -> int:
-        """How many independent directions its residual has: ``rank(C_i) - rank(C_i E_i)``.
+        """The number of independent residual directions, ``rank(C_i) - rank(C_i E_i)``.
 
         Zero means the member has no residual worth the name: with as many
         independent measurements as decoupled inputs, ``C H = I``, so
@@ -338,7 +338,9 @@ class UIOBank:
         return Isolation(faults=self.faults, fired=tuple(fired), first_alarms=tuple(first))
 
     def __repr__(self) -> str:
-        lines = [f"UIOBank({self.kind} faults of {self.plant!r})"]
+        pl = self.plant
+        name = f"{pl.name!r}, " if pl.name else ""
+        lines = [f"UIOBank({self.kind} faults of plant {name}n={pl.n}, m={pl.m}, p={pl.p})"]
         for m in self.members:
             if m.exists:
                 state = f"residual of size {m.residual_size}" if m.usable else "residual blind"
@@ -379,7 +381,7 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
     --------
     >>> import uio_teach as ut
     >>> ut.design_uio_bank(ut.examples.pa9(), "actuator", poles=[-2, -3, -4])
-    UIOBank(actuator faults of Plant('PA9', continuous-time, n=3, m=2, q=1, p=2, r=0))
+    UIOBank(actuator faults of plant 'PA9', n=3, m=2, p=2)
       blind to actuator 1: does not exist: rank condition
       blind to actuator 2: residual blind
     """
