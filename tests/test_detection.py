@@ -265,6 +265,24 @@ def test_threshold_grows_with_noise_and_shrinks_with_window(pa9, uio):
     assert long.value < thr.value
 
 
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        (dict(value=-1.0), "value"),
+        (dict(value=np.nan), "value"),
+        (dict(window=0.0), "window"),
+        (dict(design_rate=1.0), "design_rate"),
+        (dict(start=np.inf), "start"),
+        (dict(per="day"), "per"),
+    ],
+)
+def test_threshold_refuses_bad_fields(kwargs, word):
+    fields = dict(value=0.5, window=0.2, design_rate=0.01, start=0.2, samples=1)
+    fields.update(kwargs)
+    with pytest.raises(ValueError, match=word):
+        ut.Threshold(**fields)
+
+
 def test_detect_alarm_only_after_start():
     thr = ut.Threshold(value=0.5, window=0.2, design_rate=0.01, start=3.0, samples=1)
     r = np.ones((1, T.size))

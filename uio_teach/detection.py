@@ -594,6 +594,18 @@ class Threshold:
     samples: int
     per: str = "sample"
 
+    def __post_init__(self) -> None:
+        if (
+            isinstance(self.value, bool)
+            or not isinstance(self.value, Real)
+            or not (np.isfinite(self.value) and self.value >= 0)
+        ):
+            raise ValueError(f"value must be a finite number >= 0, got {self.value!r}")
+        _positive("window", self.window)
+        _rate(self.design_rate, "design_rate")
+        _start(self.start, np.zeros(1), 1.0)
+        _per(self.per)
+
     def __float__(self) -> float:
         return self.value
 
@@ -670,9 +682,9 @@ def _per(per: Any) -> str:
     return per
 
 
-def _rate(value: Any) -> float:
+def _rate(value: Any, name: str = "false_alarm_rate") -> float:
     if isinstance(value, bool) or not isinstance(value, Real) or not 0 < value < 1:
-        raise ValueError(f"false_alarm_rate must be a number between 0 and 1, got {value!r}")
+        raise ValueError(f"{name} must be a number between 0 and 1, got {value!r}")
     return float(value)
 
 
