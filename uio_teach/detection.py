@@ -33,6 +33,8 @@ from .plant import Plant
 from .simulation import (
     UIOResponse,
     _check_timepts,
+    _one_blas_thread,
+    _recursion,
     _signal,
     _uniform_step,
     foh_matrices,
@@ -440,21 +442,17 @@ def observer_residual(
     )
     S = np.vstack([U, Y])
     Bs = np.hstack([real.B_u, real.B_y])
-    w = np.empty((nw, N))
-    w[:, 0] = w0
-    if pl.is_discrete:
-        # w[k+1] = A w[k] + B s[k]
-        forcing = Bs @ S[:, :-1]
-        Phi = real.A
-    else:
-        h = _uniform_step(t)
-        if h is None:
-            raise ValueError("timepts must be uniformly spaced for a continuous-time observer")
-        # exact for inputs linear between samples: w[k+1] = Phi w[k] + G0 s[k] + G1 s[k+1]
-        Phi, G0, G1 = foh_matrices(real.A, Bs, h)
-        forcing = G0 @ S[:, :-1] + G1 @ S[:, 1:]
-    for k in range(N - 1):
-        w[:, k + 1] = Phi @ w[:, k] + forcing[:, k]
+    with _one_blas_thread():
+        if pl.is_discrete:
+            # w[k+1] = A w[k] + B s[k]
+            w = _recursion(real.A, Bs, None, S, w0)
+        else:
+            h = _uniform_step(t)
+            if h is None:
+                raise ValueError("timepts must be uniformly spaced for a continuous-time observer")
+            # exact for inputs linear between samples: w[k+1] = Phi w[k] + G0 s[k] + G1 s[k+1]
+            Phi, G0, G1 = foh_matrices(real.A, Bs, h)
+            w = _recursion(Phi, G0, G1, S, w0)
     xhat = real.C @ w + real.D_y @ Y
     return Y - pl.C @ xhat
 
