@@ -63,3 +63,44 @@ def test_chapter_runs(chapter: Path) -> None:
         client.execute()
     except CellExecutionError as error:
         pytest.fail(f"{chapter.relative_to(BOOK)}: a cell failed\n{error}", pytrace=False)
+
+
+# --- the reader sees the computation, not the test ----------------------------------------------
+
+MAX_VISIBLE_ASSERTS = 10
+HIDDEN_TAGS = {"remove-cell", "remove-input", "hide-input", "hide-cell"}
+
+
+def visible_assert_lines(chapter: Path) -> list[str]:
+    """Lines with ``assert`` in the code cells of ``chapter`` that the rendered page shows."""
+    notebook = read_myst_markdown_notebook(chapter.read_text(encoding="utf-8"), path=chapter)
+    found = []
+    for cell in notebook.cells:
+        if cell.cell_type != "code" or HIDDEN_TAGS & set(cell.metadata.get("tags", [])):
+            continue
+        found += [line.strip() for line in cell.source.splitlines() if "assert" in line]
+    return found
+
+
+def test_few_visible_asserts() -> None:
+    counts = {path.name: visible_assert_lines(path) for path in CHAPTERS}
+    total = sum(len(lines) for lines in counts.values())
+    detail = {name: len(lines) for name, lines in counts.items() if lines}
+    assert total <= MAX_VISIBLE_ASSERTS, (
+        f"{total} visible assert lines (at most {MAX_VISIBLE_ASSERTS}): {detail}; move checks"
+        " that do not teach into a hidden cell (tags: [remove-cell]) or into the tests"
+    )
+
+
+def test_hidden_checks_still_run() -> None:
+    """Hidden cells must be removed from the page, not from execution (no skip-execution)."""
+    for chapter in CHAPTERS:
+        notebook = read_myst_markdown_notebook(chapter.read_text(encoding="utf-8"), path=chapter)
+        skipped = [
+            cell.source.splitlines()[0]
+            for cell in notebook.cells
+            if cell.cell_type == "code"
+            and "skip-execution" in cell.metadata.get("tags", [])
+            and "assert" in cell.source
+        ]
+        assert not skipped, f"{chapter.name}: checks that never run: {skipped}"
