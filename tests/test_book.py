@@ -360,7 +360,7 @@ def test_long_equations_scroll_on_a_phone(page: str, book_server: str, browser) 
 
 def test_equation_css_gives_a_visible_scroll_cue() -> None:
     css = (ROOT / "_static" / "equations.css").read_text(encoding="utf-8")
-    assert re.search(r"div\.math[^{]*\{[^}]*overflow-x:\s*auto", css, flags=re.S)
+    assert re.search(r"mjx-container[^{]*\{[^}]*overflow-x:\s*auto", css, flags=re.S)
     assert "scrollbar" in css and "radial-gradient" in css
 
 
