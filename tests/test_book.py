@@ -316,9 +316,7 @@ def _display_equations(browser, book_server: str, page: str, width: int) -> list
     tab.route(
         "**/*",
         lambda route: (
-            route.continue_()
-            if urlsplit(route.request.url).hostname == host
-            else route.abort()
+            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
         ),
     )
     try:
