@@ -7,6 +7,7 @@ chapter, named after the chapter file, so a failing cell points at its chapter.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import nbclient
@@ -104,3 +105,36 @@ def test_hidden_checks_still_run() -> None:
             and "assert" in cell.source
         ]
         assert not skipped, f"{chapter.name}: checks that never run: {skipped}"
+
+
+# --- every chapter opens with its goals and closes with a summary and exercises -----------------
+
+COURSE_CHAPTERS = sorted(BOOK.glob("0[1-6]_*.md"))
+
+
+@pytest.mark.parametrize("chapter", COURSE_CHAPTERS, ids=[path.name for path in COURSE_CHAPTERS])
+def test_chapter_structure(chapter: Path) -> None:
+    text = chapter.read_text(encoding="utf-8")
+    opening = text.find("```{admonition} In this chapter")
+    assert opening >= 0, f"{chapter.name}: no 'In this chapter' box under the title"
+    box = text[opening : text.find("```", opening + 3)]
+    for phrase in ("You will be able to", "It assumes"):
+        assert phrase in box, f"{chapter.name}: the opening box does not say {phrase!r}"
+    summary, exercises = text.find("\n## Summary\n"), text.find("\n## Exercises\n")
+    assert 0 < summary < exercises, f"{chapter.name}: no '## Summary' followed by '## Exercises'"
+    assert "```{exercise}" in text[exercises:], f"{chapter.name}: no exercise"
+    starts = re.findall(r"```\{solution-start\}[^\n]*\n(:class: [^\n]*)?", text[exercises:])
+    assert starts, f"{chapter.name}: no solution"
+    unfolded = [opts for opts in starts if "dropdown" not in opts]
+    assert not unfolded, f"{chapter.name}: every solution must be folded (:class: dropdown)"
+
+
+def test_no_hard_coded_chapter_or_equation_numbers() -> None:
+    """Numbers follow the table of contents only through {numref}, {eq}, {ref} and {doc} roles."""
+    pattern = re.compile(r"\b[Cc]hapters? \d|(?<![\w`])\(\d+\.\d+\)")
+    found = []
+    for page in sorted(BOOK.glob("*.md")):
+        for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1):
+            if pattern.search(line):
+                found.append(f"{page.name}:{number}: {line.strip()}")
+    assert not found, "hard-coded chapter or equation numbers:\n" + "\n".join(found)
