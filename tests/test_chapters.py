@@ -138,3 +138,31 @@ def test_no_hard_coded_chapter_or_equation_numbers() -> None:
             if pattern.search(line):
                 found.append(f"{page.name}:{number}: {line.strip()}")
     assert not found, "hard-coded chapter or equation numbers:\n" + "\n".join(found)
+
+
+# --- each chapter as a notebook (the book's _ext/chapter_notebooks.py) --------------------------
+
+
+def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path) -> None:
+    import importlib.util
+
+    import nbformat
+
+    spec = importlib.util.spec_from_file_location(
+        "chapter_notebooks", BOOK.parent / "_ext" / "chapter_notebooks.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    chapter = BOOK / "04_case_study.md"
+    target = tmp_path / "04_case_study.ipynb"
+    module.write_notebook(chapter, target)
+    notebook = nbformat.read(target, as_version=4)
+    nbformat.validate(notebook)
+    code = [cell for cell in notebook.cells if cell.cell_type == "code"]
+    source = read_myst_markdown_notebook(chapter.read_text(encoding="utf-8"), path=chapter)
+    assert len(code) == sum(cell.cell_type == "code" for cell in source.cells)
+    assert all(not cell.outputs and cell.execution_count is None for cell in code)
+    # the checks hidden in the book are kept, and still marked as such
+    assert any("remove-cell" in cell.metadata.get("tags", []) for cell in code)
+    assert notebook.metadata["kernelspec"]["name"] == "python3"
+    assert "jupytext" not in notebook.metadata
