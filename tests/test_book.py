@@ -281,3 +281,148 @@ def test_page_in_browser(page: str, book_server: str, browser) -> None:
     match = _EXCEPTION_LINE.search(cell_outputs)
     assert match is None, f"{page}: an output cell shows an exception: {match.group(0)!r}"
     assert not console_errors, f"{page}: browser console errors: {console_errors}"
+
+
+# --- every display equation visible -------------------------------------------------------------
+
+# For each display equation of the page: the width of the formula plus its equation number, the
+# width of the box it sits in (div.math, the text column), and whether it or an ancestor up to
+# that box scrolls sideways (computed overflow-x auto or scroll).
+_DISPLAY_EQUATIONS_JS = """
+() => Array.from(document.querySelectorAll("main mjx-container[display='true']")).map((c, i) => {
+  const box = c.closest("div.math") || c.parentElement;
+  const math = c.querySelector("mjx-math") || c;
+  const eqno = box.querySelector(".eqno");
+  const width = math.getBoundingClientRect().width
+    + (eqno ? eqno.getBoundingClientRect().width : 0);
+  let scrolls = false;
+  for (let e = c; e && e !== box.parentElement; e = e.parentElement) {
+    const overflow = getComputedStyle(e).overflowX;
+    if (overflow === "auto" || overflow === "scroll") { scrolls = true; break; }
+  }
+  const number = eqno ? eqno.textContent.replace("#", "").trim() : "";
+  const label = box.id || (box.closest("section[id]") || {}).id || "";
+  const tex = (c.getAttribute("aria-label") || c.textContent || "").replace(/\\s+/g, " ");
+  return {index: i + 1, number, label, width, box: box.clientWidth, scrolls,
+          text: tex.slice(0, 70)};
+})
+"""
+
+
+def _display_equations(browser, book_server: str, page: str, width: int) -> list[dict]:
+    context = browser.new_context(viewport={"width": width, "height": 900})
+    tab = context.new_page()
+    host = urlsplit(book_server).hostname
+    tab.route(
+        "**/*",
+        lambda route: (
+            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
+        ),
+    )
+    try:
+        tab.goto(f"{book_server}/{page}.html", wait_until="load")
+        tab.evaluate(_WAIT_FOR_MATHJAX_JS)
+        return tab.evaluate(_DISPLAY_EQUATIONS_JS)
+    finally:
+        context.close()
+
+
+def _describe(page: str, equation: dict) -> str:
+    name = equation["number"] or f"display equation {equation['index']}"
+    where = f" (#{equation['label']})" if equation["label"] else ""
+    return (
+        f"{page}: {name}{where} is {equation['width']:.0f} px wide in a"
+        f" {equation['box']} px column: {equation['text']!r}"
+    )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_display_equations_fit_at_1280px(page: str, book_server: str, browser) -> None:
+    equations = _display_equations(browser, book_server, page, 1280)
+    too_wide = [_describe(page, eq) for eq in equations if eq["width"] > eq["box"] + 0.5]
+    assert not too_wide, "display equations wider than their column:\n" + "\n".join(too_wide)
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_long_equations_scroll_on_a_phone(page: str, book_server: str, browser) -> None:
+    equations = _display_equations(browser, book_server, page, 390)
+    stuck = [
+        _describe(page, eq)
+        for eq in equations
+        if eq["width"] > eq["box"] + 0.5 and not eq["scrolls"]
+    ]
+    assert not stuck, "equations cut off at 390 px (no sideways scrolling):\n" + "\n".join(stuck)
+
+
+def test_equation_css_gives_a_visible_scroll_cue() -> None:
+    css = (ROOT / "_static" / "equations.css").read_text(encoding="utf-8")
+    assert re.search(r"mjx-container[^{]*\{[^}]*overflow-x:\s*auto", css, flags=re.S)
+    assert "scrollbar" in css and "radial-gradient" in css
+
+
+# --- each chapter as a notebook -----------------------------------------------------------------
+
+
+def _is_chapter(page: str) -> bool:
+    source = ROOT / f"{page}.md"
+    if page == PAGES[0] or not source.is_file():
+        return False
+    text = source.read_text(encoding="utf-8")
+    return text.startswith("---") and "kernelspec:" in text.split("\n---", 1)[0]
+
+
+CHAPTER_PAGES = [page for page in PAGES if _is_chapter(page)]
+
+
+class _Links(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.links: list[tuple[str, str]] = []
+        self._href: str | None = None
+        self._text: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "a":
+            self._href = dict(attrs).get("href") or ""
+            self._text = []
+
+    def handle_data(self, data: str) -> None:
+        if self._href is not None:
+            self._text.append(data)
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "a" and self._href is not None:
+            self.links.append((self._href, "".join(self._text).strip()))
+            self._href = None
+
+
+def test_chapters_are_listed() -> None:
+    assert len(CHAPTER_PAGES) >= 6, CHAPTER_PAGES
+
+
+@pytest.mark.parametrize("page", CHAPTER_PAGES)
+def test_chapter_page_links_its_notebook(page: str, built_book: Path) -> None:
+    import nbformat
+
+    html = built_book / f"{page}.html"
+    parser = _Links()
+    parser.feed(html.read_text(encoding="utf-8"))
+    notebooks = [
+        (href, text)
+        for href, text in parser.links
+        if urlsplit(href).path.endswith(f"{Path(page).name}.ipynb")
+    ]
+    assert notebooks, f"{page}.html has no link to its notebook (.ipynb)"
+    href, text = notebooks[0]
+    assert "notebook" in text.lower(), f"{page}: the notebook link says {text!r}"
+    target = (html.parent / urlsplit(href).path).resolve()
+    assert target.is_file(), f"{page}: the linked notebook {target} does not exist"
+    notebook = nbformat.read(target, as_version=4)
+    nbformat.validate(notebook)
+    code = [cell for cell in notebook.cells if cell.cell_type == "code"]
+    assert code, f"{target.name}: no code cells"
+    with_outputs = [i for i, cell in enumerate(code) if cell.outputs or cell.execution_count]
+    assert not with_outputs, f"{target.name}: code cells with outputs: {with_outputs}"
+    assert notebook.metadata.get("kernelspec", {}).get("name") == "python3"

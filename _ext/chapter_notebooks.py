@@ -1,0 +1,82 @@
+"""Every chapter of the book as a Jupyter notebook (.ipynb), for machines without jupytext.
+
+When a page written from a MyST Markdown notebook (a ``.md`` source whose front matter declares a
+``kernelspec``) is rendered to HTML, its source is converted with jupytext into
+``_notebooks/<name>.ipynb`` in the output folder, with no outputs, and a link to that file is put
+under the page title. The root page (the landing page) is not a chapter and gets no link.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import jupytext
+import nbformat
+import yaml
+from sphinx.application import Sphinx
+
+NOTEBOOK_DIR = "_notebooks"
+LINK_TEXT = "Download this chapter as a notebook (.ipynb)"
+
+
+def _front_matter(text: str) -> dict:
+    if not text.startswith("---"):
+        return {}
+    end = text.find("\n---", 3)
+    if end < 0:
+        return {}
+    data = yaml.safe_load(text[3:end])
+    return data if isinstance(data, dict) else {}
+
+
+def chapter_source(app: Sphinx, pagename: str) -> Path | None:
+    """The MyST notebook behind ``pagename``, or None when the page is not a chapter."""
+    if pagename == app.config.root_doc or pagename not in app.env.found_docs:
+        return None
+    source = Path(app.env.doc2path(pagename))
+    if source.suffix != ".md" or not source.is_file():
+        return None
+    if "kernelspec" not in _front_matter(source.read_text(encoding="utf-8")):
+        return None
+    return source
+
+
+def write_notebook(source: Path, target: Path) -> None:
+    """Convert a MyST notebook to .ipynb with every output and execution count cleared."""
+    notebook = jupytext.read(source)
+    notebook.metadata.pop("jupytext", None)
+    for cell in notebook.cells:
+        if cell.cell_type == "code":
+            cell.outputs = []
+            cell.execution_count = None
+    nbformat.validate(notebook)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    nbformat.write(notebook, target)
+
+
+def add_notebook(
+    app: Sphinx, pagename: str, templatename: str, context: dict[str, Any], doctree: Any
+) -> None:
+    source = chapter_source(app, pagename)
+    if source is None or app.builder.format != "html" or "body" not in context:
+        return
+    relative = f"{NOTEBOOK_DIR}/{Path(pagename).name}.ipynb"
+    write_notebook(source, Path(app.outdir) / relative)
+    href = context["pathto"](relative, 1)
+    link = (
+        '<p class="chapter-notebook"><a class="reference download" '
+        f'href="{href}" download>{LINK_TEXT}</a></p>'
+    )
+    body = context["body"]
+    end_of_title = body.find("</h1>")
+    if end_of_title < 0:
+        context["body"] = link + body
+    else:
+        cut = end_of_title + len("</h1>")
+        context["body"] = body[:cut] + link + body[cut:]
+
+
+def setup(app: Sphinx) -> dict[str, Any]:
+    app.connect("html-page-context", add_notebook)
+    return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}
