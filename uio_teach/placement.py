@@ -5,15 +5,11 @@ from __future__ import annotations
 import control as ct
 import numpy as np
 
-from ._display import format_complex
+from ._display import format_complex, format_poles
 from ._validation import as_poles
-from .linalg import ObservabilitySplit, _sort, observability_decomposition
+from .linalg import ObservabilitySplit, observability_decomposition
 
 __all__ = ["place_observer_poles"]
-
-
-def _fmt(values) -> str:
-    return "{" + ", ".join(format_complex(v) for v in values) + "}"
 
 
 def place_observer_poles(
@@ -72,7 +68,11 @@ def place_observer_poles(
     if len(poles) == n and len(fixed) and no != n:
         poles = _strip_fixed(poles, fixed)
     if len(poles) != no:
-        fixed_txt = f"; the modes {_fmt(fixed)} are fixed ({fixed_name})" if len(fixed) else ""
+        fixed_txt = (
+            f"; the modes {format_poles(fixed, braces=True, empty='none')} are fixed ({fixed_name})"
+            if len(fixed)
+            else ""
+        )
         raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     if no == 0:
         return np.zeros((n, C.shape[0]))
@@ -112,8 +112,3 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
         return np.asarray(ct.place(Ao.T, Cr.T, poles), float).reshape(k, -1).T
     except ValueError as exc:  # pragma: no cover - scipy's message is kept for the rare case
         raise ValueError(f"poles: placement failed: {exc}") from None
-
-
-def sorted_eigvals(M: np.ndarray) -> np.ndarray:
-    """Eigenvalues sorted by real then imaginary part (internal helper)."""
-    return _sort(np.linalg.eigvals(M))
