@@ -650,7 +650,12 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     requested = None
     if K1 is None:
         Lo = place_observer_poles(
-            dec.A1, dec.N @ plant.C, poles, split=dec.split, fixed_name="invariant zeros"
+            dec.A1,
+            dec.N @ plant.C,
+            poles,
+            split=dec.split,
+            fixed_name="invariant zeros",
+            verify=False,
         )
         K1 = Lo @ dec.N
         requested = _requested(poles, dec.split)
@@ -752,7 +757,12 @@ def design_pmo(
         split = dec.split if Mv is None else observability_decomposition(dec.A1, dec.N @ plant.C)
         L = (
             place_observer_poles(
-                dec.A1, dec.N @ plant.C, poles, split=split, fixed_name="invariant zeros"
+                dec.A1,
+                dec.N @ plant.C,
+                poles,
+                split=split,
+                fixed_name="invariant zeros",
+                verify=False,
             )
             @ dec.N
         )
@@ -843,7 +853,7 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     requested = None
     if L is None:
         split = observability_decomposition(plant.A, plant.C)
-        L = place_observer_poles(plant.A, plant.C, poles, split=split)
+        L = place_observer_poles(plant.A, plant.C, poles, split=split, verify=False)
         requested = _requested(poles, split)
     else:
         L = as_matrix("L", L, plant.n, plant.p, what="n x p")
