@@ -6,12 +6,13 @@ import warnings
 
 import control as ct
 import numpy as np
+import scipy.linalg as sla
 import scipy.signal as ssig
 
 from ._display import format_complex, format_poles
 from ._validation import as_matrix, as_poles
 from .linalg import ObservabilitySplit, observability_decomposition
-from .verify import PlacementAccuracyError, check_poles
+from .verify import POLE_RTOL, PlacementAccuracyError, check_poles
 
 __all__ = ["place_observer_poles"]
 
@@ -96,18 +97,51 @@ def place_observer_poles(
         raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     if no == 0:
         return np.zeros((n, C.shape[0]))
+    L = _gain(split, poles)
+    target = np.concatenate([poles, fixed])
+    if _error(A, C, L, target) > POLE_RTOL:
+        # a badly scaled plant: place on the balanced pair (T^-1 A T, C T), L = T L_b
+        t = _balance(A)
+        if np.any(t != 1.0):
+            Ab, Cb = A / t[:, None] * t[None, :], C * t[None, :]
+            split_b = observability_decomposition(Ab, Cb)
+            if split_b.Ao.shape[0] == no:
+                try:
+                    Lb = t[:, None] * _gain(split_b, poles)
+                except PlacementAccuracyError:
+                    Lb = None
+                if Lb is not None and _error(A, C, Lb, target) < _error(A, C, L, target):
+                    L = Lb
+    if verify:
+        with np.errstate(all="ignore"):
+            F = A - L @ C
+        check_poles(F, np.concatenate([poles, fixed]), what="the placement", stacklevel=3)
+    return L
+
+
+def _gain(split: ObservabilitySplit, poles: np.ndarray) -> np.ndarray:
+    """Gain placing ``poles`` on the observable part of ``split`` (original coordinates)."""
+    n = split.Vo.shape[0]
+    if split.Ao.shape[0] == 0:
+        return np.zeros((n, split.Co.shape[0]))
     # use independent output combinations only
     U, s, _ = np.linalg.svd(split.Co, full_matrices=False)
     k = int(np.sum(s > max(split.Co.shape) * np.finfo(float).eps * (s[0] if s.size else 0)))
     Uk = U[:, :k]
     Cr = Uk.T @ split.Co
     Lr = _place(split.Ao, Cr, poles, k)
-    L = split.Vo @ Lr @ Uk.T
-    if verify:
-        with np.errstate(all="ignore"):
-            F = A - L @ C
-        check_poles(F, np.concatenate([poles, fixed]), what="the placement", stacklevel=3)
-    return L
+    return split.Vo @ Lr @ Uk.T
+
+
+def _error(A: np.ndarray, C: np.ndarray, L: np.ndarray, target: np.ndarray) -> float:
+    """Largest relative distance between ``target`` and ``eig(A - L C)`` (matched)."""
+    return _pole_error(A, C, L, target)
+
+
+def _balance(A: np.ndarray) -> np.ndarray:
+    """Diagonal similarity (powers of 2) that balances ``A``."""
+    _, (t, _) = sla.matrix_balance(A, permute=False, separate=True)
+    return np.asarray(t, float)
 
 
 def _strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
