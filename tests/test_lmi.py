@@ -32,10 +32,7 @@ def test_badly_scaled_detectable_pair_is_solved():
 def test_scaled_pairs_give_the_same_certified_stability(decades):
     s = np.logspace(0, decades, 3)
     A, C = np.diag(s) @ A0 @ np.diag(1 / s), C0 @ np.diag(1 / s)
-    try:
-        L, P = ut.lmi_gain(A, C, dt=True)
-    except LMISolverError:
-        return  # refused clearly: a numerical failure, named as such
+    L, P = ut.lmi_gain(A, C, dt=True)
     assert np.max(np.abs(np.linalg.eigvals(A - L @ C))) < 1 - STRICT_MARGIN
 
 

@@ -49,7 +49,7 @@ _EPS = np.finfo(float).eps
 
 def _fmt(values) -> str:
     """Each value on its own scale (a huge pole must not print its neighbours as 0)."""
-    return "{" + ", ".join(format_complex(v) for v in values) + "}" if len(values) else "none"
+    return "{" + ", ".join(format_complex(v, 7) for v in values) + "}" if len(values) else "none"
 
 
 class PlacementAccuracyWarning(UserWarning):
