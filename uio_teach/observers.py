@@ -267,7 +267,7 @@ class UIO(_ProjectionObserver):
     @property
     def K(self) -> np.ndarray:
         """``K1 + K2``."""
-        return self._K1 + self._K2
+        return _frozen(self._K1 + self._K2)
 
     @property
     def F(self) -> np.ndarray:
@@ -330,7 +330,7 @@ class PMO(_ProjectionObserver):
     @property
     def A1(self) -> np.ndarray:
         """``(I - M C) A``."""
-        return self._T @ self.plant.A
+        return _frozen(self._T @ self.plant.A)
 
     @property
     def L(self) -> np.ndarray:
@@ -345,7 +345,7 @@ class PMO(_ProjectionObserver):
     @property
     def G(self) -> np.ndarray:
         """``(I - MC) A M + L - L C M``: the measurement gain of eq. (13)."""
-        return self._K1 + self._K2
+        return _frozen(self._K1 + self._K2)
 
 
 class GInverseObserver(Observer):
@@ -433,7 +433,7 @@ class GInverseObserver(Observer):
     @property
     def F(self) -> np.ndarray:
         """``Av - Kv Cv``: the observer-state matrix of eq. (21)."""
-        return self.Av - self.Kv @ self.Cv
+        return _frozen(self.Av - self.Kv @ self.Cv)
 
     @property
     def error_matrix(self) -> np.ndarray:
