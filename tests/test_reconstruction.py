@@ -346,3 +346,30 @@ def test_pa9_lab_sinusoid_is_reconstructed():
     est = ut.reconstruct_input(plant, run)
     assert np.abs(est.error[:, t > 10]).max() < 1e-4
     assert ut.catch_time(t, est.actual, est.estimates) < 6.0
+
+
+def test_nan_estimate_is_never_caught():
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ValueError, match="^estimate has no finite sample"):
+        ut.catch_time(t, np.ones(11), np.full(11, np.nan))
+    # one channel all NaN, the other fine: that channel never caught anything
+    actual = np.ones((2, 11))
+    estimate = np.vstack([np.full(11, np.nan), np.ones(11)])
+    np.testing.assert_array_equal(ut.catch_time(t, actual, estimate), [1.0, 0.0])
+    # a NaN in the middle of a settled estimate counts as outside the band
+    mid = np.ones(11)
+    mid[5] = np.nan
+    assert ut.catch_time(t, np.ones(11), mid) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize(
+    ("args", "name"),
+    [
+        (("a", "b", "c"), "time"),
+        ((np.arange(3.0), "b", "c"), "actual"),
+        ((np.arange(3.0), np.ones(3), "c"), "estimate"),
+    ],
+)
+def test_catch_time_names_the_argument_that_is_not_numeric(args, name):
+    with pytest.raises(ValueError, match=rf"^{name} must"):
+        ut.catch_time(*args)
