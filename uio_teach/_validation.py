@@ -102,7 +102,7 @@ def as_time(name: str, value: Any, *, min_size: int = 2, uniform: bool = False) 
 
 
 def as_seed(name: str, value: Any) -> Any:
-    """``None``, a non-negative integer or a :class:`numpy.random.Generator`."""
+    """``None``, a non-negative integer or a ``numpy.random.Generator``."""
     if value is None or isinstance(value, np.random.Generator):
         return value
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:

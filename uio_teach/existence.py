@@ -46,7 +46,7 @@ class Condition:
     required: bool = True
     margin: float | None = None
     """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
-    rank threshold); below :data:`uio_teach.linalg.MARGIN` the verdict hangs on round-off and
+    rank threshold); below ``uio_teach.linalg.MARGIN`` the verdict hangs on round-off and
     the reason says so."""
 
     @property

@@ -3,9 +3,7 @@
 Everything here works on plain arrays and is shared by the existence check and
 the observer designs.
 
-Tolerance policy
-----------------
-Every yes/no decision of the course (a rank, observability, detectability, the
+**Tolerance policy.** Every yes/no decision of the course (a rank, observability, detectability, the
 invariant zeros, the fixed modes) is made by one rule:
 
 * **Relative to the factors, not to the product.** A singular value ``s`` of a
@@ -18,16 +16,16 @@ invariant zeros, the fixed modes) is made by one rule:
   look like a full-rank matrix.
 * **Relative to the data's precision.** ``eps`` is the double precision
   (``2.2e-16``); data known to fewer digits can pass ``rtol`` (e.g. ``1e-4``
-  for a matrix printed with four decimals) to :func:`rank_decision`.
+  for a matrix printed with four decimals) to ``rank_decision``.
 * **Marginal verdicts say so.** A kept singular value less than
-  :data:`MARGIN` times the threshold means that the verdict hangs on round-off:
-  :func:`rank_decision` returns the ratio ``s / threshold`` as ``margin`` and
+  ``MARGIN`` times the threshold means that the verdict hangs on round-off:
+  ``rank_decision`` returns the ratio ``s / threshold`` as ``margin`` and
   ``marginal=True``; the existence report then states the verdict *and* the
   margin instead of guessing.
 * **Invariant zeros** are computed on a scaled copy of the system
   (``||A|| = ||B|| = ||C|| = 1`` after a diagonal balancing of ``A``), so that a
   large eigenvalue of ``A`` does not make the other blocks look like zero.
-* **Computed designs are verified** (:mod:`uio_teach.verify`): the obtained
+* **Computed designs are verified** (``uio_teach.verify``): the obtained
   poles against the requested ones with a tolerance that grows with the
   eigenvalue condition numbers, and the decoupling identities ``T E = 0``,
   ``H C E = E``, ``L D = 0`` against ``1e-8`` relative to the factors.
@@ -149,7 +147,7 @@ def rank(M: np.ndarray, *, scale: float | None = None) -> int:
     M : array_like
         The matrix (real or complex).
     scale : float, optional
-        Size of the data ``M`` was computed from (see :func:`rank_decision`);
+        Size of the data ``M`` was computed from (see ``rank_decision``);
         default ``||M||``.
 
     Examples
@@ -264,7 +262,7 @@ class ObservabilitySplit(NamedTuple):
 
     @property
     def marginal(self) -> bool:
-        """True when a rank decision of the staircase sat within :data:`MARGIN` of round-off."""
+        """True when a rank decision of the staircase sat within ``MARGIN`` of round-off."""
         return bool(self.margin < MARGIN)
 
     @property

@@ -17,7 +17,7 @@ from .linalg import is_stable, left_null, observability_decomposition, pinv
 __all__ = ["LMIError", "LMIInfeasibleError", "LMISolverError", "LMIResult", "lmi_gain"]
 
 #: Relative margin of a certified gain: every pole at least this far inside the boundary
-#: (the margin of :func:`uio_teach.linalg.is_stable`, so a certified observer is ``is_stable``).
+#: (the margin of ``uio_teach.linalg.is_stable``, so a certified observer is ``is_stable``).
 STRICT_MARGIN = 1e-9
 
 

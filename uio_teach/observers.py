@@ -626,11 +626,17 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     ValueError
         Neither or both of ``poles`` and ``K1`` given, a wrong number of
         poles, or ``K1`` of the wrong shape.
+    PlacementAccuracyError
+        The computed design fails its own check (``uio_teach.verify``): the
+        poles obtained differ from those requested beyond the tolerance, or a
+        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
 
     Warns
     -----
     UnstableObserverWarning
         If the chosen poles or ``K1`` leave the error dynamics unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
 
     Examples
     --------
@@ -714,11 +720,17 @@ def design_pmo(
         ``method="lmi"`` and the LMI has no solution.
     ValueError
         Inconsistent arguments, wrong pole count or shapes.
+    PlacementAccuracyError
+        The computed design fails its own check (``uio_teach.verify``): the
+        poles obtained differ from those requested beyond the tolerance, or a
+        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
 
     Warns
     -----
     UnstableObserverWarning
         If the error dynamics are unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
 
     Examples
     --------
@@ -799,6 +811,10 @@ def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     ValueError
         The plant has a measurement disturbance, ``C`` is rank deficient, or
         ``Kv`` has the wrong shape.
+    PlacementAccuracyError
+        The computed design fails its own check (``uio_teach.verify``): the
+        poles obtained differ from those requested beyond the tolerance, or a
+        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
 
     Examples
     --------
@@ -839,6 +855,13 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     Returns
     -------
     LuenbergerObserver
+
+    Raises
+    ------
+    PlacementAccuracyError
+        The computed design fails its own check (``uio_teach.verify``): the
+        poles obtained differ from those requested beyond the tolerance, or a
+        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
 
     Examples
     --------

@@ -44,7 +44,7 @@ def place_observer_poles(
         How the fixed modes are called in error messages.
     verify : bool
         Compare ``eig(A - L C)`` with the requested poles and the fixed modes
-        (:func:`uio_teach.verify.check_poles`); the designs switch this off
+        (``uio_teach.verify.check_poles``); the designs switch this off
         because they check their own error matrix.
 
     Returns

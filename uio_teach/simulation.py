@@ -560,7 +560,7 @@ _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e30
 
 
 def _check_range(z: np.ndarray, Az: np.ndarray, plant: Plant, t: np.ndarray) -> None:
-    """Raise :class:`SimulationOverflowError` if the response leaves the float range."""
+    """Raise ``SimulationOverflowError`` if the response leaves the float range."""
     bad = ~np.isfinite(z) | (np.abs(z) > _BIG)
     if np.any(bad):
         k = int(np.argmax(bad.any(axis=0)))

@@ -13,12 +13,12 @@ it obtained with what it promised:
   requested value is an eigenvalue of a matrix within ``n * eps * ||F||`` of
   ``F`` (backward check) -- the last two only up to ``WARN_RTOL * max(1, |p|)``:
   an error of that size is what the problem's conditioning allows. Otherwise,
-  within ``WARN_RTOL``: a :class:`PlacementAccuracyWarning`; beyond ``WARN_RTOL``,
-  or a non-finite gain: a :class:`PlacementAccuracyError`. Both name requested
+  within ``WARN_RTOL``: a ``PlacementAccuracyWarning``; beyond ``WARN_RTOL``,
+  or a non-finite gain: a ``PlacementAccuracyError``. Both name requested
   and obtained poles and the conditioning.
 * **Identities.** ``T E = 0``, ``H C E = E``, ``L D = 0`` (and their analogues)
   must hold to ``IDENTITY_RTOL`` relative to the product of the factors' norms,
-  or a :class:`PlacementAccuracyError` is raised.
+  or a ``PlacementAccuracyError`` is raised.
 """
 
 from __future__ import annotations
@@ -85,7 +85,7 @@ def check_poles(
     what : str
         How the design is called in messages.
     stacklevel : int
-        Passed to :func:`warnings.warn`.
+        Passed to ``warnings.warn``.
 
     Returns
     -------
