@@ -161,11 +161,11 @@ def lmi_gain(
         The LMI has no solution: no gain of this form achieves the bound
         (also when a mode that no gain can move lies on or beyond it; the
         message names the mode).
-    LMISolverError
-        The solver failed numerically or returned a gain that does not meet
-        the bound: not a proof of infeasibility.
     ValueError
-        A matrix of the wrong shape or with complex or non-finite entries,
+        ``uio_teach.lmi.LMISolverError`` (a ``ValueError``, not an
+        ``LMIInfeasibleError``): the solver failed numerically or returned a
+        gain that does not meet the bound; this is not a proof of infeasibility.
+        Otherwise: a matrix of the wrong shape or with complex or non-finite entries,
         ``dt`` not None/True/a positive number, ``solver`` not installed,
         ``decay`` not a number in range.
 

@@ -626,10 +626,11 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     ValueError
         Neither or both of ``poles`` and ``K1`` given, a wrong number of
         poles, or ``K1`` of the wrong shape.
-    PlacementAccuracyError
-        The computed design fails its own check (``uio_teach.verify``): the
-        poles obtained differ from those requested beyond the tolerance, or a
-        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Warns
     -----
@@ -720,10 +721,11 @@ def design_pmo(
         ``method="lmi"`` and the LMI has no solution.
     ValueError
         Inconsistent arguments, wrong pole count or shapes.
-    PlacementAccuracyError
-        The computed design fails its own check (``uio_teach.verify``): the
-        poles obtained differ from those requested beyond the tolerance, or a
-        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Warns
     -----
@@ -811,10 +813,11 @@ def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     ValueError
         The plant has a measurement disturbance, ``C`` is rank deficient, or
         ``Kv`` has the wrong shape.
-    PlacementAccuracyError
-        The computed design fails its own check (``uio_teach.verify``): the
-        poles obtained differ from those requested beyond the tolerance, or a
-        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Examples
     --------
@@ -858,10 +861,11 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
 
     Raises
     ------
-    PlacementAccuracyError
-        The computed design fails its own check (``uio_teach.verify``): the
-        poles obtained differ from those requested beyond the tolerance, or a
-        decoupling identity (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Examples
     --------

@@ -675,9 +675,10 @@ def simulate(
         (discrete plant) not on the sampling grid, an initial state of the wrong
         length, or a plant that does not match the observer. The message names
         the argument.
-    SimulationOverflowError
-        The response leaves the floating-point range (an unstable pole over a
-        long time span): the message names the unstable poles and the time.
+    OverflowError
+        ``uio_teach.simulation.SimulationOverflowError``: the response leaves
+        the floating-point range (an unstable pole over a long time span); the
+        message names the unstable poles and the time.
 
     See Also
     --------
