@@ -93,3 +93,15 @@ def test_observability_split_reports_its_margin():
     assert "within the numerical margin" in report["observable (TA, C)"].reason
     split = ut.linalg.observability_decomposition(np.diag([-1.0, -2.0]), [[1.0, 1.0]])
     assert not split.marginal
+
+
+def test_zero_on_the_edge_of_the_stability_region_is_reported_as_marginal():
+    # G(s) = (s + 1e-8) / ((s + 1)(s + 2)): a zero 1e-8 from the imaginary axis
+    plant = ut.Plant([[0.0, 1.0], [-2.0, -3.0]], [[1e-8, 1.0]], E=[0.0, 1.0])
+    report = ut.check_existence(plant)
+    cond = report["invariant zeros stable"]
+    assert cond.holds is True
+    assert (
+        "within the numerical margin" in cond.reason and "1e-08 from the imaginary" in cond.reason
+    )
+    assert "within the numerical margin" in report["detectable (TA, C)"].reason

@@ -187,6 +187,29 @@ class UIOExistenceError(ValueError):
         super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
 
 
+ZERO_MARGIN = 1e-6
+"""A zero or fixed mode closer than this (relative to ``max(1, ||A||)``) to the stability
+boundary is reported as marginal: round-off of the data could move it across."""
+
+
+def _boundary_note(values: np.ndarray, discrete: bool, A: np.ndarray) -> str:
+    """A note for values that sit within the numerical margin of the stability boundary."""
+    if not len(values):
+        return ""
+    values = np.asarray(values, complex)
+    dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
+    scale = max(1.0, float(np.linalg.norm(A, 2)))
+    close = dist <= ZERO_MARGIN * scale
+    if not np.any(close):
+        return ""
+    where = "unit circle" if discrete else "imaginary axis"
+    return (
+        f" (within the numerical margin: {format_poles(values[close], braces=True)} lie(s) "
+        f"{float(np.max(dist[close])):.2g} from the {where}, so round-off of the data could "
+        "change this verdict)"
+    )
+
+
 def _pair_name(plant: Plant) -> str:
     return "(A1, N C)" if plant.r else "(TA, C)"
 
@@ -264,6 +287,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
     Dz = np.hstack([np.zeros((plant.p, plant.q)), D])
     zeros = invariant_zeros(plant.A, Bz, C, Dz)
     bad = zeros[~is_stable(zeros, discrete)]
+    zero_note = _boundary_note(zeros, discrete, plant.A)
     if not len(zeros):
         conds.append(Condition("invariant zeros stable", True, "no invariant zeros"))
     elif not len(bad):
@@ -271,7 +295,8 @@ def check_existence(plant: Plant) -> ExistenceReport:
             Condition(
                 "invariant zeros stable",
                 True,
-                f"zeros {format_poles(zeros, braces=True, empty='none')} all lie in {region}",
+                f"zeros {format_poles(zeros, braces=True, empty='none')} all lie in {region}"
+                + zero_note,
             )
         )
     else:
@@ -281,7 +306,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
                 False,
                 f"invariant zero(s) {format_poles(bad, braces=True, empty='none')} outside "
                 f"{region}: they are observer poles "
-                "no gain can move, so the error would not decay",
+                "no gain can move, so the error would not decay" + zero_note,
             )
         )
 
@@ -294,7 +319,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
         movable = dec.split.Ao.shape[0]
         unstable = fixed[~is_stable(fixed, discrete)]
         obs_margin = dec.split.margin
-        note = (
+        note = _boundary_note(fixed, discrete, plant.A) + (
             f" (within the numerical margin: a singular value of the observability staircase "
             f"is only {obs_margin:.3g} times the rank threshold)"
             if obs_margin < MARGIN
