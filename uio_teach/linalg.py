@@ -268,7 +268,7 @@ class ObservabilitySplit(NamedTuple):
     @property
     def unobservable_modes(self) -> np.ndarray:
         """Eigenvalues of ``Au``, sorted."""
-        return _sort(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
+        return sort_poles(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
 
 
 def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySplit:
@@ -479,7 +479,7 @@ def invariant_zeros(
     if D2.shape[0] != D2.shape[1]:  # normal-rank deficient: fall back on what remains
         return np.zeros(0, complex)
     if mr == 0:
-        return _sort(np.linalg.eigvals(A2))
+        return sort_poles(np.linalg.eigvals(A2))
     # compress the columns of [C D] onto D: [C D] W = [0 Df]
     CD = np.hstack([C2, D2])
     Q, _ = np.linalg.qr(CD.T[:, ::-1], mode="complete")
@@ -489,7 +489,7 @@ def invariant_zeros(
     Af, Ef = AB[:, :nr], IB[:, :nr]
     w = sla.eigvals(Af, Ef)
     w = w[np.isfinite(w) & (np.abs(w) < 1e12 * scale)]
-    return _sort(w)
+    return sort_poles(w)
 
 
 def _reduce(A, B, C, D, scale):
