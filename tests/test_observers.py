@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import uio_teach as ut
+from uio_teach.verify import PlacementAccuracyError
 
 
 def test_pole_count_error_says_what_can_be_placed():
@@ -201,3 +202,88 @@ def test_conjugate_pairs_sort_consistently():
     report = ut.check_existence(ut.examples.missile_autopilot())
     np.testing.assert_allclose(report.invariant_zeros, report.fixed_modes, rtol=1e-9)
     assert report.invariant_zeros[0].imag < 0
+
+
+# --- the textbook matrices are read-only and consistent -------------------------------------
+
+
+def _families():
+    pa9, missile, case = (
+        ut.examples.pa9(),
+        ut.examples.missile_autopilot(),
+        ut.examples.dt_case_study(),
+    )
+    return [
+        (ut.design_uio(pa9, poles=[-1, -2, -3]), ("H", "T", "K1", "K2", "K", "F")),
+        (ut.design_pmo(case, method="lmi"), ("M", "A1", "L", "F", "G", "Mv", "lmi_certificate")),
+        (ut.design_ginverse(missile), ("Cg", "K", "Av", "Cv", "Kv", "G", "projection")),
+        (ut.design_luenberger(pa9, poles=[-1, -2, -3]), ("L", "F")),
+    ]
+
+
+@pytest.mark.parametrize("index", range(4))
+def test_observer_matrices_are_read_only_properties(index):
+    obs, names = _families()[index]
+    for name in (*names, "plant"):
+        assert isinstance(getattr(type(obs), name, None), property), name
+        with pytest.raises(AttributeError, match=rf"{name} is read-only.*design a new observer"):
+            setattr(obs, name, np.zeros((1, 1)))
+    for name in names:
+        value = getattr(obs, name)
+        if isinstance(value, np.ndarray) and value.size:
+            with pytest.raises(ValueError, match="read-only"):
+                value[(0,) * value.ndim] = 1.0
+
+
+def test_derived_matrices_stay_consistent():
+    obs = ut.design_luenberger(ut.examples.pa9(), poles=[-1, -2, -3])
+    np.testing.assert_allclose(obs.F, obs.plant.A - obs.L @ obs.plant.C)
+    with pytest.raises(AttributeError):
+        obs.L = np.zeros_like(obs.L)
+    np.testing.assert_allclose(obs.F, obs.plant.A - obs.L @ obs.plant.C)
+
+
+def test_gains_are_keyword_only():
+    with pytest.raises(TypeError):
+        ut.design_ginverse(ut.examples.missile_autopilot(), np.zeros((4, 2)))
+    with pytest.raises(TypeError):
+        ut.design_uio(ut.examples.pa9(), None, np.zeros((3, 2)))
+    with pytest.raises(TypeError):
+        ut.design_luenberger(ut.examples.pa9(), None, np.zeros((3, 2)))
+    with pytest.raises(TypeError):
+        ut.lmi_gain([[0.5]], [[1.0]], None, True)
+
+
+@pytest.mark.parametrize("name", ["K1", "L"])
+def test_complex_gain_is_refused_not_truncated(name):
+    gain = np.zeros((3, 2)) + 1e-3j
+    design = ut.design_uio if name == "K1" else ut.design_pmo
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # not numpy's ComplexWarning: our error
+        with pytest.raises(ValueError, match=rf"^{name} must .*complex"):
+            design(ut.examples.pa9(), **{name: gain})
+
+
+def test_complex_numpy_arrays_are_refused_like_complex_lists():
+    A = np.array([[0.0, 1.0], [-2.0, -3.0]], dtype=complex)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for value in (A, A.tolist()):
+            with pytest.raises(ValueError, match="^A must be a real numeric matrix, got complex"):
+                ut.Plant(value, [[1.0, 0.0]])
+        with pytest.raises(ValueError, match="^Mv must"):
+            ut.design_pmo(ut.examples.missile_autopilot(), [-80, -120], Mv=np.ones((4, 2)) * 1j)
+        with pytest.raises(ValueError, match="^Kv must"):
+            ut.design_ginverse(ut.examples.missile_autopilot(), Kv=np.ones((4, 2)) * 1j)
+        with pytest.raises(ValueError, match="^A1 must"):
+            ut.lmi_gain(np.array([[0.5 + 0j]]), [[1.0]], dt=True)
+
+
+def test_designs_report_requested_versus_obtained_when_placement_is_inaccurate():
+    rng = np.random.default_rng(7)
+    A = rng.standard_normal((14, 14))
+    C = rng.standard_normal((1, 14))
+    with pytest.raises(
+        PlacementAccuracyError, match=r"the Luenberger observer: .*requested .*obtained"
+    ):
+        ut.design_luenberger(ut.Plant(A, C), poles=-1 - 0.05 * np.arange(14))

@@ -292,10 +292,14 @@ def test_catch_time_reads_the_last_exit_from_the_band():
     bumped = estimate.copy()
     bumped[800] += 0.5
     assert ut.catch_time(t, actual, bumped) == pytest.approx(0.8)
-    # NaN samples (undefined estimates) are skipped
+    # trailing NaN samples (undefined end of a discrete reconstruction) are not judged
+    tail = estimate.copy()
+    tail[-1] = np.nan
+    assert ut.catch_time(t, actual, tail) == caught
+    # any other NaN is never "caught": it counts as outside the band
     holes = estimate.copy()
     holes[[0, 999]] = np.nan
-    assert ut.catch_time(t, actual, holes) == caught
+    assert ut.catch_time(t, actual, holes) == pytest.approx(0.999)
     # never outside: 0.0 (even when time does not start at 0)
     assert ut.catch_time(t + 5.0, actual, actual + 0.01) == 0.0
     # the band scales with max|actual| and tol
@@ -322,10 +326,10 @@ def test_catch_time_per_channel():
     [
         ((np.arange(5.0), np.zeros(4), np.zeros(4)), {}, r"one sample per time point \(5\), got 4"),
         ((np.arange(5.0), np.zeros(5), np.zeros(4)), {}, r"same shape, got \(5,\) and \(4,\)"),
-        ((np.zeros((2, 5)), np.zeros(5), np.zeros(5)), {}, r"time must be 1-D"),
+        ((np.zeros((2, 5)), np.zeros(5), np.zeros(5)), {}, r"time must be a 1-D"),
         ((np.arange(5.0), np.zeros((1, 1, 5)), np.zeros((1, 1, 5))), {}, r"1-D or 2-D"),
-        ((np.arange(5.0), np.zeros(5), np.zeros(5)), {"tol": -0.1}, r"tol must be a finite"),
-        ((np.arange(5.0), np.zeros(5), np.zeros(5)), {"tol": "2%"}, r"tol must be a number"),
+        ((np.arange(5.0), np.zeros(5), np.zeros(5)), {"tol": -0.1}, r"tol must be >= 0"),
+        ((np.arange(5.0), np.zeros(5), np.zeros(5)), {"tol": "2%"}, r"tol must be a real number"),
     ],
 )
 def test_catch_time_validates(args, kwargs, pattern):
@@ -342,3 +346,30 @@ def test_pa9_lab_sinusoid_is_reconstructed():
     est = ut.reconstruct_input(plant, run)
     assert np.abs(est.error[:, t > 10]).max() < 1e-4
     assert ut.catch_time(t, est.actual, est.estimates) < 6.0
+
+
+def test_nan_estimate_is_never_caught():
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ValueError, match="^estimate has no finite sample"):
+        ut.catch_time(t, np.ones(11), np.full(11, np.nan))
+    # one channel all NaN, the other fine: that channel never caught anything
+    actual = np.ones((2, 11))
+    estimate = np.vstack([np.full(11, np.nan), np.ones(11)])
+    np.testing.assert_array_equal(ut.catch_time(t, actual, estimate), [1.0, 0.0])
+    # a NaN in the middle of a settled estimate counts as outside the band
+    mid = np.ones(11)
+    mid[5] = np.nan
+    assert ut.catch_time(t, np.ones(11), mid) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize(
+    ("args", "name"),
+    [
+        (("a", "b", "c"), "time"),
+        ((np.arange(3.0), "b", "c"), "actual"),
+        ((np.arange(3.0), np.ones(3), "c"), "estimate"),
+    ],
+)
+def test_catch_time_names_the_argument_that_is_not_numeric(args, name):
+    with pytest.raises(ValueError, match=rf"^{name} must"):
+        ut.catch_time(*args)

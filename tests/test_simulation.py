@@ -593,3 +593,74 @@ def test_a_different_true_plant_shows_model_error():
     wrong = ut.simulate(true, obs, t, d=d)
     assert np.abs(exact.error).max() < 1e-12
     assert np.abs(wrong.error).max() > 1e-2
+
+
+# --- arguments and overflow -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, "x", True, [1, 2]])
+def test_seed_must_be_a_non_negative_integer(seed):
+    plant = examples.pa9()
+    obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    with pytest.raises(ValueError, match="^seed must be None, a non-negative integer"):
+        ut.simulate(plant, obs, np.linspace(0, 1, 11), noise=0.1, seed=seed)
+
+
+def test_valid_seeds_reproduce_the_noise():
+    plant = examples.pa9()
+    obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    t = np.linspace(0, 1, 11)
+    a = ut.simulate(plant, obs, t, noise=0.1, seed=np.int64(3)).outputs
+    b = ut.simulate(plant, obs, t, noise=0.1, seed=3).outputs
+    c = ut.simulate(plant, obs, t, noise=0.1, seed=np.random.default_rng(3)).outputs
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a, c)
+
+
+@pytest.mark.parametrize("noise", ["0.1", b"0.1", True, 0.1j, [np.nan, 0.1], -0.1])
+def test_noise_must_be_a_finite_non_negative_number(noise):
+    plant = examples.pa9()
+    obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    with pytest.raises(ValueError, match="^noise"):
+        ut.simulate(plant, obs, np.linspace(0, 1, 11), noise=noise)
+
+
+def test_stiff_but_stable_observer_pole_is_simulated():
+    plant = examples.pa9()
+    obs = ut.design_uio(plant, poles=[-1, -2, -1e4])
+    t = np.linspace(0, 2, 201)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run = ut.simulate(plant, obs, t, initial_state=[1, 0, 0], d=signals.step(1.0))
+    assert np.all(np.isfinite(run.error))
+    # the error obeys e' = F e: compare with the matrix exponential
+    e0 = run.error[:, 0]
+    np.testing.assert_allclose(run.error[:, -1], sla.expm(obs.F * 2.0) @ e0, atol=1e-9)
+
+
+@pytest.mark.parametrize(("pole", "t_end"), [(100.0, 10.0), (1e4, 1.0), (100.0, 1e4)])
+def test_overflow_names_the_unstable_pole_and_the_time(pole, t_end):
+    plant = examples.pa9()
+    with pytest.warns(ut.UnstableObserverWarning):
+        obs = ut.design_uio(plant, poles=[-1, -2, pole])
+    t = np.linspace(0, t_end, 1001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # no raw overflow warnings
+        with pytest.raises(ut.simulation.SimulationOverflowError) as info:
+            ut.simulate(plant, obs, t, initial_state=[1, 0, 0])
+    err = info.value
+    assert isinstance(err, OverflowError)
+    assert f"{ut._display.format_complex(pole)} (observer)" in str(err)
+    assert np.any(np.isclose(err.poles.real, pole))
+    # the response leaves the float range (1e300) after about ln(1e300) / pole time units
+    expected = math.log(1e300) / pole
+    assert err.time >= min(expected, t[1]) - 1e-12
+    assert err.time <= max(expected + 2 * (t[1] - t[0]), t[1])
+    assert f"t = {err.time:g}" in str(err)
+
+
+def test_unstable_plant_overflow_names_the_plant_pole():
+    plant = ut.Plant([[50.0]], [[1.0]])
+    obs = ut.design_luenberger(plant, poles=[-1.0])
+    with pytest.raises(ut.simulation.SimulationOverflowError, match=r"50 \(plant\)"):
+        ut.simulate(plant, obs, np.linspace(0, 20, 2001), initial_state=[1.0])

@@ -7,7 +7,110 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["as_matrix", "as_poles", "shape_str"]
+__all__ = [
+    "as_matrix",
+    "as_poles",
+    "as_real_array",
+    "as_time",
+    "as_seed",
+    "as_real_number",
+    "shape_str",
+]
+
+
+def _refuse_non_real(name: str, value: Any, noun: str = "numeric") -> None:
+    """Complex values and text are refused with a message naming the argument."""
+    if isinstance(value, (str, bytes)):
+        raise ValueError(f"{name} must be {noun}, got the text {value!r}")
+    try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):
+        return  # ragged: the float conversion below names the argument
+    if kind == "c":
+        raise ValueError(
+            f"{name} must be {noun}, got complex values (the imaginary part would be dropped)"
+        )
+    if kind in "US":
+        raise ValueError(f"{name} must be {noun}, got text entries")
+    if kind == "O":
+        flat = np.asarray(value, dtype=object).ravel()
+        if any(isinstance(v, (complex, np.complexfloating)) for v in flat):
+            raise ValueError(
+                f"{name} must be {noun}, got complex values (the imaginary part would be dropped)"
+            )
+        if any(isinstance(v, (str, bytes)) for v in flat):
+            raise ValueError(f"{name} must be {noun}, got text entries")
+
+
+def as_real_array(name: str, value: Any, *, finite: bool = True) -> np.ndarray:
+    """``value`` as a float array; complex, text or (with ``finite``) non-finite values refused."""
+    _refuse_non_real(name, value, "real numbers")
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must hold real numbers: {exc}") from None
+    if finite and not np.all(np.isfinite(arr)):
+        bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0]) if arr.ndim else ()
+        raise ValueError(f"{name} has a non-finite value at position {bad}; all must be finite")
+    return arr
+
+
+def as_real_number(
+    name: str, value: Any, *, low: float | None = None, strict: bool = False
+) -> float:
+    """A finite real number (not a bool, not text), optionally ``>= low`` (``> low``)."""
+    from numbers import Real
+
+    if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    x = float(value)
+    if not np.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    if low is not None and (x <= low if strict else x < low):
+        raise ValueError(f"{name} must be {'>' if strict else '>='} {low:g}, got {value!r}")
+    return x
+
+
+def as_time(name: str, value: Any, *, min_size: int = 2, uniform: bool = False) -> np.ndarray:
+    """A 1-D, finite, strictly increasing time vector (uniformly spaced if ``uniform``)."""
+    if isinstance(value, (str, bytes)):
+        raise ValueError(f"{name} must be a 1-D array of times, got the text {value!r}")
+    t = as_real_array(name, value, finite=False)
+    if t.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D array of times, got shape {t.shape}")
+    if t.size < min_size:
+        raise ValueError(f"{name} must hold at least {min_size} time points, got {t.size}")
+    if not np.all(np.isfinite(t)):
+        k = int(np.argmax(~np.isfinite(t)))
+        raise ValueError(f"{name} must be finite numbers: {name}[{k}] = {t[k]}")
+    steps = np.diff(t)
+    if np.any(steps <= 0):
+        k = int(np.argmax(steps <= 0))
+        raise ValueError(
+            f"{name} must be strictly increasing: {name}[{k}] = {t[k]:g} and "
+            f"{name}[{k + 1}] = {t[k + 1]:g}"
+        )
+    if uniform and t.size > 2:
+        h = (t[-1] - t[0]) / (t.size - 1)
+        tol = 1e-9 * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
+        if np.max(np.abs(steps - h)) > tol:
+            raise ValueError(
+                f"{name} must be uniformly spaced, got steps from {steps.min():g} to "
+                f"{steps.max():g}"
+            )
+    return t
+
+
+def as_seed(name: str, value: Any) -> Any:
+    """``None``, a non-negative integer or a ``numpy.random.Generator``."""
+    if value is None or isinstance(value, np.random.Generator):
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ValueError(
+            f"{name} must be None, a non-negative integer or a numpy.random.Generator, "
+            f"got {value!r}"
+        )
+    return int(value)
 
 
 def shape_str(shape: Sequence[Any]) -> str:
@@ -40,6 +143,7 @@ def as_matrix(
     what : str
         Short explanation of the expected shape, appended to the error.
     """
+    _refuse_non_real(name, value, "a real numeric matrix")
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -75,6 +179,8 @@ def as_matrix(
 
 def as_poles(name: str, value: Any) -> np.ndarray:
     """Return requested poles as a 1-D complex array; conjugate pairs are required."""
+    if isinstance(value, (str, bytes)) or np.asarray(value).dtype.kind in "US":
+        raise ValueError(f"{name} must be a list of numbers, got {value!r}")
     try:
         poles = np.atleast_1d(np.array(value, dtype=complex)).ravel()
     except (TypeError, ValueError) as exc:

@@ -8,15 +8,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._display import format_complex
+from ._display import format_poles
 from .linalg import (
+    MARGIN,
     ObservabilitySplit,
     invariant_zeros,
     is_stable,
     left_null,
     observability_decomposition,
     pinv,
-    rank,
+    rank_decision,
 )
 from .plant import Plant
 
@@ -43,6 +44,15 @@ class Condition:
     holds: bool | None
     reason: str
     required: bool = True
+    margin: float | None = None
+    """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
+    rank threshold); below ``uio_teach.linalg.MARGIN`` the verdict hangs on round-off and
+    the reason says so."""
+
+    @property
+    def marginal(self) -> bool:
+        """True when the verdict sits within the numerical margin of the rank threshold."""
+        return self.margin is not None and self.margin < MARGIN
 
     @property
     def symbol(self) -> str:
@@ -177,8 +187,27 @@ class UIOExistenceError(ValueError):
         super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
 
 
-def _fmt(values: np.ndarray) -> str:
-    return "{" + ", ".join(format_complex(v) for v in values) + "}" if len(values) else "none"
+ZERO_MARGIN = 1e-6
+"""A zero or fixed mode closer than this (relative to ``max(1, ||A||)``) to the stability
+boundary is reported as marginal: round-off of the data could move it across."""
+
+
+def _boundary_note(values: np.ndarray, discrete: bool, A: np.ndarray) -> str:
+    """A note for values that sit within the numerical margin of the stability boundary."""
+    if not len(values):
+        return ""
+    values = np.asarray(values, complex)
+    dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
+    scale = max(1.0, float(np.linalg.norm(A, 2)))
+    close = dist <= ZERO_MARGIN * scale
+    if not np.any(close):
+        return ""
+    where = "unit circle" if discrete else "imaginary axis"
+    return (
+        f" (within the numerical margin: {format_poles(values[close], braces=True)} lie(s) "
+        f"{float(np.max(dist[close])):.2g} from the {where}, so round-off of the data could "
+        "change this verdict)"
+    )
 
 
 def _pair_name(plant: Plant) -> str:
@@ -227,7 +256,12 @@ def check_existence(plant: Plant) -> ExistenceReport:
     discrete = plant.is_discrete
     region = "the open unit disk" if discrete else "the open left half-plane"
     C, E, D = plant.C, plant.E, plant.D
-    rE, rD, rG = rank(E), rank(D), rank(np.hstack([C @ E, D]))
+    # ranks decided relative to the factors (the tolerance policy of uio_teach.linalg)
+    nC, nE, nD = (float(np.linalg.norm(X, 2)) if X.size else 0.0 for X in (C, E, D))
+    dE, dD = rank_decision(E), rank_decision(D)
+    dG = rank_decision(np.hstack([C @ E, D]), scale=max(nC * nE, nD))
+    rE, rD, rG = dE.rank, dD.rank, dG.rank
+    rank_margin = min(dE.margin, dD.margin, dG.margin)
     conds: list[Condition] = []
 
     if plant.r:
@@ -242,25 +276,37 @@ def check_existence(plant: Plant) -> ExistenceReport:
             f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
             "at once, so it cannot be cancelled"
         )
-    conds.append(Condition("rank condition", rank_ok, reason))
+    if rank_margin < MARGIN:
+        reason += (
+            f" (within the numerical margin: a singular value is only {rank_margin:.3g} times "
+            "the rank threshold, so round-off of the data could change this verdict)"
+        )
+    conds.append(Condition("rank condition", rank_ok, reason, margin=rank_margin))
 
     Bz = np.hstack([E, np.zeros((plant.n, plant.r))])
     Dz = np.hstack([np.zeros((plant.p, plant.q)), D])
     zeros = invariant_zeros(plant.A, Bz, C, Dz)
     bad = zeros[~is_stable(zeros, discrete)]
+    zero_note = _boundary_note(zeros, discrete, plant.A)
     if not len(zeros):
         conds.append(Condition("invariant zeros stable", True, "no invariant zeros"))
     elif not len(bad):
         conds.append(
-            Condition("invariant zeros stable", True, f"zeros {_fmt(zeros)} all lie in {region}")
+            Condition(
+                "invariant zeros stable",
+                True,
+                f"zeros {format_poles(zeros, braces=True, empty='none')} all lie in {region}"
+                + zero_note,
+            )
         )
     else:
         conds.append(
             Condition(
                 "invariant zeros stable",
                 False,
-                f"invariant zero(s) {_fmt(bad)} outside {region}: they are observer poles "
-                "no gain can move, so the error would not decay",
+                f"invariant zero(s) {format_poles(bad, braces=True, empty='none')} outside "
+                f"{region}: they are observer poles "
+                "no gain can move, so the error would not decay" + zero_note,
             )
         )
 
@@ -272,29 +318,48 @@ def check_existence(plant: Plant) -> ExistenceReport:
         fixed = dec.split.unobservable_modes
         movable = dec.split.Ao.shape[0]
         unstable = fixed[~is_stable(fixed, discrete)]
+        obs_margin = dec.split.margin
+        note = _boundary_note(fixed, discrete, plant.A) + (
+            f" (within the numerical margin: a singular value of the observability staircase "
+            f"is only {obs_margin:.3g} times the rank threshold)"
+            if obs_margin < MARGIN
+            else ""
+        )
         if not len(unstable):
             reason = (
-                f"unobservable modes {_fmt(fixed)} lie in {region}"
+                f"unobservable modes {format_poles(fixed, braces=True, empty='none')} "
+                f"lie in {region}"
                 if len(fixed)
                 else "observable, hence detectable"
             )
-            conds.append(Condition(f"detectable {pair}", True, reason))
+            conds.append(Condition(f"detectable {pair}", True, reason + note, margin=obs_margin))
         else:
             conds.append(
                 Condition(
                     f"detectable {pair}",
                     False,
-                    f"unobservable mode(s) {_fmt(unstable)} outside {region}",
+                    f"unobservable mode(s) {format_poles(unstable, braces=True, empty='none')} "
+                    f"outside {region}" + note,
+                    margin=obs_margin,
                 )
             )
         if len(fixed):
             reason = (
-                f"{movable} of {plant.n} poles can be placed; {_fmt(fixed)} are fixed "
+                f"{movable} of {plant.n} poles can be placed; "
+                f"{format_poles(fixed, braces=True, empty='none')} are fixed "
                 "(they are the invariant zeros)"
             )
         else:
             reason = f"all {plant.n} observer poles can be placed"
-        conds.append(Condition(f"observable {pair}", not len(fixed), reason, required=False))
+        conds.append(
+            Condition(
+                f"observable {pair}",
+                not len(fixed),
+                reason + note,
+                required=False,
+                margin=obs_margin,
+            )
+        )
     else:
         why = "not evaluated: the rank condition fails"
         conds.append(Condition(f"detectable {pair}", None, why))

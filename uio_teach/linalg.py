@@ -1,8 +1,34 @@
 """Linear-algebra building blocks: ranks, projections, observability and invariant zeros.
 
 Everything here works on plain arrays and is shared by the existence check and
-the observer designs. Rank decisions use the singular values with the tolerance
-``max(shape) * eps * sigma_max`` (the one of :func:`numpy.linalg.matrix_rank`).
+the observer designs.
+
+**Tolerance policy.** Every yes/no decision of the course (a rank, observability, detectability, the
+invariant zeros, the fixed modes) is made by one rule:
+
+* **Relative to the factors, not to the product.** A singular value ``s`` of a
+  matrix ``M`` counts as zero when ``s <= max(M.shape) * eps * scale``, where
+  ``scale`` is the size of the data ``M`` was computed from: ``||C|| ||E||`` for
+  ``C E``, ``||A||`` for the steps of the observability staircase, ``||M||``
+  for a matrix given as data. A product that is zero in exact arithmetic and
+  ``5.6e-17`` in floating point is then rank 0, because ``5.6e-17`` is round-off
+  of numbers of size ``||C|| ||E||``; judged against its own tiny norm it would
+  look like a full-rank matrix.
+* **Relative to the data's precision.** ``eps`` is the double precision
+  (``2.2e-16``); data known to fewer digits can pass ``rtol`` (e.g. ``1e-4``
+  for a matrix printed with four decimals) to ``rank_decision``.
+* **Marginal verdicts say so.** A kept singular value less than
+  ``MARGIN`` times the threshold means that the verdict hangs on round-off:
+  ``rank_decision`` returns the ratio ``s / threshold`` as ``margin`` and
+  ``marginal=True``; the existence report then states the verdict *and* the
+  margin instead of guessing.
+* **Invariant zeros** are computed on a scaled copy of the system
+  (``||A|| = ||B|| = ||C|| = 1`` after a diagonal balancing of ``A``), so that a
+  large eigenvalue of ``A`` does not make the other blocks look like zero.
+* **Computed designs are verified** (``uio_teach.verify``): the obtained
+  poles against the requested ones with a tolerance that grows with the
+  eigenvalue condition numbers, and the decoupling identities ``T E = 0``,
+  ``H C E = E``, ``L D = 0`` against ``1e-8`` relative to the factors.
 """
 
 from __future__ import annotations
@@ -13,6 +39,9 @@ import numpy as np
 import scipy.linalg as sla
 
 __all__ = [
+    "MARGIN",
+    "RankDecision",
+    "rank_decision",
     "rank",
     "pinv",
     "left_null",
@@ -25,17 +54,101 @@ __all__ = [
 ]
 
 
+MARGIN = 1e4
+"""A kept singular value below ``MARGIN`` times the rank threshold makes the verdict marginal."""
+
+
+class RankDecision(NamedTuple):
+    """A numerical rank with the evidence for it.
+
+    Attributes
+    ----------
+    rank : int
+        Number of singular values above ``threshold``.
+    threshold : float
+        ``max(shape) * rtol * scale``: singular values at or below it are round-off.
+    margin : float
+        Smallest kept singular value divided by ``threshold`` (``inf`` when the
+        rank is 0 or no singular value was dropped by a hair): how far the
+        verdict is from the boundary.
+    marginal : bool
+        ``margin < MARGIN``: the verdict hangs on round-off.
+
+    Examples
+    --------
+    >>> from uio_teach.linalg import rank_decision
+    >>> rank_decision([[1.0, 0.0], [0.0, 1e-14]]).marginal
+    True
+    """
+
+    rank: int
+    threshold: float
+    margin: float
+    marginal: bool
+
+
+def _threshold(shape, scale: float, rtol: float | None = None) -> float:
+    rtol = np.finfo(float).eps if rtol is None else float(rtol)
+    return max(shape) * rtol * scale
+
+
 def _tol(M: np.ndarray, s: np.ndarray) -> float:
-    return max(M.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0)
+    return _threshold(M.shape, s[0] if s.size else 0.0)
 
 
-def rank(M: np.ndarray) -> int:
+def rank_decision(
+    M: np.ndarray, *, scale: float | None = None, rtol: float | None = None
+) -> RankDecision:
+    """Numerical rank of ``M`` decided relative to ``scale``, with its margin.
+
+    Parameters
+    ----------
+    M : array_like
+        The matrix (real or complex).
+    scale : float, optional
+        Size of the data ``M`` was computed from, e.g. ``||C|| ||E||`` for the
+        product ``C E``. Default: ``||M||`` (the largest singular value).
+    rtol : float, optional
+        Relative precision of the data; default the double precision ``eps``.
+
+    Returns
+    -------
+    RankDecision
+
+    Examples
+    --------
+    The product ``C E`` below is zero in exact arithmetic; judged against the
+    size of its factors it has rank 0:
+
+    >>> import numpy as np
+    >>> from uio_teach.linalg import rank_decision
+    >>> C = np.array([[1.0, 1.0, 1.0]]); E = np.array([[0.1], [0.2], [-0.3]])
+    >>> scale = np.linalg.norm(C, 2) * np.linalg.norm(E, 2)
+    >>> rank_decision(C @ E, scale=scale).rank
+    0
+    """
+    M = np.atleast_2d(np.asarray(M))
+    M = M.astype(complex if np.iscomplexobj(M) else float)
+    if M.size == 0:
+        return RankDecision(0, 0.0, np.inf, False)
+    s = np.linalg.svd(M, compute_uv=False)
+    ref = float(s[0]) if scale is None else float(scale)
+    tol = _threshold(M.shape, ref, rtol)
+    r = int(np.sum(s > tol))
+    margin = float(s[r - 1] / tol) if r and tol > 0 else np.inf
+    return RankDecision(r, tol, margin, bool(margin < MARGIN))
+
+
+def rank(M: np.ndarray, *, scale: float | None = None) -> int:
     """Numerical rank of ``M`` (0 for an empty matrix).
 
     Parameters
     ----------
     M : array_like
         The matrix (real or complex).
+    scale : float, optional
+        Size of the data ``M`` was computed from (see ``rank_decision``);
+        default ``||M||``.
 
     Examples
     --------
@@ -43,12 +156,7 @@ def rank(M: np.ndarray) -> int:
     >>> rank([[1, 2], [2, 4]])
     1
     """
-    M = np.atleast_2d(np.asarray(M))
-    M = M.astype(complex if np.iscomplexobj(M) else float)
-    if M.size == 0:
-        return 0
-    s = np.linalg.svd(M, compute_uv=False)
-    return int(np.sum(s > _tol(M, s)))
+    return rank_decision(M, scale=scale).rank
 
 
 def pinv(M: np.ndarray) -> np.ndarray:
@@ -149,11 +257,18 @@ class ObservabilitySplit(NamedTuple):
     Ao: np.ndarray
     Co: np.ndarray
     Au: np.ndarray
+    margin: float = np.inf
+    """Smallest ratio (kept singular value / threshold) over the staircase's rank decisions."""
+
+    @property
+    def marginal(self) -> bool:
+        """True when a rank decision of the staircase sat within ``MARGIN`` of round-off."""
+        return bool(self.margin < MARGIN)
 
     @property
     def unobservable_modes(self) -> np.ndarray:
         """Eigenvalues of ``Au``, sorted."""
-        return _sort(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
+        return sort_poles(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
 
 
 def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySplit:
@@ -184,11 +299,13 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     C = np.atleast_2d(np.asarray(C, float))
     n = A.shape[0]
     # Staircase: W spans the current candidate unobservable subspace (start: ker C).
-    W = _null(C) if C.shape[0] else np.eye(n)
+    margins = [np.inf]
+    W = _null(C, margins=margins) if C.shape[0] else np.eye(n)
+    ref = max(np.linalg.norm(A, 2), np.linalg.norm(C, 2), np.finfo(float).tiny)
     while W.shape[1]:
         # keep the part of W that A maps back into W: ker((I - W W^T) A W)
         R = A @ W - W @ (W.T @ A @ W)
-        K = _null(R, ref=max(np.linalg.norm(A, 2), 1.0))
+        K = _null(R, ref=ref, margins=margins)
         if K.shape[1] == W.shape[1]:
             break
         W = W @ K
@@ -200,11 +317,16 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
         Ao=Vo.T @ A @ Vo,
         Co=C @ Vo,
         Au=Vu.T @ A @ Vu,
+        margin=float(min(margins)),
     )
 
 
-def _null(M: np.ndarray, ref: float | None = None) -> np.ndarray:
-    """Orthonormal basis of the right null space of ``M`` (columns)."""
+def _null(M: np.ndarray, ref: float | None = None, margins: list | None = None) -> np.ndarray:
+    """Orthonormal basis of the right null space of ``M`` (columns).
+
+    With ``margins`` (a list), the ratio of the smallest kept singular value to
+    the threshold is appended to it.
+    """
     M = np.atleast_2d(M)
     n = M.shape[1]
     if M.shape[0] == 0 or n == 0:
@@ -213,6 +335,8 @@ def _null(M: np.ndarray, ref: float | None = None) -> np.ndarray:
     scale = ref if ref is not None else (s[0] if s.size else 0.0)
     tol = max(M.shape) * 1e3 * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
     k = int(np.sum(s > tol))
+    if margins is not None and k and tol > 0:
+        margins.append(float(s[k - 1] / tol))
     return Vt[k:].T.copy()
 
 
@@ -229,6 +353,15 @@ def sort_poles(z: np.ndarray) -> np.ndarray:
 
     Imaginary parts that are round-off of a real value are dropped, and a conjugate pair always
     comes out negative imaginary part first.
+
+    Parameters
+    ----------
+    z : array_like of complex
+        The values.
+
+    Returns
+    -------
+    numpy.ndarray of complex
 
     Examples
     --------
@@ -322,6 +455,20 @@ def invariant_zeros(
     C = np.asarray(C, float).reshape(-1, n)
     D = np.zeros((C.shape[0], B.shape[1])) if D is None else np.asarray(D, float)
     D = D.reshape(C.shape[0], B.shape[1])
+    # Scale first (see the module's tolerance policy): a diagonal similarity balances A,
+    # then input and output scalings bring ||B|| and ||C|| to ||A||. The zeros do not change,
+    # and no block is judged against another block's size.
+    if n:
+        _, (bal, _) = sla.matrix_balance(A, permute=False, separate=True)
+        A = A / bal[:, None] * bal[None, :]
+        B = B / bal[:, None]
+        C = C * bal[None, :]
+    alpha = max(float(np.linalg.norm(A, 2)), 1.0) if n else 1.0
+    nb = float(np.linalg.norm(B, 2)) if B.size else 0.0
+    nc = float(np.linalg.norm(C, 2)) if C.size else 0.0
+    beta = alpha / nb if nb > 0 else 1.0
+    gamma = alpha / nc if nc > 0 else 1.0
+    B, C, D = B * beta, C * gamma, D * (beta * gamma)
     scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
     A1, B1, C1, D1 = _reduce(A, B, C, D, scale)
     A2, B2, C2, D2 = _reduce(A1.T, C1.T, B1.T, D1.T, scale)
@@ -332,7 +479,7 @@ def invariant_zeros(
     if D2.shape[0] != D2.shape[1]:  # normal-rank deficient: fall back on what remains
         return np.zeros(0, complex)
     if mr == 0:
-        return _sort(np.linalg.eigvals(A2))
+        return sort_poles(np.linalg.eigvals(A2))
     # compress the columns of [C D] onto D: [C D] W = [0 Df]
     CD = np.hstack([C2, D2])
     Q, _ = np.linalg.qr(CD.T[:, ::-1], mode="complete")
@@ -342,7 +489,7 @@ def invariant_zeros(
     Af, Ef = AB[:, :nr], IB[:, :nr]
     w = sla.eigvals(Af, Ef)
     w = w[np.isfinite(w) & (np.abs(w) < 1e12 * scale)]
-    return _sort(w)
+    return sort_poles(w)
 
 
 def _reduce(A, B, C, D, scale):

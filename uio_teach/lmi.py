@@ -2,23 +2,42 @@
 
 from __future__ import annotations
 
+import warnings
+from numbers import Real
 from typing import NamedTuple
 
 import cvxpy as cp
 import numpy as np
+import scipy.linalg as sla
 
+from ._display import format_complex
 from ._validation import as_matrix
-from .linalg import pinv
+from .linalg import is_stable, left_null, observability_decomposition, pinv
 
-__all__ = ["LMIInfeasibleError", "LMIResult", "lmi_gain"]
+__all__ = ["LMIError", "LMIInfeasibleError", "LMISolverError", "LMIResult", "lmi_gain"]
+
+#: Relative margin of a certified gain: every pole at least this far inside the boundary
+#: (the margin of ``uio_teach.linalg.is_stable``, so a certified observer is ``is_stable``).
+STRICT_MARGIN = 1e-9
 
 
-class LMIInfeasibleError(ValueError):
-    """The LMI has no solution (or the solver failed); ``.status`` is the solver's word."""
+class LMIError(ValueError):
+    """Base class of the LMI errors; ``.status`` is the solver's word."""
 
     def __init__(self, message: str, status: str) -> None:
         super().__init__(message)
         self.status = status
+
+
+class LMIInfeasibleError(LMIError):
+    """The LMI has no solution: no gain of this form meets the bound (a proof, not a failure)."""
+
+
+class LMISolverError(LMIError):
+    """The solver failed (numerical trouble) or returned a gain that does not meet the bound.
+
+    This says nothing about feasibility: scale the problem, try another ``solver``.
+    """
 
 
 class LMIResult(NamedTuple):
@@ -34,6 +53,55 @@ class LMIResult(NamedTuple):
 
     L: np.ndarray
     P: np.ndarray
+
+
+def _check_dt(dt) -> bool:
+    """True for discrete time; ``dt`` as for :class:`~uio_teach.Plant`."""
+    if dt is None or dt is False:
+        return False
+    if dt is True:
+        return True
+    if isinstance(dt, Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt >= 0:
+        return dt != 0
+    raise ValueError(
+        "dt must be None (continuous time), True (discrete time, unspecified period) or a "
+        f"positive sampling period, got {dt!r}"
+    )
+
+
+def _check_decay(decay, discrete: bool) -> float | None:
+    if decay is None:
+        return None
+    if isinstance(decay, bool) or not isinstance(decay, Real):
+        raise ValueError(f"decay must be a real number, got {decay!r}")
+    decay = float(decay)
+    if not np.isfinite(decay) or decay < 0 or (discrete and not 0 < decay <= 1):
+        rng = "0 < decay <= 1 (a radius)" if discrete else "decay >= 0 (a rate)"
+        raise ValueError(f"decay must satisfy {rng}, got {decay!r}")
+    return decay
+
+
+_SDP_SOLVERS = ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA")
+
+
+def _check_solver(solver) -> list[str]:
+    if solver is None:
+        return ["CLARABEL", "SCS"]
+    installed = [s for s in cp.installed_solvers() if s in _SDP_SOLVERS]
+    if not isinstance(solver, str) or solver.upper() not in installed:
+        raise ValueError(
+            "solver must be an installed cvxpy solver for semidefinite programs "
+            f"({', '.join(installed)}), got {solver!r}"
+        )
+    return [solver.upper()]
+
+
+def _balance(A1: np.ndarray) -> np.ndarray:
+    """Diagonal similarity (powers of 2, exact) that balances ``A1``."""
+    if A1.shape[0] == 0:
+        return np.ones(0)
+    _, (scale, _) = sla.matrix_balance(A1, permute=False, separate=True)
+    return np.asarray(scale, float)
 
 
 def lmi_gain(
@@ -71,13 +139,15 @@ def lmi_gain(
     D : array_like, shape (p, r), optional
         Measurement-disturbance matrix; adds ``L D = 0``.
     dt : None, True or float, optional
-        ``None`` for continuous time, otherwise discrete.
+        ``None`` (or 0, False) for continuous time; ``True`` or a positive
+        sampling period for discrete time.
     decay : float, optional
         Discrete: the poles' radius bound (0 < decay <= 1). Continuous: the
         minimum decay rate (decay >= 0).
     solver : str, optional
-        A cvxpy solver name. By default Clarabel, then SCS if Clarabel
-        fails numerically (as it may on an infeasible LMI).
+        An installed cvxpy solver (e.g. ``"CLARABEL"``, ``"SCS"``). By default
+        Clarabel, then SCS if Clarabel fails numerically (as it may on an
+        infeasible LMI).
 
     Returns
     -------
@@ -88,7 +158,27 @@ def lmi_gain(
     Raises
     ------
     LMIInfeasibleError
-        The LMI has no solution: no gain of this form achieves the bound.
+        The LMI has no solution: no gain of this form achieves the bound
+        (also when a mode that no gain can move lies on or beyond it; the
+        message names the mode).
+    ValueError
+        ``uio_teach.lmi.LMISolverError`` (a ``ValueError``, not an
+        ``LMIInfeasibleError``): the solver failed numerically or returned a
+        gain that does not meet the bound; this is not a proof of infeasibility.
+        Otherwise: a matrix of the wrong shape or with complex or non-finite entries,
+        ``dt`` not None/True/a positive number, ``solver`` not installed,
+        ``decay`` not a number in range.
+
+    Notes
+    -----
+    **Scaling.** ``A1`` is first balanced by a diagonal similarity ``T`` of
+    powers of 2 (:func:`scipy.linalg.matrix_balance`); the LMI is solved for
+    ``(T^-1 A1 T, C T)`` and ``L = T L_s``, ``P = T^-1 P_s T^-1`` are returned.
+    **Strict margin.** Every gain returned is verified: with ``decay`` given,
+    all poles meet the bound (to ``1e-6``); without it, every pole lies at
+    least ``STRICT_MARGIN = 1e-9`` (relative) inside the stability region. A
+    solution on the boundary (the LMI in discrete time is non-strict) is
+    solved again with ``... <= -0.01 I``.
 
     Examples
     --------
@@ -105,52 +195,124 @@ def lmi_gain(
     C = as_matrix("C", C, None, n, vector="row", what="p x n")
     p = C.shape[0]
     D = None if D is None else as_matrix("D", D, p, None, what="p x r")
-    discrete = dt is not None and dt is not False and dt != 0
-    if decay is not None:
-        if not np.isfinite(decay) or decay < 0 or (discrete and not 0 < decay <= 1):
-            rng = "0 < decay <= 1 (a radius)" if discrete else "decay >= 0 (a rate)"
-            raise ValueError(f"decay must satisfy {rng}, got {decay!r}")
+    has_d = D is not None and D.shape[1] > 0
+    discrete = _check_dt(dt)
+    decay = _check_decay(decay, discrete)
+    solvers = _check_solver(solver)
+    if discrete:
+        bound = f"poles inside radius {decay if decay is not None else 1}"
+    else:
+        bound = f"poles left of {-(decay or 0.0)}"
+    with_d = " with L D = 0" if has_d else ""
+
+    # modes no gain can move: on or beyond the bound, the LMI is infeasible (say which)
+    N = left_null(D) if has_d else np.eye(p)
+    fixed = observability_decomposition(A1, N @ C).unobservable_modes
+    bad = [z for z in fixed if not _meets(np.array([z]), discrete, decay)]
+    if bad:
+        raise LMIInfeasibleError(
+            f"the LMI is infeasible: no observer gain achieves {bound}{with_d}: the mode(s) "
+            + ", ".join(format_complex(z) for z in bad)
+            + " cannot be moved by any gain (unobservable from the outputs"
+            + (" that D leaves free" if has_d else "")
+            + ") and lie on or beyond that bound",
+            "infeasible",
+        )
+
+    # scale: a diagonal similarity (powers of 2) balances A1; undone on L and P below
+    t = _balance(A1)
+    As = A1 / t[:, None] * t[None, :]
+    Cs = C * t[None, :]
+    L, P = _solve(As, Cs, D if has_d else None, discrete, decay, solvers, bound, with_d)
+    if not _meets(np.linalg.eigvals(As - L @ Cs), discrete, decay):
+        # a non-strict LMI may return a gain on the boundary: ask again with a strict margin
+        L, P = _solve(
+            As, Cs, D if has_d else None, discrete, decay, solvers, bound, with_d, strict=True
+        )
+    # undo the scaling: A1 = T As T^-1 with T = diag(t), so L = T Ls and P = T^-1 Ps T^-1
+    L = t[:, None] * L
+    P = P / t[:, None] / t[None, :]
+    if has_d:
+        L = L - L @ D @ pinv(D)
+    with np.errstate(all="ignore"):
+        obtained = np.linalg.eigvals(A1 - L @ C) if np.all(np.isfinite(L)) else None
+    if obtained is None or not _meets(obtained, discrete, decay):
+        worst = (
+            "a non-finite gain"
+            if obtained is None
+            else "poles "
+            + ", ".join(
+                format_complex(z) for z in obtained[~_meets_each(obtained, discrete, decay)]
+            )
+        )
+        raise LMISolverError(
+            f"the LMI solver returned a gain that does not achieve {bound}{with_d} ({worst}): "
+            "a numerical failure, not a proof of infeasibility; try solver='SCS' or scale the "
+            "system",
+            "inaccurate",
+        )
+    return LMIResult(L=L, P=P)
+
+
+def _meets_each(z: np.ndarray, discrete: bool, decay: float | None) -> np.ndarray:
+    """Elementwise: the pole meets the bound (strictly stable when no decay is asked)."""
+    z = np.asarray(z, complex)
+    if decay is None:
+        return is_stable(z, discrete, margin=STRICT_MARGIN)
+    tol = 1e-6 * max(1.0, decay)
+    if discrete:
+        return np.abs(z) <= decay + tol
+    return z.real <= -decay + tol * np.maximum(1.0, np.abs(z))
+
+
+def _meets(z: np.ndarray, discrete: bool, decay: float | None) -> bool:
+    return bool(np.all(_meets_each(z, discrete, decay)))
+
+
+def _solve(A1, C, D, discrete, decay, solvers, bound, with_d, strict=False):
+    """One cvxpy solve of the LMI; returns ``(L, P)`` or raises an LMI error."""
+    n, p = C.shape[1], C.shape[0]
     P = cp.Variable((n, n), symmetric=True)
     Y = cp.Variable((n, p))
     eps = 0.01
     cons = [P >> eps * np.eye(n)]
+    X = P @ A1 - Y @ C
     if discrete:
         rho2 = 1.0 if decay is None else float(decay) ** 2
-        X = P @ A1 - Y @ C
         LMI = cp.bmat([[-rho2 * P, X.T], [X, -P]])
-        cons.append(0.5 * (LMI + LMI.T) << 0)
+        margin = eps * np.eye(2 * n) if strict else 0
+        cons.append(0.5 * (LMI + LMI.T) << -margin)
     else:
         alpha = 0.0 if decay is None else float(decay)
-        X = P @ A1 - Y @ C
         LMI = X + X.T + 2 * alpha * P
         cons.append(0.5 * (LMI + LMI.T) << -eps * np.eye(n))
-    if D is not None and D.shape[1]:
+    if D is not None:
         cons.append(Y @ D == 0)
     prob = cp.Problem(cp.Minimize(0), cons)
     # Clarabel is the default; on infeasible LMIs it sometimes stops with a numerical
     # failure instead of a certificate, so SCS is asked next to classify the problem.
     errors = []
-    for name in [solver] if solver else ["CLARABEL", "SCS"]:
+    for name in solvers:
         try:
-            prob.solve(solver=name)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "solution may be inaccurate": verified below
+                prob.solve(solver=name)
         except cp.error.SolverError as exc:
             errors.append(f"{name}: {exc}")
             continue
-        break
+        if prob.status in ("optimal", "optimal_inaccurate", "infeasible", "infeasible_inaccurate"):
+            break
+        errors.append(f"{name}: status {prob.status}")
     else:
-        raise LMIInfeasibleError("the LMI solver failed: " + "; ".join(errors), "solver_error")
-    if prob.status not in ("optimal", "optimal_inaccurate"):
-        bound = (
-            f"poles inside radius {decay if decay is not None else 1}"
-            if discrete
-            else f"poles left of {-(decay or 0.0)}"
+        raise LMISolverError(
+            "the LMI solver failed (" + "; ".join(errors) + "): a numerical failure, not a "
+            "proof of infeasibility; try another solver= or scale the system",
+            "solver_error",
         )
-        with_d = " with L D = 0" if D is not None and D.shape[1] else ""
+    if prob.status not in ("optimal", "optimal_inaccurate"):
         raise LMIInfeasibleError(
             f"the LMI is {prob.status}: no observer gain achieves {bound}{with_d}", prob.status
         )
     Pv = 0.5 * (P.value + P.value.T)
     L = np.linalg.solve(Pv, Y.value)
-    if D is not None and D.shape[1]:
-        L = L - L @ D @ pinv(D)
-    return LMIResult(L=L, P=Pv)
+    return L, Pv

@@ -22,10 +22,11 @@ import numpy as np
 from ._display import format_complex, matrices_html, matrices_text
 from ._validation import as_matrix
 from .existence import UIOExistenceError, check_existence, decoupling
-from .linalg import _sort, is_stable, observability_decomposition, pinv, rank
+from .linalg import is_stable, observability_decomposition, pinv, rank, sort_poles
 from .lmi import lmi_gain
 from .placement import place_observer_poles
 from .plant import Plant
+from .verify import check_identity, check_poles
 
 __all__ = [
     "Observer",
@@ -85,9 +86,24 @@ class Observer:
 
     family = "observer"
     _display_names: tuple[str, ...] = ()
+    _designer = "the design function"
 
     def __init__(self, plant: Plant) -> None:
-        self.plant = plant
+        self._plant = plant
+
+    def __setattr__(self, key: str, value: Any) -> None:
+        if not key.startswith("_"):
+            raise AttributeError(
+                f"{type(self).__name__}.{key} is read-only: the observer's matrices are derived "
+                f"from each other, so changing one would leave the others stale; design a new "
+                f"observer instead ({self._designer})"
+            )
+        object.__setattr__(self, key, value)
+
+    @property
+    def plant(self) -> Plant:
+        """The plant the observer was designed for."""
+        return self._plant
 
     # interface --------------------------------------------------------------
     @property
@@ -113,7 +129,7 @@ class Observer:
         >>> obs.poles().real.round(6).tolist()
         [-3.0, -2.0, -1.0]
         """
-        return _sort(np.linalg.eigvals(self.error_matrix))
+        return sort_poles(np.linalg.eigvals(self.error_matrix))
 
     @property
     def is_stable(self) -> bool:
@@ -187,11 +203,11 @@ class _ProjectionObserver(Observer):
     def __init__(self, plant: Plant, H: np.ndarray, K1: np.ndarray) -> None:
         super().__init__(plant)
         n = plant.n
-        self._H = H
-        self._T = np.eye(n) - H @ plant.C
-        self._K1 = K1
-        self._F = self._T @ plant.A - K1 @ plant.C
-        self._K2 = self._F @ H
+        self._H = _frozen(H)
+        self._T = _frozen(np.eye(n) - H @ plant.C)
+        self._K1 = _frozen(K1)
+        self._F = _frozen(self._T @ plant.A - K1 @ plant.C)
+        self._K2 = _frozen(self._F @ H)
 
     @property
     def error_matrix(self) -> np.ndarray:
@@ -226,6 +242,7 @@ class UIO(_ProjectionObserver):
 
     family = "UIO"
     _display_names = ("H", "T", "K1", "K2", "K", "F")
+    _designer = "design_uio(plant, poles=...) or design_uio(plant, K1=...)"
 
     @property
     def H(self) -> np.ndarray:
@@ -250,7 +267,7 @@ class UIO(_ProjectionObserver):
     @property
     def K(self) -> np.ndarray:
         """``K1 + K2``."""
-        return self._K1 + self._K2
+        return _frozen(self._K1 + self._K2)
 
     @property
     def F(self) -> np.ndarray:
@@ -276,6 +293,7 @@ class PMO(_ProjectionObserver):
 
     family = "PMO"
     _display_names = ("M", "A1", "L", "F", "G")
+    _designer = "design_pmo(plant, poles=...) or design_pmo(plant, L=...)"
 
     def __init__(
         self,
@@ -286,8 +304,18 @@ class PMO(_ProjectionObserver):
         certificate: np.ndarray | None,
     ) -> None:
         super().__init__(plant, M, L)
-        self.Mv = Mv
-        self.lmi_certificate = certificate
+        self._Mv = None if Mv is None else _frozen(Mv)
+        self._certificate = None if certificate is None else _frozen(certificate)
+
+    @property
+    def Mv(self) -> np.ndarray | None:
+        """The free matrix of eq. (19) used, or None."""
+        return self._Mv
+
+    @property
+    def lmi_certificate(self) -> np.ndarray | None:
+        """The Lyapunov matrix ``P`` of :func:`lmi_gain` (``method="lmi"``), or None."""
+        return self._certificate
 
     @property
     def M(self) -> np.ndarray:
@@ -302,7 +330,7 @@ class PMO(_ProjectionObserver):
     @property
     def A1(self) -> np.ndarray:
         """``(I - M C) A``."""
-        return self._T @ self.plant.A
+        return _frozen(self._T @ self.plant.A)
 
     @property
     def L(self) -> np.ndarray:
@@ -317,7 +345,7 @@ class PMO(_ProjectionObserver):
     @property
     def G(self) -> np.ndarray:
         """``(I - MC) A M + L - L C M``: the measurement gain of eq. (13)."""
-        return self._K1 + self._K2
+        return _frozen(self._K1 + self._K2)
 
 
 class GInverseObserver(Observer):
@@ -343,6 +371,7 @@ class GInverseObserver(Observer):
 
     family = "g-inverse observer"
     _display_names = ("Cg", "K", "Av", "Cv", "Kv", "G")
+    _designer = "design_ginverse(plant, Kv=...)"
 
     def __init__(self, plant: Plant, Kv: np.ndarray) -> None:
         super().__init__(plant)
@@ -353,23 +382,58 @@ class GInverseObserver(Observer):
         CE = C @ E
         CEg = pinv(CE)
         W = np.eye(p) - CE @ CEg
-        self.Cg = Cg
-        self.projection = Pc
-        self.Kv = Kv
-        self.K = Pc @ E @ CEg + Kv @ W
-        self.Av = Pc @ A @ Pc - Pc @ E @ CEg @ C @ A @ Pc
-        self.Cv = W @ C @ A @ Pc
-        K = self.K
-        self.G = Pc @ A @ Cg - K @ C @ A @ Cg + Pc @ A @ Pc @ K - K @ C @ A @ Pc @ K
-        self._Ae = (Pc - Pc @ K @ C) @ A @ Pc
+        K = Pc @ E @ CEg + Kv @ W
+        self._Cg = _frozen(Cg)
+        self._Pc = _frozen(Pc)
+        self._Kv = _frozen(Kv)
+        self._K = _frozen(K)
+        self._Av = _frozen(Pc @ A @ Pc - Pc @ E @ CEg @ C @ A @ Pc)
+        self._Cv = _frozen(W @ C @ A @ Pc)
+        self._G = _frozen(Pc @ A @ Cg - K @ C @ A @ Cg + Pc @ A @ Pc @ K - K @ C @ A @ Pc @ K)
+        self._Ae = _frozen((Pc - Pc @ K @ C) @ A @ Pc)
         # orthonormal basis of range(Pc): the error lives there
         U, s, _ = np.linalg.svd(Pc)
         self._basis = U[:, : n - rank(C)]
 
     @property
+    def Cg(self) -> np.ndarray:
+        """``C^g``, the Moore-Penrose inverse of ``C``."""
+        return self._Cg
+
+    @property
+    def projection(self) -> np.ndarray:
+        """``Pc = I - C^g C``: the orthogonal projection onto the unmeasured directions."""
+        return self._Pc
+
+    @property
+    def Kv(self) -> np.ndarray:
+        """The free gain of eq. (23)."""
+        return self._Kv
+
+    @property
+    def K(self) -> np.ndarray:
+        """``Pc E (CE)^g + Kv (I - CE (CE)^g)``."""
+        return self._K
+
+    @property
+    def Av(self) -> np.ndarray:
+        """``Pc A Pc - Pc E (CE)^g C A Pc``."""
+        return self._Av
+
+    @property
+    def Cv(self) -> np.ndarray:
+        """``(I - CE (CE)^g) C A Pc``."""
+        return self._Cv
+
+    @property
+    def G(self) -> np.ndarray:
+        """The measurement gain of eq. (21)."""
+        return self._G
+
+    @property
     def F(self) -> np.ndarray:
         """``Av - Kv Cv``: the observer-state matrix of eq. (21)."""
-        return self.Av - self.Kv @ self.Cv
+        return _frozen(self.Av - self.Kv @ self.Cv)
 
     @property
     def error_matrix(self) -> np.ndarray:
@@ -385,7 +449,7 @@ class GInverseObserver(Observer):
         state never reaches ``xhat``.
         """
         V = self._basis
-        return _sort(np.linalg.eigvals(V.T @ self._Ae @ V))
+        return sort_poles(np.linalg.eigvals(V.T @ self._Ae @ V))
 
     def realization(self) -> ObserverRealization:
         pl = self.plant
@@ -413,11 +477,22 @@ class LuenbergerObserver(Observer):
 
     family = "Luenberger observer"
     _display_names = ("L", "F")
+    _designer = "design_luenberger(plant, poles=...) or design_luenberger(plant, L=...)"
 
     def __init__(self, plant: Plant, L: np.ndarray) -> None:
         super().__init__(plant)
-        self.L = L
-        self.F = plant.A - L @ plant.C
+        self._L = _frozen(L)
+        self._F = _frozen(plant.A - L @ plant.C)
+
+    @property
+    def L(self) -> np.ndarray:
+        """The output-injection gain."""
+        return self._L
+
+    @property
+    def F(self) -> np.ndarray:
+        """``A - L C``: the error dynamics without unknown inputs."""
+        return self._F
 
     @property
     def decouples(self) -> bool:
@@ -435,6 +510,42 @@ class LuenbergerObserver(Observer):
 
 
 # design functions ---------------------------------------------------------------
+
+
+def _frozen(M: np.ndarray) -> np.ndarray:
+    """A read-only copy: an observer's matrices cannot be changed in place."""
+    out = np.array(M, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
+def _norm(M: np.ndarray) -> float:
+    return float(np.linalg.norm(M, 2)) if M.size else 0.0
+
+
+def _verify_projection(obs: _ProjectionObserver, what: str) -> None:
+    """UIO/PMO decoupling identities: ``H C E = E``, ``T E = 0``, ``H D = 0``, ``L D = 0``."""
+    pl = obs.plant
+    H, T, K1 = obs._H, obs._T, obs._K1
+    nH, nC, nE, nD = _norm(H), _norm(pl.C), _norm(pl.E), _norm(pl.D)
+    if pl.q:
+        check_identity("H C E = E", H @ pl.C @ pl.E - pl.E, max(nH * nC * nE, nE), what=what)
+        check_identity("T E = 0", T @ pl.E, max(_norm(T) * nE, nE), what=what)
+    if pl.r:
+        check_identity("H D = 0", H @ pl.D, nH * nD, what=what)
+        check_identity("L D = 0", K1 @ pl.D, max(_norm(K1), 1.0) * nD, what=what)
+
+
+def _verify_ginverse(obs: GInverseObserver) -> None:
+    pl = obs.plant
+    Pc, K = obs.projection, obs.K
+    if pl.q:
+        check_identity(
+            "(Pc - Pc K C) E = 0",
+            (Pc - Pc @ K @ pl.C) @ pl.E,
+            max(1.0, _norm(K) * _norm(pl.C)) * _norm(pl.E),
+            what="the g-inverse observer",
+        )
 
 
 def _check_plant(plant: Any) -> Plant:
@@ -466,6 +577,15 @@ def _decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
         f"{name} D must be 0 so that the measurement disturbance does not enter the "
         f"error; got {name} D = {np.array2string(GD, precision=4)}"
     )
+
+
+def _requested(poles: Any, split) -> np.ndarray:
+    """All poles the error dynamics must have: the requested ones plus the fixed modes."""
+    req = np.atleast_1d(np.asarray(poles, complex)).ravel()
+    fixed = split.unobservable_modes
+    if len(req) == split.Ao.shape[0] + len(fixed):
+        return req  # all n poles were given, the fixed modes among them
+    return np.concatenate([req, fixed])
 
 
 def _require(plant: Plant, what: str):
@@ -506,11 +626,18 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     ValueError
         Neither or both of ``poles`` and ``K1`` given, a wrong number of
         poles, or ``K1`` of the wrong shape.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Warns
     -----
     UnstableObserverWarning
         If the chosen poles or ``K1`` leave the error dynamics unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
 
     Examples
     --------
@@ -527,14 +654,24 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
         raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
     _require(plant, "an unknown input observer")
     dec = decoupling(plant)
+    requested = None
     if K1 is None:
         Lo = place_observer_poles(
-            dec.A1, dec.N @ plant.C, poles, split=dec.split, fixed_name="invariant zeros"
+            dec.A1,
+            dec.N @ plant.C,
+            poles,
+            split=dec.split,
+            fixed_name="invariant zeros",
+            verify=False,
         )
         K1 = Lo @ dec.N
+        requested = _requested(poles, dec.split)
     else:
         K1 = _decoupled_gain("K1", plant, K1)
     obs = UIO(plant, dec.M, K1)
+    _verify_projection(obs, "the UIO")
+    if requested is not None:
+        check_poles(obs.F, requested, what="the UIO", stacklevel=3)
     obs._warn_if_unstable()
     return obs
 
@@ -584,11 +721,18 @@ def design_pmo(
         ``method="lmi"`` and the LMI has no solution.
     ValueError
         Inconsistent arguments, wrong pole count or shapes.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Warns
     -----
     UnstableObserverWarning
         If the error dynamics are unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
 
     Examples
     --------
@@ -620,22 +764,34 @@ def design_pmo(
     if method == "lmi":
         res = lmi_gain(dec.A1, plant.C, D=plant.D if plant.r else None, dt=plant.dt, decay=decay)
         L, certificate = res.L, res.P
+    requested = None
+    if method == "lmi":
+        pass
     elif L is None:
         split = dec.split if Mv is None else observability_decomposition(dec.A1, dec.N @ plant.C)
         L = (
             place_observer_poles(
-                dec.A1, dec.N @ plant.C, poles, split=split, fixed_name="invariant zeros"
+                dec.A1,
+                dec.N @ plant.C,
+                poles,
+                split=split,
+                fixed_name="invariant zeros",
+                verify=False,
             )
             @ dec.N
         )
+        requested = _requested(poles, split)
     else:
         L = _decoupled_gain("L", plant, L)
     obs = PMO(plant, dec.M, L, Mv, certificate)
+    _verify_projection(obs, "the PMO")
+    if requested is not None:
+        check_poles(obs.F, requested, what="the PMO", stacklevel=3)
     obs._warn_if_unstable()
     return obs
 
 
-def design_ginverse(plant: Plant, Kv: Any = None) -> GInverseObserver:
+def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     """Design the generalized-matrix-inverse full-order observer (missile paper, eqs. (20)-(23)).
 
     Parameters
@@ -657,6 +813,11 @@ def design_ginverse(plant: Plant, Kv: Any = None) -> GInverseObserver:
     ValueError
         The plant has a measurement disturbance, ``C`` is rank deficient, or
         ``Kv`` has the wrong shape.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
 
     Examples
     --------
@@ -677,6 +838,7 @@ def design_ginverse(plant: Plant, Kv: Any = None) -> GInverseObserver:
     _require(plant, "a g-inverse observer")
     Kv = np.zeros((plant.n, plant.p)) if Kv is None else as_matrix("Kv", Kv, plant.n, plant.p)
     obs = GInverseObserver(plant, Kv)
+    _verify_ginverse(obs)
     obs._warn_if_unstable()
     return obs
 
@@ -697,6 +859,14 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     -------
     LuenbergerObserver
 
+    Raises
+    ------
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+
     Examples
     --------
     >>> import uio_teach as ut
@@ -707,10 +877,15 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     plant = _check_plant(plant)
     if (poles is None) == (L is None):
         raise ValueError("give exactly one of poles= or L=")
+    requested = None
     if L is None:
-        L = place_observer_poles(plant.A, plant.C, poles)
+        split = observability_decomposition(plant.A, plant.C)
+        L = place_observer_poles(plant.A, plant.C, poles, split=split, verify=False)
+        requested = _requested(poles, split)
     else:
         L = as_matrix("L", L, plant.n, plant.p, what="n x p")
     obs = LuenbergerObserver(plant, L)
+    if requested is not None:
+        check_poles(obs.F, requested, what="the Luenberger observer", stacklevel=3)
     obs._warn_if_unstable()
     return obs

@@ -2,18 +2,19 @@
 
 from __future__ import annotations
 
+import warnings
+
 import control as ct
 import numpy as np
+import scipy.linalg as sla
+import scipy.signal as ssig
 
-from ._display import format_complex
-from ._validation import as_poles
-from .linalg import ObservabilitySplit, _sort, observability_decomposition
+from ._display import format_complex, format_poles
+from ._validation import as_matrix, as_poles
+from .linalg import ObservabilitySplit, observability_decomposition
+from .verify import POLE_RTOL, PlacementAccuracyError, check_poles
 
 __all__ = ["place_observer_poles"]
-
-
-def _fmt(values) -> str:
-    return "{" + ", ".join(format_complex(v) for v in values) + "}"
 
 
 def place_observer_poles(
@@ -23,6 +24,7 @@ def place_observer_poles(
     *,
     split: ObservabilitySplit | None = None,
     fixed_name: str = "unobservable modes",
+    verify: bool = True,
 ) -> np.ndarray:
     """Gain ``L`` such that ``eig(A - L C)`` = the requested poles plus the fixed modes.
 
@@ -40,6 +42,10 @@ def place_observer_poles(
         A precomputed :func:`~uio_teach.linalg.observability_decomposition`.
     fixed_name : str
         How the fixed modes are called in error messages.
+    verify : bool
+        Compare ``eig(A - L C)`` with the requested poles and the fixed modes
+        (``uio_teach.verify.check_poles``); the designs switch this off
+        because they check their own error matrix.
 
     Returns
     -------
@@ -51,6 +57,15 @@ def place_observer_poles(
         Wrong number of poles (the message says how many can be placed and
         which modes are fixed), unpaired complex poles, or a multiplicity the
         outputs cannot produce.
+    PlacementAccuracyError
+        The computed gain does not give the requested poles (a badly
+        conditioned problem: many states per output, close poles, a badly
+        scaled plant) or is not finite.
+
+    Warns
+    -----
+    PlacementAccuracyWarning
+        The poles obtained are slightly off (more than round-off allows).
 
     Examples
     --------
@@ -61,9 +76,11 @@ def place_observer_poles(
     >>> np.sort(np.linalg.eigvals(A - L @ C).real).round(6).tolist()
     [-6.0, -5.0]
     """
-    A = np.asarray(A, float)
-    C = np.atleast_2d(np.asarray(C, float))
+    A = as_matrix("A", A, what="n x n")
     n = A.shape[0]
+    if A.shape[1] != n:
+        raise ValueError(f"A has shape {A.shape}, expected a square (n, n) matrix")
+    C = as_matrix("C", C, None, n, vector="row", what="p x n")
     if split is None:
         split = observability_decomposition(A, C)
     poles = as_poles("poles", poles)
@@ -72,10 +89,41 @@ def place_observer_poles(
     if len(poles) == n and len(fixed) and no != n:
         poles = _strip_fixed(poles, fixed)
     if len(poles) != no:
-        fixed_txt = f"; the modes {_fmt(fixed)} are fixed ({fixed_name})" if len(fixed) else ""
+        fixed_txt = (
+            f"; the modes {format_poles(fixed, braces=True, empty='none')} are fixed ({fixed_name})"
+            if len(fixed)
+            else ""
+        )
         raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     if no == 0:
         return np.zeros((n, C.shape[0]))
+    L = _gain(split, poles)
+    target = np.concatenate([poles, fixed])
+    if _error(A, C, L, target) > POLE_RTOL:
+        # a badly scaled plant: place on the balanced pair (T^-1 A T, C T), L = T L_b
+        t = _balance(A)
+        if np.any(t != 1.0):
+            Ab, Cb = A / t[:, None] * t[None, :], C * t[None, :]
+            split_b = observability_decomposition(Ab, Cb)
+            if split_b.Ao.shape[0] == no:
+                try:
+                    Lb = t[:, None] * _gain(split_b, poles)
+                except PlacementAccuracyError:
+                    Lb = None
+                if Lb is not None and _error(A, C, Lb, target) < _error(A, C, L, target):
+                    L = Lb
+    if verify:
+        with np.errstate(all="ignore"):
+            F = A - L @ C
+        check_poles(F, np.concatenate([poles, fixed]), what="the placement", stacklevel=3)
+    return L
+
+
+def _gain(split: ObservabilitySplit, poles: np.ndarray) -> np.ndarray:
+    """Gain placing ``poles`` on the observable part of ``split`` (original coordinates)."""
+    n = split.Vo.shape[0]
+    if split.Ao.shape[0] == 0:
+        return np.zeros((n, split.Co.shape[0]))
     # use independent output combinations only
     U, s, _ = np.linalg.svd(split.Co, full_matrices=False)
     k = int(np.sum(s > max(split.Co.shape) * np.finfo(float).eps * (s[0] if s.size else 0)))
@@ -83,6 +131,17 @@ def place_observer_poles(
     Cr = Uk.T @ split.Co
     Lr = _place(split.Ao, Cr, poles, k)
     return split.Vo @ Lr @ Uk.T
+
+
+def _error(A: np.ndarray, C: np.ndarray, L: np.ndarray, target: np.ndarray) -> float:
+    """Largest relative distance between ``target`` and ``eig(A - L C)`` (matched)."""
+    return _pole_error(A, C, L, target)
+
+
+def _balance(A: np.ndarray) -> np.ndarray:
+    """Diagonal similarity (powers of 2) that balances ``A``."""
+    _, (t, _) = sla.matrix_balance(A, permute=False, separate=True)
+    return np.asarray(t, float)
 
 
 def _strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
@@ -96,24 +155,61 @@ def _strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     return np.array(rest)
 
 
+def _pole_error(Ao: np.ndarray, Cr: np.ndarray, Lr: np.ndarray, poles: np.ndarray) -> float:
+    """Largest relative distance between the requested and the obtained poles (matched)."""
+    from scipy.optimize import linear_sum_assignment
+
+    with np.errstate(all="ignore"):
+        F = Ao - Lr @ Cr
+        if not np.all(np.isfinite(F)):
+            return np.inf
+        w = np.linalg.eigvals(F)
+    cost = np.abs(poles[:, None] - w[None, :]) / np.maximum(1.0, np.abs(poles))[:, None]
+    r, c = linear_sum_assignment(cost)
+    return float(cost[r, c].max())
+
+
 def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndarray:
-    if k == 1:
-        # single output: Ackermann's formula accepts repeated poles
-        return np.asarray(ct.acker(Ao.T, Cr.T, poles), float).reshape(1, -1).T
-    values, counts = np.unique(np.round(poles, 9), return_counts=True)
-    if np.any(counts > k):
+    """Gain of the observable part; python-control's and scipy's messages are translated."""
+    with np.errstate(all="ignore"):
+        values, counts = np.unique(np.round(poles, 9), return_counts=True)
+    if k > 1 and np.any(counts > k):
         worst = values[np.argmax(counts)]
         raise ValueError(
             f"poles: {format_complex(worst)} is repeated {counts.max()} times but only {k} "
             "independent outputs can be used; choose poles with multiplicity at most "
             f"{k} (e.g. spread them slightly)"
         )
-    try:
-        return np.asarray(ct.place(Ao.T, Cr.T, poles), float).reshape(k, -1).T
-    except ValueError as exc:  # pragma: no cover - scipy's message is kept for the rare case
-        raise ValueError(f"poles: placement failed: {exc}") from None
-
-
-def sorted_eigvals(M: np.ndarray) -> np.ndarray:
-    """Eigenvalues sorted by real then imaginary part (internal helper)."""
-    return _sort(np.linalg.eigvals(M))
+    candidates = []
+    failures = []
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        # scipy warns "Convergence was not reached" and numpy about overflow; the result is
+        # verified below instead, and the user gets one plain message
+        warnings.simplefilter("ignore")
+        if k == 1:
+            # single output: Ackermann's formula accepts repeated poles; scipy's algorithm
+            # is often more accurate for distinct poles: keep the better of the two
+            try:
+                candidates.append(np.asarray(ct.acker(Ao.T, Cr.T, poles), float).reshape(1, -1).T)
+            except Exception as exc:  # noqa: BLE001 - translated below
+                failures.append(str(exc))
+            if counts.max() == 1:
+                try:
+                    res = ssig.place_poles(Ao.T, Cr.T, poles)
+                    candidates.append(np.asarray(res.gain_matrix, float).reshape(1, -1).T)
+                except Exception as exc:  # noqa: BLE001 - translated below
+                    failures.append(str(exc))
+        else:
+            try:
+                candidates.append(np.asarray(ct.place(Ao.T, Cr.T, poles), float).reshape(k, -1).T)
+            except Exception as exc:  # noqa: BLE001 - translated below
+                failures.append(str(exc))
+    if not candidates:
+        raise PlacementAccuracyError(
+            f"poles: the pole placement failed numerically ({'; '.join(failures)}). The pair is "
+            "observable to the rank tolerance, but so badly conditioned that the gain cannot "
+            "be computed in double precision: place fewer poles per output, spread them "
+            "apart, or scale the plant's states"
+        )
+    errors = [_pole_error(Ao, Cr, Lr, poles) for Lr in candidates]
+    return candidates[int(np.argmin(errors))]

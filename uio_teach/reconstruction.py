@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter
 
+from ._validation import as_real_array, as_real_number, as_time
 from .linalg import pinv, rank
 from .plant import Plant
 
@@ -252,10 +253,12 @@ def reconstruct_input(
     if method not in ("derivative", "filtered"):
         raise ValueError(f"method must be 'derivative' or 'filtered', got {method!r}")
     if method == "filtered":
-        try:
-            ok = tau is not None and np.isfinite(float(tau)) and float(tau) > 0
-        except (TypeError, ValueError):
-            ok = False
+        ok = (
+            isinstance(tau, (int, float, np.integer, np.floating))
+            and not isinstance(tau, bool)
+            and np.isfinite(tau)
+            and tau > 0
+        )
         if not ok:
             raise ValueError(
                 f"tau must be a positive time constant with method='filtered', got {tau!r}"
@@ -311,8 +314,9 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     actual : array_like, shape (N,) or (k, N)
         The true signal; rows are channels.
     estimate : array_like, same shape as ``actual``
-        Its estimate. NaN samples (e.g. the undefined last sample of a
-        discrete reconstruction) are skipped.
+        Its estimate. Trailing NaN samples (the undefined last sample of a
+        discrete reconstruction) are not judged; any other NaN counts as
+        outside the band (NaN is never "caught").
     tol : float, optional
         Relative tolerance, default 2 %.
 
@@ -326,8 +330,10 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     Raises
     ------
     ValueError
-        Mismatched shapes or lengths, more than 2 dimensions, or a negative
-        ``tol``.
+        Mismatched shapes or lengths, more than 2 dimensions, a negative
+        ``tol``, ``time`` not 1-D, finite and strictly increasing, non-numeric
+        or complex data, a non-finite ``actual``, or an estimate without a
+        finite sample; the message names the argument.
 
     Examples
     --------
@@ -341,11 +347,9 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     >>> catch_time(t, np.vstack([x, x]), np.vstack([xhat, x])).tolist()
     [0.39, 0.0]
     """
-    t = np.asarray(time, dtype=float)
-    if t.ndim != 1:
-        raise ValueError(f"time must be 1-D, got shape {t.shape}")
-    a = np.asarray(actual, dtype=float)
-    e = np.asarray(estimate, dtype=float)
+    t = as_time("time", time, min_size=1)
+    a = as_real_array("actual", actual)
+    e = as_real_array("estimate", estimate, finite=False)
     if a.shape != e.shape:
         raise ValueError(
             f"actual and estimate must have the same shape, got {a.shape} and {e.shape}"
@@ -356,15 +360,22 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
         raise ValueError(
             f"actual and estimate must have one sample per time point ({t.size}), got {a.shape[-1]}"
         )
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise ValueError(f"tol must be a number, got {tol!r}") from None
-    if not np.isfinite(tol) or tol < 0:
-        raise ValueError(f"tol must be a finite number >= 0, got {tol}")
+    if np.any(np.isinf(e)):
+        raise ValueError("estimate has an infinite value; only NaN (undefined samples) is allowed")
+    tol = as_real_number("tol", tol, low=0.0)
     a2, e2 = np.atleast_2d(a), np.atleast_2d(e)
-    band = tol * np.nanmax(np.abs(a2), axis=1, keepdims=True)
+    band = tol * np.max(np.abs(a2), axis=1, keepdims=True)
+    # trailing NaN samples are undefined (the last sample of a discrete reconstruction) and
+    # are not judged; any other NaN counts as outside the band: NaN is never "caught"
+    defined = np.isfinite(e2)
+    if not np.any(defined):
+        raise ValueError("estimate has no finite sample: nothing can have caught the signal")
+    end = t.size - int(np.argmax(defined.any(axis=0)[::-1]))  # one past the last defined sample
     with np.errstate(invalid="ignore"):
-        outside = np.abs(e2 - a2) > band  # NaN compares False: skipped
+        outside = ~(np.abs(e2 - a2) <= band)  # NaN compares False: outside
+    outside[:, end:] = False
     last = np.where(outside.any(axis=1), t[t.size - 1 - np.argmax(outside[:, ::-1], axis=1)], 0.0)
+    # a channel whose only samples are NaN never caught anything
+    never = ~defined[:, :end].any(axis=1)
+    last = np.where(never, t[end - 1], last)
     return float(last[0]) if a.ndim == 1 else last

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from numbers import Real
 
 import numpy as np
+
+from ._validation import as_real_array
 
 __all__ = ["Signal", "sinusoid", "piecewise_constant", "damped_sinusoid", "step", "stack"]
 
@@ -42,10 +45,10 @@ class Signal:
 
 
 def _num(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    """A finite real number (not text, not complex, not a bool), or a ValueError naming it."""
+    if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    v = float(value)
     if not np.isfinite(v):
         raise ValueError(f"{name} must be finite, got {value!r}")
     return v
@@ -139,15 +142,17 @@ def piecewise_constant(times: Sequence[float], values: Sequence[float]) -> Signa
     >>> s([0, 4.9, 5, 12]).tolist()
     [1.0, 1.0, -0.5, 0.0]
     """
-    t_sw = np.asarray(times, dtype=float).ravel()
-    vals = np.asarray(values, dtype=float).ravel()
+    t_sw = as_real_array("times", times, finite=False).ravel()
+    vals = as_real_array("values", values, finite=False).ravel()
     if t_sw.size == 0 or t_sw.shape != vals.shape:
         raise ValueError(
             f"times and values must be non-empty and of the same length, got {t_sw.size} "
             f"and {vals.size}"
         )
-    if not (np.all(np.isfinite(t_sw)) and np.all(np.isfinite(vals))):
-        raise ValueError("times and values must be finite")
+    if not np.all(np.isfinite(t_sw)):
+        raise ValueError("times must be finite")
+    if not np.all(np.isfinite(vals)):
+        raise ValueError("values must be finite")
     if np.any(np.diff(t_sw) <= 0):
         raise ValueError("times must be strictly increasing")
     padded = np.concatenate([[0.0], vals])

@@ -47,10 +47,26 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.signal import lfilter
 
+from ._display import format_complex
+from ._validation import as_seed, as_time
 from .observers import Observer
 from .plant import Plant
 
-__all__ = ["simulate", "UIOResponse", "SimulationInputs"]
+__all__ = ["simulate", "UIOResponse", "SimulationInputs", "SimulationOverflowError"]
+
+
+class SimulationOverflowError(OverflowError):
+    """The response leaves the floating-point range: an unstable pole, too long a time span.
+
+    ``.poles`` are the unstable poles of the plant/observer system and ``.time`` the
+    first time point at which the response is no longer a finite float.
+    """
+
+    def __init__(self, message: str, poles: np.ndarray, time: float) -> None:
+        super().__init__(message)
+        self.poles = poles
+        self.time = time
+
 
 SignalLike = Callable[[np.ndarray], Any] | Sequence[Callable[[np.ndarray], Any]] | Any
 
@@ -202,23 +218,7 @@ class UIOResponse:
 
 
 def _check_timepts(timepts: Any) -> np.ndarray:
-    try:
-        t = np.array(timepts, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"timepts must be a 1-D array of times: {exc}") from None
-    if t.ndim != 1:
-        raise ValueError(f"timepts must be a 1-D array of times, got shape {t.shape}")
-    if t.size < 2:
-        raise ValueError(f"timepts must hold at least 2 time points, got {t.size}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("timepts must be finite numbers")
-    steps = np.diff(t)
-    if np.any(steps <= 0):
-        k = int(np.argmax(steps <= 0))
-        raise ValueError(
-            f"timepts must be strictly increasing: timepts[{k}] = {t[k]:g} and "
-            f"timepts[{k + 1}] = {t[k + 1]:g}"
-        )
+    t = as_time("timepts", timepts)
     t.setflags(write=False)
     return t
 
@@ -251,8 +251,12 @@ def _check_discrete_grid(plant: Plant, t: np.ndarray) -> float:
 
 def _finite_real(name: str, arr: Any) -> np.ndarray:
     """``arr`` as a float array; complex or non-numeric values raise a ValueError naming it."""
+    if isinstance(arr, (str, bytes)):
+        raise ValueError(f"{name} must be numeric, got the text {arr!r}")
     if np.iscomplexobj(arr):
         raise ValueError(f"{name} must be real, got complex values")
+    if isinstance(arr, bool) or np.asarray(arr).dtype.kind in "USb":
+        raise ValueError(f"{name} must hold real numbers, got {np.asarray(arr).dtype} values")
     try:
         out = np.asarray(arr, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -350,7 +354,7 @@ def _noise(noise: Any, seed: Any, p: int, N: int) -> np.ndarray:
         )
     if not np.all(np.isfinite(sd)) or np.any(sd < 0):
         raise ValueError(f"noise standard deviations must be finite and >= 0, got {sd}")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(as_seed("seed", seed))
     return sd[:, None] * rng.standard_normal((p, N))
 
 
@@ -552,6 +556,54 @@ def _stepwise(
     return z
 
 
+_BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
+
+
+def _check_range(z: np.ndarray, Az: np.ndarray, plant: Plant, t: np.ndarray) -> None:
+    """Raise ``SimulationOverflowError`` if the response leaves the float range."""
+    bad = ~np.isfinite(z) | (np.abs(z) > _BIG)
+    if np.any(bad):
+        k = int(np.argmax(bad.any(axis=0)))
+        raise _overflow(Az, plant, t, k)
+
+
+def _overflow(Az: np.ndarray, plant: Plant, t: np.ndarray, k: int) -> SimulationOverflowError:
+    """The error explaining an overflow at time point ``k``: which poles, and when."""
+    poles = np.linalg.eigvals(Az)
+    discrete = plant.is_discrete
+    growth = np.log(np.abs(poles)) if discrete else poles.real
+    unstable = poles[growth > 0]
+    n = plant.n
+    plant_poles = np.linalg.eigvals(Az[:n, :n])
+    words = []
+    for pole in sorted(unstable, key=lambda z: -abs(z)):
+        src = (
+            "plant"
+            if np.min(np.abs(plant_poles - pole)) <= 1e-9 * max(1, abs(pole))
+            else ("observer")
+        )
+        words.append(f"{format_complex(pole)} ({src})")
+    rate = float(np.max(growth)) if growth.size else 0.0
+    when = f"t = {t[k]:g}" if k < t.size else "the first step"
+    expected = ""
+    if rate > 0:
+        span = (
+            np.log(_BIG) / rate * (1.0 if not discrete else (1.0 if plant.dt is True else plant.dt))
+        )
+        expected = (
+            f"; growing like exp({rate:.3g} t)"
+            if not discrete
+            else f"; growing like {np.exp(rate):.3g}^k"
+        ) + f", a response of size 1 reaches 1e300 after about {span:.3g} time units"
+    return SimulationOverflowError(
+        f"the response leaves the floating-point range at {when}: the plant/observer system "
+        f"has unstable pole(s) {', '.join(words) or 'none found'}{expected}. Simulate a "
+        "shorter time span, or stabilize the plant or the observer",
+        unstable,
+        float(t[min(k, t.size - 1)]),
+    )
+
+
 def simulate(
     plant: Plant,
     observer: Observer,
@@ -607,8 +659,8 @@ def simulate(
         all outputs or one per output. It is sampled at the time points and,
         like every input, linear between them. ``None`` means no noise.
     seed : int or numpy.random.Generator, optional
-        Seed of :func:`numpy.random.default_rng` for the noise: the same seed
-        gives the same noise.
+        Seed of :func:`numpy.random.default_rng` for the noise (a
+        non-negative integer): the same seed gives the same noise.
 
     Returns
     -------
@@ -623,6 +675,10 @@ def simulate(
         (discrete plant) not on the sampling grid, an initial state of the wrong
         length, or a plant that does not match the observer. The message names
         the argument.
+    OverflowError
+        ``uio_teach.simulation.SimulationOverflowError``: the response leaves
+        the floating-point range (an unstable pole over a long time span); the
+        message names the unstable poles and the time.
 
     See Also
     --------
@@ -682,6 +738,7 @@ def simulate(
             f"dt = {plant.dt!r}, observer designed for dt = {design.dt!r}"
         )
 
+    as_seed("seed", seed)
     t = _check_timepts(timepts)
     N = t.size
     h = _check_discrete_grid(plant, t) if plant.is_discrete else _uniform_step(t)
@@ -705,14 +762,18 @@ def simulate(
     z0 = np.concatenate([x0, w0])
 
     Az, Bz = joint_system(plant, observer)
-    with _one_blas_thread():
+    with _one_blas_thread(), np.errstate(all="ignore"):
+        # overflow is detected and explained below, not left to RuntimeWarnings and NaNs
         if plant.is_discrete:
             z = _recursion(Az, Bz, None, S, z0)
         elif h is not None:
             Phi, G0, G1 = foh_matrices(Az, Bz, h)
+            if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
+                raise _overflow(Az, plant, t, 1)
             z = _recursion(Phi, G0, G1, S, z0)
         else:
             z = _stepwise(Az, Bz, t, S, z0)
+        _check_range(z, Az, plant, t)
         x, w = z[: plant.n], z[plant.n :]
         y = plant.C @ x
         if r:
@@ -721,6 +782,7 @@ def simulate(
             y += inputs.noise
         xhat = real.C @ w
         xhat += real.D_y @ y
+        _check_range(np.vstack([y, xhat]), Az, plant, t)
     for arr in (z, y, xhat):
         arr.setflags(write=False)
     return UIOResponse(

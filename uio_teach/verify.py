@@ -1,0 +1,190 @@
+"""Checks run after every design: the poles obtained and the decoupling identities.
+
+A gain is computed in floating point; for badly conditioned problems (many
+states, one output, close poles, badly scaled plants) the computed gain may
+not give the poles that were asked for. Every design therefore compares what
+it obtained with what it promised:
+
+* **Poles.** The obtained eigenvalues are matched one to one with the
+  requested ones (fixed modes included). A pole is accepted when it lies within
+  ``POLE_RTOL * max(1, |p|)`` of its request, or within the round-off bound of
+  the eigenvalue problem, ``n * eps * ||F|| * kappa`` (``kappa`` the eigenvalue's
+  condition number; repeated poles are ill-conditioned by nature), or when the
+  requested value is an eigenvalue of a matrix within ``n * eps * ||F||`` of
+  ``F`` (backward check) -- the last two only up to ``WARN_RTOL * max(1, |p|)``:
+  an error of that size is what the problem's conditioning allows. Otherwise,
+  within ``WARN_RTOL``: a ``PlacementAccuracyWarning``; beyond ``WARN_RTOL``,
+  or a non-finite gain: a ``PlacementAccuracyError``. Both name requested
+  and obtained poles and the conditioning.
+* **Identities.** ``T E = 0``, ``H C E = E``, ``L D = 0`` (and their analogues)
+  must hold to ``IDENTITY_RTOL`` relative to the product of the factors' norms,
+  or a ``PlacementAccuracyError`` is raised.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from ._display import format_complex
+
+__all__ = [
+    "POLE_RTOL",
+    "WARN_RTOL",
+    "IDENTITY_RTOL",
+    "PlacementAccuracyWarning",
+    "PlacementAccuracyError",
+    "check_poles",
+    "check_identity",
+]
+
+POLE_RTOL = 1e-6
+WARN_RTOL = 1e-3
+IDENTITY_RTOL = 1e-8
+_EPS = np.finfo(float).eps
+
+
+def _fmt(values) -> str:
+    """Each value on its own scale (a huge pole must not print its neighbours as 0)."""
+    return "{" + ", ".join(format_complex(v, 7) for v in values) + "}" if len(values) else "none"
+
+
+class PlacementAccuracyWarning(UserWarning):
+    """The obtained poles differ from the requested ones by more than round-off allows."""
+
+
+class PlacementAccuracyError(ValueError):
+    """A computed design fails its own check: wrong poles, non-finite gain or broken identity."""
+
+
+def _condition_numbers(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues of ``F`` and their condition numbers ``1 / |y^H x|`` (unit vectors)."""
+    with np.errstate(all="ignore"):
+        w, vl, vr = sla.eig(F, left=True, right=True)
+        vl = vl / np.linalg.norm(vl, axis=0)
+        vr = vr / np.linalg.norm(vr, axis=0)
+        cos = np.abs(np.sum(vl.conj() * vr, axis=0))
+        kappa = np.where(cos > 0, 1.0 / np.maximum(cos, 1e-300), np.inf)
+    return w, kappa
+
+
+def check_poles(
+    F: np.ndarray, requested, *, what: str = "the observer", stacklevel: int = 3
+) -> np.ndarray:
+    """Compare ``eig(F)`` with the requested poles; warn or raise beyond the tolerance.
+
+    Parameters
+    ----------
+    F : array_like, shape (n, n)
+        The matrix of the error dynamics.
+    requested : array_like, shape (n,)
+        The poles asked for, fixed modes included.
+    what : str
+        How the design is called in messages.
+    stacklevel : int
+        Passed to ``warnings.warn``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The obtained poles, in the order of ``requested``.
+
+    Raises
+    ------
+    PlacementAccuracyError
+        A pole is off by more than ``WARN_RTOL`` relative (or ``F`` is not finite).
+
+    Warns
+    -----
+    PlacementAccuracyWarning
+        A pole is off by more than round-off allows but less than ``WARN_RTOL``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import check_poles
+    >>> check_poles(np.diag([-1.0, -2.0]), [-2, -1]).real.tolist()
+    [-2.0, -1.0]
+    """
+    F = np.asarray(F)
+    req = np.asarray(requested, complex).ravel()
+    if not np.all(np.isfinite(F)):
+        raise PlacementAccuracyError(
+            f"{what}: the computed gain is not finite (requested poles "
+            f"{_fmt(req)} are out of the floating-point "
+            "range for this plant); choose poles of a size comparable to the plant's"
+        )
+    n = F.shape[0]
+    if n == 0:
+        return np.zeros(0, complex)
+    w, kappa = _condition_numbers(F)
+    cost = np.abs(req[:, None] - w[None, :])
+    rows, cols = linear_sum_assignment(cost)
+    obtained = w[cols[np.argsort(rows)]]
+    kap = kappa[cols[np.argsort(rows)]]
+    normF = float(np.linalg.norm(F, 2))
+    err = np.abs(obtained - req)
+    size = np.maximum(1.0, np.abs(req))
+    round_off = n * _EPS * normF * np.where(np.isfinite(kap), kap, 1e300)
+    tight = err <= POLE_RTOL * size
+    explained = err <= 10 * round_off
+    for i in np.flatnonzero(~tight & ~explained & (err <= WARN_RTOL * size)):
+        # backward check: is the requested value an eigenvalue of a matrix close to F?
+        smin = np.linalg.svd(F - req[i] * np.eye(n), compute_uv=False)[-1]
+        explained[i] = smin <= 10 * n * _EPS * max(normF, abs(req[i]))
+    ok = tight | (explained & (err <= WARN_RTOL * size))
+    if np.all(ok):
+        return obtained
+    bad = ~ok
+    worst = float(np.max(err[bad] / size[bad]))
+    text = (
+        f"{what}: the poles obtained differ from those requested beyond round-off: requested "
+        f"{_fmt(req[bad])}, "
+        f"obtained {_fmt(obtained[bad])} "
+        f"(relative error up to {worst:.2g}; eigenvalue condition numbers up to "
+        f"{float(np.max(kap[bad])):.2g}, ||F|| = {normF:.3g}). The placement problem is badly "
+        "conditioned: spread the poles apart, choose them closer to the plant's own, or "
+        "scale the plant's states"
+    )
+    if worst > WARN_RTOL:
+        raise PlacementAccuracyError(text)
+    warnings.warn(text, PlacementAccuracyWarning, stacklevel=stacklevel)
+    return obtained
+
+
+def check_identity(name: str, residual, scale: float, *, what: str = "the observer") -> float:
+    """Raise if ``||residual|| > IDENTITY_RTOL * scale``; return the relative residual.
+
+    Parameters
+    ----------
+    name : str
+        The identity, e.g. ``"T E = 0"``.
+    residual : array_like
+        The matrix that should be zero.
+    scale : float
+        Product of the norms of the factors that form it.
+    what : str
+        How the design is called in messages.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import check_identity
+    >>> check_identity("T E = 0", np.zeros((2, 1)), 1.0)
+    0.0
+    """
+    R = np.asarray(residual, float)
+    if R.size == 0:
+        return 0.0
+    res = float(np.linalg.norm(R, 2)) if np.all(np.isfinite(R)) else np.inf
+    rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
+    if not rel <= IDENTITY_RTOL:
+        raise PlacementAccuracyError(
+            f"{what}: the identity {name} holds only to {rel:.2g} relative to its factors "
+            f"(tolerance {IDENTITY_RTOL:g}); the decoupling is lost to round-off, the data are "
+            "too badly conditioned (scale the plant's states or outputs)"
+        )
+    return rel
