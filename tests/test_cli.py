@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import uio_teach as ut
-from uio_teach import cli, figures
+from uio_teach.instructor import cli, figures
 
 ALL = list(figures.FIGURES)
 TABLES = [name for name, spec in figures.FIGURES.items() if spec.table]
@@ -85,7 +85,7 @@ def test_python_dash_m_entry_point_lists_the_figures():
 
 def test_console_script_is_declared():
     pyproject = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
-    assert pyproject["project"]["scripts"]["uio-teach"] == "uio_teach.cli:main"
+    assert pyproject["project"]["scripts"]["uio-teach"] == "uio_teach.instructor.cli:main"
     script = shutil.which("uio-teach", path=str(Path(sys.executable).parent))
     if script is None:
         pytest.skip("the package is not reinstalled yet (make venv): no uio-teach script")

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import uio_teach as ut
-from uio_teach.explorer import (
+from uio_teach.explorers import (
     DISTURBANCES,
     ExplorerFigure,
     Settings,
