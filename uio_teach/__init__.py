@@ -13,7 +13,7 @@ True
 [-3.0, -2.0, -1.0]
 """
 
-from . import checks, examples, linalg, plotting, signals
+from . import checks, examples, experiments, linalg, plotting, signals
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
 from .observers import (
@@ -40,6 +40,7 @@ _LAZY = {
     "widgets": None,
     "explorer": None,
     "static_explorer": None,
+    "explorers": None,
     "pa9_explorer": "widgets",
     "case_study_explorer": "widgets",
     "missile_explorer": "widgets",
@@ -62,6 +63,7 @@ def __dir__() -> list[str]:
 __all__ = [
     "Plant",
     "examples",
+    "experiments",
     "linalg",
     "signals",
     "plotting",
@@ -91,6 +93,7 @@ __all__ = [
     "InputEstimate",
     "catch_time",
     "widgets",
+    "explorers",
     "explorer",
     "static_explorer",
     "pa9_explorer",

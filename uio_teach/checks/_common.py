@@ -170,6 +170,11 @@ def _never_raises(title: str) -> Callable[[_F], _F]:
 # small helpers --------------------------------------------------------------------------------
 
 
+def _numbers(values: Iterable[float]) -> str:
+    """A list of real numbers as Python source: ``[1, -1, 0.5]``."""
+    return "[" + ", ".join(f"{float(np.real(x)):g}" for x in values) + "]"
+
+
 def _up_to(x: float, what: str) -> str:
     """`` (up to rounding)`` for a number that should be zero, else `` (<what> 3e-09)``."""
     return " (up to rounding)" if x <= 1e-12 else f" ({what} {x:.1g})"

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._display import format_matrix_line, format_poles
+from ..experiments import PA9
 from ._common import (
     CheckResult,
     _close,
@@ -26,6 +27,7 @@ from ._common import (
     _looks_two_decimals,
     _maxdiff,
     _never_raises,
+    _numbers,
     _read_matrix,
     _stability,
     _up_to,
@@ -246,6 +248,6 @@ def pa9_design(
             f"{format_poles(bad)} "
             f"{'are' if len(bad) > 1 else 'is'} not {region}, so the error {law} does not "
             "decay. Choose K1 so that TA - K1C has the poles you want, e.g. "
-            "K1 = ct.place((T @ A).T, C.T, [-1, -2, -3]).T.",
+            f"K1 = ct.place((T @ A).T, C.T, {_numbers(PA9.poles)}).T.",
         )
     return result

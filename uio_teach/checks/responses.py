@@ -5,14 +5,11 @@
 
 Examples
 --------
->>> import numpy as np
 >>> import uio_teach as ut
 >>> from uio_teach.checks import pa9_simulation
->>> plant = ut.examples.pa9()
->>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
->>> resp = ut.simulate(plant, obs, np.linspace(0, 10, 1001), d=ut.signals.sinusoid(1.0, 2.0),
-...                    initial_state=[1.0, -1.0, 0.5])
->>> pa9_simulation(resp).passed
+>>> from uio_teach.experiments import PA9
+>>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+>>> pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
 True
 """
 
@@ -24,9 +21,11 @@ from typing import Any
 import numpy as np
 
 from .._display import format_complex, format_poles
+from ..experiments import PA9
 from ._common import (
     CheckResult,
     _never_raises,
+    _numbers,
     _plural,
     _stability,
     _up_to,
@@ -56,7 +55,8 @@ def _disturbance(result: CheckResult, resp) -> np.ndarray | None:
         result.add(
             False,
             "d is zero during the whole simulation, so the test says nothing about the "
-            "disturbance: pass one, e.g. ut.simulate(..., d=ut.signals.sinusoid(1.0, 2.0)).",
+            "disturbance: pass one, e.g. ut.simulate(..., "
+            f"d=ut.signals.sinusoid({PA9.sine_amplitude:g}, {PA9.sine_frequency:g})).",
         )
         return None
     return d
@@ -79,7 +79,7 @@ def _initial_error(result: CheckResult, resp) -> float:
         result.add(
             False,
             "the error is zero at t = 0, so nothing can be seen decaying: start the plant from "
-            "a nonzero state, e.g. initial_state=[1, -1, 0.5].",
+            f"a nonzero state, e.g. initial_state={_numbers(PA9.initial_state)}.",
         )
     return e0
 
@@ -199,19 +199,15 @@ def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
 
     Examples
     --------
-    >>> import numpy as np
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> plant = ut.examples.pa9()
-    >>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
-    >>> t = np.linspace(0, 10, 1001)
-    >>> resp = ut.simulate(plant, obs, t, d=ut.signals.sinusoid(1.0, 2.0),
-    ...                    initial_state=[1, -1, 0.5])
-    >>> checks.pa9_simulation(resp).passed
+    >>> from uio_teach.experiments import PA9
+    >>> plant = PA9.plant()
+    >>> obs = ut.design_uio(plant, poles=PA9.poles)
+    >>> checks.pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
     True
-    >>> luen = ut.simulate(plant, ut.design_luenberger(plant, poles=[-1, -2, -3]), t,
-    ...                    d=ut.signals.sinusoid(1.0, 2.0), initial_state=[1, -1, 0.5])
-    >>> checks.pa9_simulation(luen).passed
+    >>> luen = ut.design_luenberger(plant, poles=PA9.poles)
+    >>> checks.pa9_simulation(PA9.simulate(luen, d=PA9.d_sine)).passed
     False
     """
     result = CheckResult("Practical Assignment 9: the test with a sinusoidal disturbance")
@@ -277,16 +273,12 @@ def pa9_piecewise(
 
     Examples
     --------
-    >>> import numpy as np
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> plant = ut.examples.pa9()
-    >>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
-    >>> t = np.linspace(0, 10, 1001)
-    >>> sin = ut.simulate(plant, obs, t, d=ut.signals.sinusoid(1.0, 2.0),
-    ...                   initial_state=[1, -1, 0.5])
-    >>> pw = ut.simulate(plant, obs, t, d=ut.signals.piecewise_constant([0, 4], [1.0, -2.0]),
-    ...                  initial_state=[1, -1, 0.5])
+    >>> from uio_teach.experiments import PA9
+    >>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+    >>> sin = PA9.simulate(obs, d=PA9.d_sine)
+    >>> pw = PA9.simulate(obs, d=PA9.d_piecewise)
     >>> checks.pa9_piecewise(pw, sinusoidal=sin).passed
     True
     >>> checks.pa9_piecewise(sin).failures[0][:35]

@@ -21,9 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import signals
-from ..examples import MISSILE_PUBLISHED, dt_case_study, missile_autopilot, pa9
 from ..existence import check_existence
+from ..experiments import CASE_STUDY, MISSILE, PA9
 from ..linalg import is_stable, rank
 from ..plant import Plant
 from .model import FAMILIES, Channel, Scenario, Settings, expand_poles
@@ -51,9 +50,11 @@ def _scenario(plant: Plant, family: str, **kwargs: Any) -> Scenario:
 def pa9_scenario() -> Scenario:
     """Practical Assignment 9: the decoupling UIO, three movable poles, ``d`` sinusoidal by default.
 
-    Known input ``u = [1, 0.5 sin t]``, initial state ``[1, -1, 0.5]``,
-    10 s on 1001 samples; the poles start at ``-1, -2, -3`` as in the
-    assignment.
+    The known input, initial state and starting poles are those of
+    :data:`uio_teach.experiments.PA9` (``u = [1, 0.5 sin t]``,
+    ``x(0) = [1, -1, 0.5]``, poles ``-1, -2, -3``), and so is the default
+    disturbance, its sinusoid; the 10 s window is drawn on 1001 samples (half
+    the experiment's resolution, for a quick redraw).
 
     Returns
     -------
@@ -67,18 +68,18 @@ def pa9_scenario() -> Scenario:
     (3, (-1.0, -2.0, -3.0))
     """
     return _scenario(
-        pa9(),
+        PA9.plant(),
         "uio",
         name="pa9",
         title="PA9",
-        timepts=np.linspace(0.0, 10.0, 1001),
-        initial_state=[1.0, -1.0, 0.5],
-        u=signals.stack(signals.step(1.0), signals.sinusoid(0.5, 1.0)),
+        timepts=PA9.grid(samples=1001),
+        initial_state=PA9.initial_state,
+        u=PA9.inputs,
         defaults=Settings(
-            poles=(-1.0, -2.0, -3.0),
+            poles=PA9.poles,
             disturbance="sinusoid",
-            amplitude=1.0,
-            frequency=2.0,
+            amplitude=PA9.sine_amplitude,
+            frequency=PA9.sine_frequency,
             period=2.5,
         ),
         pole_limits=(-10.0, 1.0),
@@ -100,8 +101,10 @@ def case_study_scenario() -> Scenario:
     """The discrete-time case study: projection-operator observer, one movable pole or the LMI.
 
     Two fixed poles at 0.5 (the invariant zeros); ``d`` and ``v`` of the
-    chosen type (``v`` at half the amplitude and twice the frequency),
-    initial state ``[1, -2, 3]``, steps ``k = 0 ... 40``. The alternative
+    chosen type (``v`` at half the amplitude and twice the frequency). The
+    steps ``k = 0 ... 40``, the initial state ``[1, -2, 3]`` and the default
+    ``d``, the experiment's ``u2``, come from
+    :data:`uio_teach.experiments.CASE_STUDY`. The alternative
     mode designs the gain from the LMI with a radius bound
     (``Settings(mode="lmi", decay=...)``).
 
@@ -117,19 +120,19 @@ def case_study_scenario() -> Scenario:
     (1, [0.5, 0.5], (0.3, 1.0))
     """
     return _scenario(
-        dt_case_study(),
+        CASE_STUDY.plant(),
         "pmo",
         name="case-study",
         title="Case study",
-        timepts=np.arange(41.0),
-        initial_state=[1.0, -2.0, 3.0],
+        timepts=CASE_STUDY.timepts,
+        initial_state=CASE_STUDY.initial_state,
         u=None,
         defaults=Settings(
             poles=(0.0,),
             decay=0.9,
             disturbance="sinusoid",
-            amplitude=2.0,
-            frequency=0.6,
+            amplitude=CASE_STUDY.u2_amplitude,
+            frequency=CASE_STUDY.u2_frequency,
             period=5.0,
         ),
         pole_limits=(-1.1, 1.1),
@@ -151,8 +154,10 @@ def missile_scenario() -> Scenario:
     """The missile autopilot: PMO with two movable poles, the unknown inputs reconstructed.
 
     The default disturbance is the paper's pair of damped sinusoids
-    ``v1 = 10 exp(-2t) cos(10t)``, ``v2 = 50 exp(-5t) sin(100t)``; the
-    initial state is the paper's ``x0``; 0.5 s on 1001 samples. The unknown
+    ``v1 = 10 exp(-2t) cos(10t)``, ``v2 = 50 exp(-5t) sin(100t)``, with the
+    paper's initial state and the PMO poles ``-100, -120``, all from
+    :data:`uio_teach.experiments.MISSILE` (the observers start at ``q(0) = 0``
+    here); 0.5 s on 1001 samples. The unknown
     inputs are reconstructed from each observer's estimate with
     :func:`uio_teach.reconstruct_input` (filtered, ``tau`` = 2 ms).
 
@@ -167,19 +172,21 @@ def missile_scenario() -> Scenario:
     >>> s.defaults.poles, s.defaults.tau
     ((-100.0, -120.0), 0.002)
     """
+    # the controls' amplitude and frequency are v1's; each channel is a multiple of them
+    amplitude, _, frequency, _ = MISSILE.v_parameters[0]
     return _scenario(
-        missile_autopilot(),
+        MISSILE.plant(),
         "pmo",
         name="missile",
         title="Missile autopilot",
-        timepts=np.linspace(0.0, 0.5, 1001),
-        initial_state=MISSILE_PUBLISHED.x0,
+        timepts=MISSILE.grid(samples=1001),
+        initial_state=MISSILE.initial_state,
         u=None,
         defaults=Settings(
-            poles=(-100.0, -120.0),
+            poles=MISSILE.poles,
             disturbance="damped sinusoid",
-            amplitude=10.0,
-            frequency=10.0,
+            amplitude=amplitude,
+            frequency=frequency,
             period=0.05,
             tau=0.002,
         ),
@@ -191,7 +198,10 @@ def missile_scenario() -> Scenario:
         noise_limits=(0.0, 0.5),
         tau_limits=(0.0, 0.05),
         decay_limits=None,
-        d_channels=(Channel(kind="cos"), Channel(gain=5.0, speed=10.0, decay=0.05)),
+        d_channels=tuple(
+            Channel(gain=a / amplitude, speed=w / frequency, decay=rate / w, kind=kind)
+            for a, rate, w, kind in MISSILE.v_parameters
+        ),
         v_channels=(),
         static_values=(20.0, -20.0, -50.0, -100.0, -200.0, -400.0),
         static_control="pole",

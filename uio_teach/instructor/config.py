@@ -27,6 +27,7 @@ from types import MappingProxyType
 from typing import Any
 
 from .._display import format_poles
+from ..experiments import CASE_STUDY, MISSILE, PA9
 
 __all__ = ["ConfigError", "FigureConfig", "load_config", "default_config_toml"]
 
@@ -48,27 +49,33 @@ class _Option:
 
 _SCHEMA: dict[str, _Option] = {
     "seed": _Option(
-        "int", 4, "seed of every random number: PA9's measurement noise, the case study's v"
+        "int",
+        CASE_STUDY.seed,
+        "seed of every random number: PA9's measurement noise, the case study's v",
     ),
     "style": _Option(
         "str",
         "default",
         "matplotlib style: a name of matplotlib.style.available or a .mplstyle file",
     ),
-    "pa9.poles": _Option("poles", [-1.0, -2.0, -3.0], "UIO poles (also the Luenberger poles)"),
-    "pa9.duration": _Option("float", 10.0, "simulated time in s", positive=True),
-    "pa9.samples": _Option("int", 2001, "number of time points", minimum=2),
-    "pa9.initial_state": _Option("floats", [1.0, -1.0, 0.5], "plant state x(0)", length=3),
+    "pa9.poles": _Option("poles", list(PA9.poles), "UIO poles (also the Luenberger poles)"),
+    "pa9.duration": _Option("float", PA9.duration, "simulated time in s", positive=True),
+    "pa9.samples": _Option("int", PA9.timepts.size, "number of time points", minimum=2),
+    "pa9.initial_state": _Option(
+        "floats", PA9.initial_state.tolist(), "plant state x(0)", length=3
+    ),
     "pa9.noise": _Option(
         "float", 0.0, "standard deviation of the measurement noise (0: none)", minimum=0.0
     ),
-    "pa9.sine.amplitude": _Option("float", 1.0, "d(t) = amplitude sin(frequency t)"),
-    "pa9.sine.frequency": _Option("float", 2.0, "angular frequency in rad/s", positive=True),
+    "pa9.sine.amplitude": _Option("float", PA9.sine_amplitude, "d(t) = amplitude sin(frequency t)"),
+    "pa9.sine.frequency": _Option(
+        "float", PA9.sine_frequency, "angular frequency in rad/s", positive=True
+    ),
     "pa9.piecewise.times": _Option(
-        "floats", [0.0, 2.0, 5.0, 7.5], "switching times in s, increasing", minimum=0.0
+        "floats", list(PA9.switch_times), "switching times in s, increasing", minimum=0.0
     ),
     "pa9.piecewise.values": _Option(
-        "floats", [1.0, -1.5, 2.0, 0.0], "the level held from each switching time"
+        "floats", list(PA9.switch_values), "the level held from each switching time"
     ),
     "case_study.poles": _Option(
         "poles",
@@ -76,18 +83,29 @@ _SCHEMA: dict[str, _Option] = {
         "the one movable pole, e.g. [0.2]; absent: the LMI gain of the case study",
         optional=True,
     ),
-    "case_study.steps": _Option("int", 40, "number of steps k = 0 ... steps", minimum=2),
-    "case_study.initial_state": _Option("floats", [1.0, -2.0, 3.0], "plant state x[0]", length=3),
-    "case_study.u2.amplitude": _Option("float", 2.0, "u2[k] = amplitude sin(frequency k)"),
+    "case_study.steps": _Option(
+        "int", int(CASE_STUDY.duration), "number of steps k = 0 ... steps", minimum=2
+    ),
+    "case_study.initial_state": _Option(
+        "floats", CASE_STUDY.initial_state.tolist(), "plant state x[0]", length=3
+    ),
+    "case_study.u2.amplitude": _Option(
+        "float", CASE_STUDY.u2_amplitude, "u2[k] = amplitude sin(frequency k)"
+    ),
     "case_study.u2.frequency": _Option(
-        "float", 0.6, "angular frequency in rad per step", positive=True
+        "float", CASE_STUDY.u2_frequency, "angular frequency in rad per step", positive=True
     ),
     "case_study.v.amplitude": _Option(
-        "float", 1.0, "v: a random staircase, levels uniform in [-amplitude, amplitude]", minimum=0
+        "float",
+        CASE_STUDY.v_amplitude,
+        "v: a random staircase, levels uniform in [-amplitude, amplitude]",
+        minimum=0,
     ),
-    "case_study.v.hold": _Option("int", 5, "steps each level of v is held", minimum=1),
+    "case_study.v.hold": _Option(
+        "int", CASE_STUDY.v_hold, "steps each level of v is held", minimum=1
+    ),
     "missile.pmo_poles": _Option(
-        "poles", [-100.0, -120.0], "PMO poles (the paper's are not given; see chapter 5)"
+        "poles", list(MISSILE.poles), "PMO poles (the paper's are not given; see chapter 5)"
     ),
     "missile.duration": _Option("float", 0.3, "simulated time in s", positive=True),
     "missile.samples": _Option("int", 6001, "number of time points", minimum=2),

@@ -30,6 +30,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import os
 import time
@@ -43,6 +44,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._display import format_poles
+from ..experiments import CASE_STUDY, MISSILE, PA9
 from .config import ConfigError, FigureConfig, _design, default_config_toml, load_config
 from .output import FORMATS, OutputError, prepare_output_dir, save_figure
 
@@ -69,7 +71,11 @@ CATCH_TOL = 0.02
 
 
 class _Runs:
-    """Every simulation the figures need, computed once and shared (lazily)."""
+    """Every simulation the figures need, computed once and shared (lazily).
+
+    Each run is a worked experiment of :mod:`uio_teach.experiments` with the
+    configuration's values in place of its own.
+    """
 
     def __init__(self, cfg: FigureConfig) -> None:
         self.cfg = cfg
@@ -80,59 +86,53 @@ class _Runs:
         import uio_teach as ut
 
         c = self.cfg
-        plant = ut.examples.pa9()
+        run = dataclasses.replace(
+            PA9,
+            timepts=PA9.grid(samples=c["pa9.samples"], duration=c["pa9.duration"]),
+            initial_state=c["pa9.initial_state"],
+            poles=c["pa9.poles"],
+            sine_amplitude=c["pa9.sine.amplitude"],
+            sine_frequency=c["pa9.sine.frequency"],
+            switch_times=c["pa9.piecewise.times"],
+            switch_values=c["pa9.piecewise.values"],
+            noise=c["pa9.noise"] or None,
+            seed=c["seed"],
+        )
+        plant = run.plant()
         uio = _design(c, "pa9.poles")
         luen = ut.design_luenberger(plant, poles=list(c["pa9.poles"]))
-        t = np.linspace(0.0, c["pa9.duration"], c["pa9.samples"])
-        u = ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0))
-        d_sine = ut.signals.sinusoid(c["pa9.sine.amplitude"], c["pa9.sine.frequency"])
-        d_steps = ut.signals.piecewise_constant(c["pa9.piecewise.times"], c["pa9.piecewise.values"])
-        noise = c["pa9.noise"] or None
-
-        def run(obs, d):
-            return ut.simulate(
-                plant,
-                obs,
-                t,
-                u=u,
-                d=d,
-                initial_state=c["pa9.initial_state"],
-                noise=noise,
-                seed=c["seed"],
-            )
-
+        d_sine, d_steps = run.d_sine, run.d_piecewise
         return {
             "plant": plant,
             "uio": uio,
             "d_sine": d_sine,
             "d_steps": d_steps,
-            "uio_sine": run(uio, d_sine),
-            "uio_steps": run(uio, d_steps),
-            "luen_sine": run(luen, d_sine),
-            "luen_steps": run(luen, d_steps),
+            "uio_sine": run.simulate(uio, d=d_sine),
+            "uio_steps": run.simulate(uio, d=d_steps),
+            "luen_sine": run.simulate(luen, d=d_sine),
+            "luen_steps": run.simulate(luen, d=d_steps),
         }
 
     # case study -------------------------------------------------------------------------------
     @cached_property
     def case(self) -> dict[str, Any]:
-        import uio_teach as ut
-
         c = self.cfg
-        plant = ut.examples.dt_case_study()
+        run = dataclasses.replace(
+            CASE_STUDY,
+            timepts=np.arange(c["case_study.steps"] + 1, dtype=float),
+            initial_state=c["case_study.initial_state"],
+            u2_amplitude=c["case_study.u2.amplitude"],
+            u2_frequency=c["case_study.u2.frequency"],
+            v_amplitude=c["case_study.v.amplitude"],
+            v_hold=c["case_study.v.hold"],
+            seed=c["seed"],
+        )
         pmo = _design(c, "case_study.poles")
-        steps = np.arange(c["case_study.steps"] + 1, dtype=float)
-        rng = np.random.default_rng(c["seed"])
-        hold = c["case_study.v.hold"]
-        switch = np.arange(0, steps[-1] + 1, hold)
-        amp = c["case_study.v.amplitude"]
-        v = ut.signals.piecewise_constant(switch, rng.uniform(-amp, amp, switch.size))
-        u2 = ut.signals.sinusoid(c["case_study.u2.amplitude"], c["case_study.u2.frequency"])
-        x0 = c["case_study.initial_state"]
         return {
-            "plant": plant,
+            "plant": run.plant(),
             "pmo": pmo,
-            "loud": ut.simulate(plant, pmo, steps, d=u2, v=v, initial_state=x0),
-            "quiet": ut.simulate(plant, pmo, steps, initial_state=x0),
+            "loud": run.simulate(pmo),
+            "quiet": run.simulate(pmo, d=None, v=None),
         }
 
     # missile ----------------------------------------------------------------------------------
@@ -141,20 +141,23 @@ class _Runs:
         import uio_teach as ut
 
         c = self.cfg
-        plant = ut.examples.missile_autopilot()
-        t = np.linspace(0.0, c["missile.duration"], c["missile.samples"])
-        x0 = ut.examples.MISSILE_PUBLISHED.x0
-        v = ut.examples.missile_inputs()
+        run = dataclasses.replace(
+            MISSILE,
+            timepts=MISSILE.grid(samples=c["missile.samples"], duration=c["missile.duration"]),
+            poles=c["missile.pmo_poles"],
+        )
+        plant, t = run.plant(), run.timepts
         out: dict[str, Any] = {"plant": plant, "time": t}
-        out["free"] = ut.simulate(plant, ut.design_ginverse(plant), t, initial_state=x0)
+        ginverse = ut.design_ginverse(plant)
+        out["free"] = run.simulate(ginverse, d=None, observer_state=None)
         pmo = _design(c, "missile.pmo_poles")
         # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
         # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
         # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles
         # (chapter 5 explains both starts and Table II).
-        q0 = -pmo.M @ plant.C @ x0
-        for name, obs in (("pmo", pmo), ("ginverse", ut.design_ginverse(plant))):
-            resp = ut.simulate(plant, obs, t, d=v, initial_state=x0, observer_state=q0)
+        q0 = run.observer_state(pmo)
+        for name, obs in (("pmo", pmo), ("ginverse", ginverse)):
+            resp = run.simulate(obs, observer_state=q0)
             est = ut.reconstruct_input(plant, resp)
             out[name] = {
                 "observer": obs,
