@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import experiments
 from .._display import format_matrix_line, format_poles
-from ..experiments import PA9
 from ._common import (
     CheckResult,
     _close,
@@ -248,6 +248,6 @@ def pa9_design(
             f"{format_poles(bad)} "
             f"{'are' if len(bad) > 1 else 'is'} not {region}, so the error {law} does not "
             "decay. Choose K1 so that TA - K1C has the poles you want, e.g. "
-            f"K1 = ct.place((T @ A).T, C.T, {_numbers(PA9.poles)}).T.",
+            f"K1 = ct.place((T @ A).T, C.T, {_numbers(experiments.PA9.poles)}).T.",
         )
     return result

@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import experiments
 from .._display import format_complex, format_poles
-from ..experiments import PA9
 from ._common import (
     CheckResult,
     _never_raises,
@@ -52,11 +52,12 @@ def _disturbance(result: CheckResult, resp) -> np.ndarray | None:
         return None
     d = np.asarray(resp.inputs.d, float)
     if not np.any(d):
+        pa9 = experiments.PA9
         result.add(
             False,
             "d is zero during the whole simulation, so the test says nothing about the "
             "disturbance: pass one, e.g. ut.simulate(..., "
-            f"d=ut.signals.sinusoid({PA9.sine_amplitude:g}, {PA9.sine_frequency:g})).",
+            f"d=ut.signals.sinusoid({pa9.sine_amplitude:g}, {pa9.sine_frequency:g})).",
         )
         return None
     return d
@@ -79,7 +80,7 @@ def _initial_error(result: CheckResult, resp) -> float:
         result.add(
             False,
             "the error is zero at t = 0, so nothing can be seen decaying: start the plant from "
-            f"a nonzero state, e.g. initial_state={_numbers(PA9.initial_state)}.",
+            f"a nonzero state, e.g. initial_state={_numbers(experiments.PA9.initial_state)}.",
         )
     return e0
 
