@@ -10,7 +10,6 @@ from numpydoc.docscrape import FunctionDoc
 
 import uio_teach as ut
 
-
 # The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest.
 SUBPACKAGE_API = (
     "experiments",

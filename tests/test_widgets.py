@@ -24,8 +24,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import uio_teach as ut
-from uio_teach.explorers import widgets
-from uio_teach.explorers import DISTURBANCES, case_study_scenario, missile_scenario, pa9_scenario
+from uio_teach.explorers import (
+    DISTURBANCES,
+    case_study_scenario,
+    missile_scenario,
+    pa9_scenario,
+    widgets,
+)
 from uio_teach.explorers.static import static_explorer
 
 EXPLORERS = {

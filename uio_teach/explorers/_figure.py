@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..plotting import axis_label, symbol, time_label
 from .frames import Frame, compute_frame
 from .model import Scenario, Settings
 
@@ -181,21 +182,17 @@ class ExplorerFigure:
         self.lines: dict[str, list] = {}
         discrete = scenario.discrete
         style = {"drawstyle": "steps-post"} if discrete else {}
-        xlabel = "step k" if plant.dt is True else "time (s)"
+        xlabel = time_label(plant.dt)
         sym = scenario.input_symbol
         for r in rows:
             axes[f"lb.{r}"].sharey(axes[f"uio.{r}"])
         counts = {"error": plant.n, "residual": plant.p, "input": plant.q}
         labels = {
-            "error": lambda i: f"$e_{{{i + 1}}}$",
-            "residual": lambda i: f"$r_{{{i + 1}}}$",
-            "input": lambda i: f"$\\hat{{{sym}}}_{{{i + 1}}}$",
+            "error": lambda i: symbol("e", i),
+            "residual": lambda i: symbol("r", i),
+            "input": lambda i: symbol(sym, i, hat=True),
         }
-        ylabels = {
-            "error": r"error $e = x - \hat{x}$",
-            "residual": r"residual $r = y - C\hat{x}$",
-            "input": f"${sym}$ and $\\hat{{{sym}}}$",
-        }
+        ylabels = {r: axis_label(r, sym) for r in ("error", "residual", "input")}
         for who in ("uio", "lb"):
             for r in rows:
                 ax = axes[f"{who}.{r}"]
@@ -282,12 +279,12 @@ class ExplorerFigure:
         sig = axes["signals"]
         sig.set_ylabel("unknown inputs", fontsize=8)
         self.lines["d"] = [
-            sig.plot([], [], color=f"C{i}", lw=1.0, label=f"${sym}_{{{i + 1}}}$", **style)[0]
+            sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sym, i), **style)[0]
             for i in range(plant.q)
         ]
         self.lines["v"] = [
             sig.plot(
-                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=f"$v_{{{i + 1}}}$", **style
+                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
             )[0]
             for i in range(plant.r)
         ]

@@ -45,6 +45,14 @@ import numpy as np
 
 from .._display import format_poles
 from ..experiments import CASE_STUDY, MISSILE, PA9
+from ..plotting import (
+    finish_panel,
+    new_figure,
+    plot_error,
+    plot_residual,
+    symbol,
+    time_label,
+)
 from .config import ConfigError, FigureConfig, _design, default_config_toml, load_config
 from .output import FORMATS, OutputError, prepare_output_dir, save_figure
 
@@ -172,40 +180,23 @@ class _Runs:
 # drawing ----------------------------------------------------------------------------------------
 
 
-def _new_figure(width: float = 8.0, height: float = 5.0) -> Figure:
-    from matplotlib.figure import Figure
-
-    return Figure(figsize=(width, height), layout="constrained")
-
-
 def _poles_text(obs) -> str:
     return format_poles(obs.poles(), 4)
-
-
-def _finish(ax, ylabel: str, legend: bool = True) -> None:
-    ax.set_ylabel(ylabel)
-    ax.grid(True, alpha=0.3)
-    if legend:
-        ax.legend(loc="upper right", fontsize="small")
 
 
 def _pa9_disturbance(runs: _Runs, which: str) -> Figure:
     r = runs.pa9
     resp, d = r[f"uio_{which}"], r[f"d_{which}"]
-    fig = _new_figure(8.0, 6.5)
+    fig = new_figure(8.0, 6.5)
     ax_d, ax_e, ax_r = fig.subplots(3, 1, sharex=True)
     t = resp.time
     ax_d.plot(t, resp.inputs.d[0], color="k")
     formula = repr(d)
     ax_d.set_title(f"d(t) = {formula if len(formula) <= 80 else formula[:77] + '...'}")
-    _finish(ax_d, "disturbance $d$", legend=False)
-    for i in range(resp.error.shape[0]):
-        ax_e.plot(t, resp.error[i], label=f"$e_{i + 1}$")
-    _finish(ax_e, r"error $e = x - \hat{x}$")
-    for i in range(resp.residual.shape[0]):
-        ax_r.plot(t, resp.residual[i], label=f"$r_{i + 1}$")
-    _finish(ax_r, r"residual $r = y - C\hat{x}$")
-    ax_r.set_xlabel("time (s)")
+    finish_panel(ax_d, "disturbance $d$", legend=False)
+    plot_error(ax_e, resp)
+    plot_residual(ax_r, resp)
+    ax_r.set_xlabel(time_label(resp.plant.dt))
     kind = "sinusoidal" if which == "sine" else "piecewise-constant"
     fig.suptitle(f"PA9: UIO with a {kind} disturbance (poles {_poles_text(r['uio'])})")
     return fig
@@ -222,13 +213,13 @@ def _pa9_piecewise(runs: _Runs) -> Figure:
 def _pa9_states(runs: _Runs) -> Figure:
     r = runs.pa9
     return r["uio_sine"].plot(
-        fig=_new_figure(9.0, 6.0), title=f"PA9: UIO, sinusoidal disturbance d(t) = {r['d_sine']!r}"
+        fig=new_figure(9.0, 6.0), title=f"PA9: UIO, sinusoidal disturbance d(t) = {r['d_sine']!r}"
     )
 
 
 def _pa9_luenberger(runs: _Runs) -> Figure:
     r = runs.pa9
-    fig = _new_figure(9.0, 5.5)
+    fig = new_figure(9.0, 5.5)
     axes = fig.subplots(2, 2, sharex=True, sharey="row")
     pairs = [
         ("UIO", r["uio_sine"], r["uio_steps"]),
@@ -241,11 +232,11 @@ def _pa9_luenberger(runs: _Runs) -> Figure:
             ax = axes[row, col]
             values = getattr(sine, what)
             for i in range(values.shape[0]):
-                ax.plot(sine.time, values[i], color=f"C{i}", label=f"${sym}_{i + 1}$")
+                ax.plot(sine.time, values[i], color=f"C{i}", label=symbol(sym, i))
                 ax.plot(steps.time, getattr(steps, what)[i], color=f"C{i}", linestyle="--")
-            _finish(ax, label)
+            finish_panel(ax, label)
         axes[0, col].set_title(name)
-        axes[1, col].set_xlabel("time (s)")
+        axes[1, col].set_xlabel(time_label(r["plant"].dt))
     fig.suptitle(
         f"PA9, poles {_poles_text(r['uio'])}: solid sinusoidal d, dashed piecewise-constant d"
     )
@@ -255,7 +246,7 @@ def _pa9_luenberger(runs: _Runs) -> Figure:
 def _case_response(runs: _Runs) -> Figure:
     r = runs.case
     return r["loud"].plot(
-        fig=_new_figure(9.0, 6.0),
+        fig=new_figure(9.0, 6.0),
         title=f"Case study: PMO (poles {_poles_text(r['pmo'])}), unknown input u2 and "
         "disturbance v active",
     )
@@ -265,7 +256,7 @@ def _case_error(runs: _Runs) -> Figure:
     r = runs.case
     loud, quiet = r["loud"], r["quiet"]
     k = loud.time
-    fig = _new_figure(8.0, 4.5)
+    fig = new_figure(8.0, 4.5)
     ax = fig.subplots()
     norm = np.linalg.norm(loud.error, axis=0)
     ax.semilogy(k, norm, "o", label=r"$\|e[k]\|$ with $u_2$ and $v$")
@@ -273,8 +264,8 @@ def _case_error(runs: _Runs) -> Figure:
     rho = float(np.max(np.abs(r["pmo"].poles())))
     if rho > 0:
         ax.semilogy(k, norm[0] * rho**k, "--", label=rf"$\|e[0]\|\,{rho:.3g}^k$")
-    ax.set_xlabel("step k")
-    _finish(ax, r"$\|e[k]\|_2$")
+    ax.set_xlabel(time_label(True))  # the case study counts steps k
+    finish_panel(ax, r"$\|e[k]\|_2$")
     ax.set_title("Case study: the estimation error ignores both unknown signals")
     return fig
 
@@ -282,16 +273,17 @@ def _case_error(runs: _Runs) -> Figure:
 def _missile_states(runs: _Runs, name: str, label: str, figs: str) -> Figure:
     m = runs.missile
     resp, free = m[name]["response"], m["free"]
-    fig = _new_figure(9.0, 6.0)
+    fig = new_figure(9.0, 6.0)
     axes = fig.subplots(2, 2, sharex=True)
     t = resp.time
     for i, ax in enumerate(axes.flat):
-        ax.plot(t, resp.states[i], color="tab:red", label=f"$x_{i + 1}$ with $v$")
-        ax.plot(t, free.states[i], color="tab:green", label=f"$x_{i + 1}$ without $v$")
-        ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=rf"$\hat{{x}}_{i + 1}$")
-        _finish(ax, f"$x_{i + 1}$")
+        ax.plot(t, resp.states[i], color="tab:red", label=f"{symbol('x', i)} with $v$")
+        ax.plot(t, free.states[i], color="tab:green", label=f"{symbol('x', i)} without $v$")
+        hat = symbol("x", i, hat=True)
+        ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=hat)
+        finish_panel(ax, symbol("x", i))
     for ax in axes[1]:
-        ax.set_xlabel("time (s)")
+        ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle(
         f"Missile autopilot, {label} (poles {_poles_text(m[name]['observer'])}); the paper's {figs}"
     )
@@ -308,36 +300,35 @@ def _missile_ginverse(runs: _Runs) -> Figure:
 
 def _missile_error(runs: _Runs) -> Figure:
     m = runs.missile
-    fig = _new_figure(9.0, 6.0)
+    fig = new_figure(9.0, 6.0)
     axes = fig.subplots(2, 2, sharex=True)
     for i, ax in enumerate(axes.flat):
         for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", "--")):
             resp = m[name]["response"]
             ax.plot(resp.time, resp.error[i], linestyle=style, label=label)
-        _finish(ax, rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$")
+        finish_panel(ax, rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$")
     for ax in axes[1]:
-        ax.set_xlabel("time (s)")
+        ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle("Missile autopilot: estimation error of both observers")
     return fig
 
 
 def _missile_inputs(runs: _Runs) -> Figure:
     m = runs.missile
-    fig = _new_figure(9.0, 5.5)
+    fig = new_figure(9.0, 5.5)
     axes = fig.subplots(2, 1, sharex=True)
     t = m["time"]
     actual = m["pmo"]["response"].inputs.d
     for i, ax in enumerate(axes):
-        ax.plot(t, actual[i], color="tab:red", lw=2.5, alpha=0.6, label=f"$v_{i + 1}$")
+        ax.plot(t, actual[i], color="tab:red", lw=2.5, alpha=0.6, label=symbol("v", i))
         for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", ":")):
             est = m[name]["inputs"].estimates[i]
-            ax.plot(
-                t, est, color="k", linestyle=style, lw=1.2, label=rf"$\hat{{v}}_{i + 1}$ {label}"
-            )
-        _finish(ax, f"$v_{i + 1}$")
+            hat = symbol("v", i, hat=True)
+            ax.plot(t, est, color="k", linestyle=style, lw=1.2, label=f"{hat} {label}")
+        finish_panel(ax, symbol("v", i))
         lim = 1.3 * float(np.max(np.abs(actual[i])))
         ax.set_ylim(-lim, lim)
-    axes[-1].set_xlabel("time (s)")
+    axes[-1].set_xlabel(time_label(m["plant"].dt))
     fig.suptitle(
         r"Missile autopilot: unknown inputs and their reconstructions "
         r"$\hat{v} = E^+(\dot{\hat{x}} - A\hat{x})$ (Fig. 4.5-4.6, 4.11-4.12)"
