@@ -68,7 +68,7 @@ def test_every_run_time_import_is_declared_in_pyproject():
 
 def test_the_instructor_extra_holds_what_only_the_labs_need():
     declared = _declared()
-    assert {"jupytext", "nbformat", "pyyaml", "pybtex"} <= declared["instructor"]
+    assert {"jupytext", "mdit-py-plugins", "nbformat", "pyyaml", "pybtex"} <= declared["instructor"]
     assert not declared["instructor"] & declared[""]
 
 

@@ -63,10 +63,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 from .book import (
-    _DIRECTIVE,
     _HEADING,
     _LABELLED_MATH,
-    _OPTION,
     _TARGET,
     BookIndex,
     _fence_states,
@@ -126,39 +124,34 @@ class _Directive:
 
 
 def _tokens(text: str) -> list[str | _Directive]:
-    """Split Markdown into plain text and top-level directives."""
-    out: list[str | _Directive] = []
+    """Split Markdown into plain text and top-level directives, as jupytext's MyST parser does.
+
+    The block parser of :mod:`jupytext.myst` (markdown-it-py with the MyST plugins, and the
+    colon fence of mdit-py-plugins) finds the directives; jupytext reads their options.
+    """
+    from jupytext.myst import get_parser, parse_directive_options
+    from mdit_py_plugins.colon_fence import colon_fence_plugin
+
     lines = text.split("\n")
-    buf: list[str] = []
-    i = 0
-    while i < len(lines):
-        m = _DIRECTIVE.match(lines[i].strip())
-        if not m:
-            buf.append(lines[i])
-            i += 1
+    out: list[str | _Directive] = []
+    done = 0
+    for token in get_parser().use(colon_fence_plugin).parse(text):
+        info = token.info.strip()
+        if token.level or token.type not in ("fence", "colon_fence") or not info.startswith("{"):
             continue
-        fence = m.group("fence")
-        j = i + 1
-        options: dict[str, str] = {}
-        while j < len(lines) and (o := _OPTION.match(lines[j].strip())):
-            options[o.group("key")] = o.group("value")
-            j += 1
-        body: list[str] = []
-        while j < len(lines):
-            s = lines[j].strip()
-            if s and not s.strip(fence[0]) and len(s) >= len(fence):
-                break
-            body.append(lines[j])
-            j += 1
-        if buf:
-            out.append("\n".join(buf))
-            buf = []
-        text_body = "\n".join(body).strip("\n")
-        out.append(_Directive(m.group("name"), m.group("arg"), options, text_body))
-        i = j + 1
-    if buf:
-        out.append("\n".join(buf))
-    return out
+        head = re.match(r"^\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*)$", info)
+        if head is None:
+            continue
+        start, end = token.map
+        if start > done:
+            out.append("\n".join(lines[done:start]))
+        body, options = parse_directive_options(token.content, f"line {start + 1}: ")
+        options = {str(k): "" if v is None else str(v) for k, v in options.items()}
+        out.append(_Directive(head["name"], head["arg"], options, "\n".join(body).strip("\n")))
+        done = end
+    if done < len(lines):
+        out.append("\n".join(lines[done:]))
+    return [t for t in out if not isinstance(t, str) or t.strip("\n")] or [text]
 
 
 def _quote(text: str) -> str:
