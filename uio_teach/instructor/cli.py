@@ -217,7 +217,7 @@ def build_parser() -> argparse.ArgumentParser:
     labs.add_argument(
         "--book",
         metavar="DIR",
-        help="the book's chapters (default: book/ of this source tree, else ./book)",
+        help="the book's chapters (default: book/ of a checkout, else the installed copy)",
     )
     labs.add_argument(
         "--source",
