@@ -230,6 +230,15 @@ def sort_poles(z: np.ndarray) -> np.ndarray:
     Imaginary parts that are round-off of a real value are dropped, and a conjugate pair always
     comes out negative imaginary part first.
 
+    Parameters
+    ----------
+    z : array_like of complex
+        The values.
+
+    Returns
+    -------
+    numpy.ndarray of complex
+
     Examples
     --------
     >>> from uio_teach.linalg import sort_poles
