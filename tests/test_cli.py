@@ -389,3 +389,13 @@ def test_the_sample_configurations_in_the_docs_are_valid(tmp_path):
     assert cfg["seed"] == 7 and cfg["pa9.piecewise.values"] == (1.0, -2.0, 0.5)
     for line in re.findall(r"^uio-teach figures: error: term\.toml: (.*)$", page, re.M):
         assert any(expected in line for _, expected in BAD_CONFIGS.values()), line
+
+
+def test_labs_without_the_instructor_extra_say_what_to_install(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "jupytext", None)  # as if it were not installed
+    code, out, err = run(["labs", "--out", str(tmp_path / "labs")], capsys)
+    assert code == 1 and "Traceback" not in err
+    assert err.strip() == (
+        "uio-teach labs: error: the lab notebooks need jupytext, which is not installed: "
+        "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)"
+    )

@@ -129,7 +129,7 @@ class Experiment:
         Parameters
         ----------
         samples : int, optional
-            Number of time points (default: as :attr:`timepts`).
+            Number of time points (default: as ``timepts``).
         duration : float, optional
             The last time point (default: :attr:`duration`).
 
@@ -162,7 +162,7 @@ class Experiment:
         return MappingProxyType({})
 
     def measurement_disturbance(self) -> Callable | None:
-        """The measurement disturbance ``v``, or ``None`` (seeded with :attr:`seed`).
+        """The measurement disturbance ``v``, or ``None`` (seeded with ``seed``).
 
         Returns
         -------
@@ -250,10 +250,14 @@ class PA9Experiment(Experiment):
 
     Attributes
     ----------
-    sine_amplitude, sine_frequency : float
-        The sinusoidal disturbance ``d(t) = amplitude sin(frequency t)`` (rad/s).
-    switch_times, switch_values : tuple of float
-        The piecewise-constant disturbance: the level held from each time (0 before).
+    sine_amplitude : float
+        Amplitude of the sinusoidal disturbance ``d(t) = amplitude sin(frequency t)``.
+    sine_frequency : float
+        Its angular frequency (rad/s).
+    switch_times : tuple of float
+        The piecewise-constant disturbance: the times it switches (0 before the first).
+    switch_values : tuple of float
+        The level held from each switching time.
 
     Examples
     --------
@@ -311,8 +315,10 @@ class CaseStudyExperiment(Experiment):
 
     Attributes
     ----------
-    u2_amplitude, u2_frequency : float
-        The unknown state input ``u2[k] = amplitude sin(frequency k)`` (rad per step).
+    u2_amplitude : float
+        Amplitude of the unknown state input ``u2[k] = amplitude sin(frequency k)``.
+    u2_frequency : float
+        Its angular frequency (rad per step).
     v_amplitude : float
         The measurement disturbance ``v`` holds levels drawn uniformly in
         ``[-v_amplitude, v_amplitude]``.
@@ -359,14 +365,14 @@ class CaseStudyExperiment(Experiment):
     def measurement_disturbance(
         self, seed: int | None = None, timepts: np.ndarray | None = None
     ) -> signals.Signal:
-        """The random staircase ``v``: a new level every :attr:`v_hold` steps.
+        """The random staircase ``v``: a new level every ``v_hold`` steps.
 
         Parameters
         ----------
         seed : int, optional
-            Seed of ``numpy.random.default_rng`` (default: :attr:`seed`).
+            Seed of ``numpy.random.default_rng`` (default: ``seed``).
         timepts : numpy.ndarray, optional
-            The steps it must cover (default: :attr:`timepts`).
+            The steps it must cover (default: ``timepts``).
 
         Returns
         -------
@@ -392,7 +398,7 @@ class MissileExperiment(Experiment):
 
     The unknown inputs are the paper's damped sinusoids
     ``v_i(t) = amplitude exp(-rate t) cos/sin(frequency t)``, one tuple
-    ``(amplitude, rate, frequency, "cos" or "sin")`` each in :attr:`v_parameters`.
+    ``(amplitude, rate, frequency, "cos" or "sin")`` each in ``v_parameters``.
 
     Attributes
     ----------
@@ -465,7 +471,10 @@ PA9 = PA9Experiment(
     initial_state=[1.0, -1.0, 0.5],
     poles=(-1.0, -2.0, -3.0),
 )
-"""Practical Assignment 9: 10 s on 2001 points, ``x(0) = [1, -1, 0.5]``, poles ``-1, -2, -3``."""
+"""The run of Practical Assignment 9.
+
+10 s on 2001 points, ``x(0) = [1, -1, 0.5]``, poles -1, -2, -3.
+"""
 
 CASE_STUDY = CaseStudyExperiment(
     name="case-study",
@@ -474,7 +483,10 @@ CASE_STUDY = CaseStudyExperiment(
     poles=None,
     seed=4,
 )
-"""The case study: steps ``k = 0 ... 40``, ``x[0] = [1, -2, 3]``, the LMI gain, seed 4."""
+"""The run of the case study.
+
+Steps ``k = 0 ... 40``, ``x[0] = [1, -2, 3]``, the LMI gain, seed 4.
+"""
 
 MISSILE = MissileExperiment(
     name="missile",
@@ -482,4 +494,7 @@ MISSILE = MissileExperiment(
     initial_state=examples.MISSILE_PUBLISHED.x0,
     poles=(-100.0, -120.0),
 )
-"""The missile autopilot: 0.5 s on 10001 points, the paper's ``x0``, PMO poles ``-100, -120``."""
+"""The run of the missile autopilot.
+
+0.5 s on 10001 points, the paper's ``x0``, PMO poles -100, -120.
+"""

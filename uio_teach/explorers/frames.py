@@ -242,7 +242,7 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
 
     The unknown input observer of ``scenario.family`` is designed with the
     settings' poles (or the LMI bound), the Luenberger observer with the poles
-    of :func:`uio_teach.explorers.luenberger_poles`; both are simulated with
+    of :func:`uio_teach.luenberger.luenberger_poles`; both are simulated with
     :func:`uio_teach.simulate` on the same plant, inputs, noise (same seed)
     and initial state, with observer states starting at zero. Errors,
     residuals (and reconstructed inputs) are clipped for display at ten times

@@ -290,7 +290,7 @@ def default_book_dir() -> Path:
     """The book's chapters: ``book/`` of a checkout, else the copy installed with the package.
 
     A wheel carries the chapters, ``_toc.yml`` and ``references.bib`` in
-    ``uio_teach/_course/`` (see :data:`PACKAGED_COURSE`), so the labs can be
+    ``uio_teach/_course/`` (``PACKAGED_COURSE``), so the labs can be
     written from any folder; ``./book`` is the last resort.
 
     Returns

@@ -310,6 +310,14 @@ def _labs(args: argparse.Namespace) -> int:
 
     try:
         results = labs.write_labs(args.out, args.source, book_dir=args.book, progress=progress)
+    except ImportError as err:
+        missing = err.name or str(err)
+        _error(
+            "labs",
+            f"the lab notebooks need {missing}, which is not installed: "
+            "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)",
+        )
+        return 1
     except (labs.LabError, OSError) as err:
         _error("labs", str(err))
         return 1

@@ -485,8 +485,8 @@ class FigureResult:
     ----------
     name : str
         The figure's name.
-    paths : tuple of pathlib.Path
-        The files written (empty on failure).
+    paths : tuple
+        The files written, as ``pathlib.Path`` (empty on failure).
     seconds : float
         Wall-clock time spent on it (its share of shared simulations included).
     error : str or None
@@ -549,7 +549,7 @@ def generate(
     ------
     ValueError
         An unknown name, format or a non-positive ``dpi``.
-    OutputError
+    uio_teach.instructor.output.OutputError
         ``out`` cannot be created or written to.
 
     Examples

@@ -509,7 +509,7 @@ def make_notebook(
     Parameters
     ----------
     source : str or path-like
-        The MyST Markdown notebook (read with :func:`jupytext.read`).
+        The MyST Markdown notebook (read with ``jupytext.read``).
     version : {"student", "solution"}
         Which notebook to build.
     index : BookIndex, optional
@@ -655,7 +655,7 @@ def write_labs(
         The lab chapters; by default every ``*lab*.md`` of ``book_dir``.
     book_dir : str or path-like, optional
         The book's chapters (for the cross-references and the default
-        sources); :func:`default_book_dir` by default.
+        sources); :func:`~uio_teach.instructor.book.default_book_dir` by default.
     progress : callable, optional
         Called as ``progress(index, total, result)`` after each lab.
 
