@@ -13,7 +13,7 @@ True
 [-3.0, -2.0, -1.0]
 """
 
-from . import checks, examples, experiments, linalg, plotting, signals
+from . import checks, examples, linalg, plotting, signals
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
 from .observers import (
@@ -36,11 +36,13 @@ from .simulation import SimulationInputs, UIOResponse, simulate
 __version__ = "0.1.0"
 
 # The explorers need ipywidgets and matplotlib: loaded on first use, not by `import uio_teach`.
+# The worked experiments (`ut.experiments`) are found the same way if nothing imported them yet.
 _LAZY = {
     "widgets": None,
     "explorer": None,
     "static_explorer": None,
     "explorers": None,
+    "experiments": None,
     "pa9_explorer": "widgets",
     "case_study_explorer": "widgets",
     "missile_explorer": "widgets",
@@ -93,9 +95,9 @@ __all__ = [
     "InputEstimate",
     "catch_time",
     "widgets",
-    "explorers",
     "explorer",
     "static_explorer",
+    "explorers",
     "pa9_explorer",
     "case_study_explorer",
     "missile_explorer",
