@@ -10,8 +10,9 @@ installed with the package.
 Examples
 --------
 >>> from uio_teach.instructor.book import BookIndex, default_book_dir
->>> BookIndex.from_book(default_book_dir()).chapters.get("07_lab_pa9")
-7
+>>> index = BookIndex.from_book(default_book_dir())
+>>> index.chapters["07_lab_pa9"] > index.chapters["02_toolbox"] > index.chapters["01_introduction"]
+True
 """
 
 from __future__ import annotations
@@ -111,8 +112,8 @@ class BookIndex:
     --------
     >>> from uio_teach.instructor.book import BookIndex, default_book_dir
     >>> index = BookIndex.from_book(default_book_dir())
-    >>> index.chapters.get("07_lab_pa9")
-    7
+    >>> index.chapters["01_introduction"], "08_api" in index.chapters   # numbered parts only
+    (1, False)
     >>> index.cite("p", "de2014comparison")
     '(De et al., 2014)'
     """

@@ -107,7 +107,7 @@ Write every lab of the book (book/*lab*.md, MyST notebooks) as two Jupyter
 notebooks, with empty outputs:
 
   DIR/student/<lab>.ipynb   each solution replaced by a cell starting with
-                            `# TODO: Exercise 7.1 (ex-...)`; the check cells
+                            `# TODO: Exercise <number> (<label>)`; check cells
                             kept, the instructor notes left out
   DIR/solution/<lab>.ipynb  complete, for marking: solution cells tagged
                             `solution`, check cells tagged `check`

@@ -6,7 +6,7 @@ A lab chapter is a MyST Markdown notebook in ``book/`` whose file name contains
 tagged ``solution``. From the one source, :func:`make_notebook` builds:
 
 * the **student** version: every solution is replaced by one code cell
-  starting with ``# TODO: Exercise 7.1 (ex-labpa9-1)``. When later cells use
+  starting with ``# TODO: Exercise <number> (<label>)``. When later cells use
   names that the solution defined (``checks.pa9_design(H, T, K1)``), the TODO
   cell sets them to ``None``, so the notebook runs from top to bottom and each
   check cell says, in plain words, what is still missing. Check cells are kept
@@ -17,7 +17,7 @@ tagged ``solution``. From the one source, :func:`make_notebook` builds:
 
 Both have empty outputs and pass :func:`nbformat.validate`. The MyST syntax
 that Jupyter does not render is rewritten as plain Markdown: exercises become
-quotes titled "Exercise 7.1" (numbered as in the book), ``{eq}`` references
+quotes titled "Exercise <number>" (numbered as in the book), ``{eq}`` references
 become equation numbers, ``{ref}`` and ``{doc}`` become titles, ``{cite:p}``
 becomes (Author, year), labelled display equations get a ``\\tag``.
 
