@@ -22,7 +22,7 @@ help:
 	@echo "make lint   ruff check and ruff format --check"
 	@echo "make clean  remove build outputs and caches (keeps $(VENV))"
 
-$(STAMP): requirements.txt pyproject.toml $(wildcard uio_teach/__init__.py)
+$(STAMP): requirements.txt pyproject.toml setup.py $(wildcard uio_teach/__init__.py)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --disable-pip-version-check -q -r requirements.txt
 	$(BIN)/python -m pip install --disable-pip-version-check -q -e . --no-deps

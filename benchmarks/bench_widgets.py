@@ -35,9 +35,8 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 
-from uio_teach import widgets  # noqa: E402
-from uio_teach.explorer import DISTURBANCES, ExplorerFigure, compute_frame  # noqa: E402
-from uio_teach.static_explorer import static_explorer  # noqa: E402
+from uio_teach.explorers import DISTURBANCES, ExplorerFigure, compute_frame, widgets  # noqa: E402
+from uio_teach.explorers.static import static_explorer  # noqa: E402
 
 
 def changes(ex: widgets.Explorer, count: int) -> list[tuple[str, object]]:

@@ -10,10 +10,26 @@ from numpydoc.docscrape import FunctionDoc
 
 import uio_teach as ut
 
+# The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest.
+SUBPACKAGE_API = (
+    "experiments",
+    "luenberger",
+    "explorers",
+    "explorers.widgets",
+    "explorers.static",
+    "instructor.cli",
+    "instructor.config",
+    "instructor.figures",
+    "instructor.output",
+    "instructor.labs",
+    "instructor.book",
+)
+
 
 def public_callables():
     seen = {}
     modules = [ut] + [getattr(ut, m) for m in ("examples", "linalg", "signals")]
+    modules += [importlib.import_module(f"uio_teach.{m}") for m in SUBPACKAGE_API]
     for mod in modules:
         for name in getattr(mod, "__all__", []):
             obj = getattr(mod, name)
@@ -61,9 +77,9 @@ def test_every_public_name_has_examples(qualname):
 
 def _modules():
     names = ["uio_teach"]
-    for info in pkgutil.iter_modules(ut.__path__):
-        if info.name != "__main__":
-            names.append(f"uio_teach.{info.name}")
+    for info in pkgutil.walk_packages(ut.__path__, prefix="uio_teach."):
+        if not info.name.endswith("__main__"):
+            names.append(info.name)
     return names
 
 

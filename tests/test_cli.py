@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import uio_teach as ut
-from uio_teach import cli, figures
+from uio_teach.instructor import cli, figures
 
 ALL = list(figures.FIGURES)
 TABLES = [name for name, spec in figures.FIGURES.items() if spec.table]
@@ -85,7 +85,7 @@ def test_python_dash_m_entry_point_lists_the_figures():
 
 def test_console_script_is_declared():
     pyproject = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
-    assert pyproject["project"]["scripts"]["uio-teach"] == "uio_teach.cli:main"
+    assert pyproject["project"]["scripts"]["uio-teach"] == "uio_teach.instructor.cli:main"
     script = shutil.which("uio-teach", path=str(Path(sys.executable).parent))
     if script is None:
         pytest.skip("the package is not reinstalled yet (make venv): no uio-teach script")
@@ -389,3 +389,13 @@ def test_the_sample_configurations_in_the_docs_are_valid(tmp_path):
     assert cfg["seed"] == 7 and cfg["pa9.piecewise.values"] == (1.0, -2.0, 0.5)
     for line in re.findall(r"^uio-teach figures: error: term\.toml: (.*)$", page, re.M):
         assert any(expected in line for _, expected in BAD_CONFIGS.values()), line
+
+
+def test_labs_without_the_instructor_extra_say_what_to_install(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "jupytext", None)  # as if it were not installed
+    code, out, err = run(["labs", "--out", str(tmp_path / "labs")], capsys)
+    assert code == 1 and "Traceback" not in err
+    assert err.strip() == (
+        "uio-teach labs: error: the lab notebooks need jupytext, which is not installed: "
+        "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)"
+    )

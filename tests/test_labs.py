@@ -16,7 +16,7 @@ import nbclient
 import nbformat
 import pytest
 
-from uio_teach import cli, labs
+from uio_teach.instructor import cli, labs
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 LABS = labs.find_labs(BOOK)

@@ -24,9 +24,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import uio_teach as ut
-from uio_teach import widgets
-from uio_teach.explorer import DISTURBANCES, case_study_scenario, missile_scenario, pa9_scenario
-from uio_teach.static_explorer import static_explorer
+from uio_teach.explorers import (
+    DISTURBANCES,
+    case_study_scenario,
+    missile_scenario,
+    pa9_scenario,
+    widgets,
+)
+from uio_teach.explorers.static import static_explorer
 
 EXPLORERS = {
     "pa9": widgets.pa9_explorer,

@@ -52,10 +52,13 @@ from .simulation import SimulationInputs, UIOResponse, simulate
 __version__ = "0.1.0"
 
 # The explorers need ipywidgets and matplotlib: loaded on first use, not by `import uio_teach`.
+# The worked experiments (`ut.experiments`) are found the same way if nothing imported them yet.
 _LAZY = {
     "widgets": None,
     "explorer": None,
     "static_explorer": None,
+    "explorers": None,
+    "experiments": None,
     "pa9_explorer": "widgets",
     "case_study_explorer": "widgets",
     "missile_explorer": "widgets",
@@ -78,6 +81,7 @@ def __dir__() -> list[str]:
 __all__ = [
     "Plant",
     "examples",
+    "experiments",
     "linalg",
     "signals",
     "plotting",
@@ -126,6 +130,7 @@ __all__ = [
     "widgets",
     "explorer",
     "static_explorer",
+    "explorers",
     "pa9_explorer",
     "case_study_explorer",
     "missile_explorer",

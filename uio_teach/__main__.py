@@ -1,6 +1,6 @@
-"""``python -m uio_teach``: the instructor's command line (see :mod:`uio_teach.cli`)."""
+"""``python -m uio_teach``: the instructor's command line (:mod:`uio_teach.instructor.cli`)."""
 
-from .cli import main
+from .instructor.cli import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

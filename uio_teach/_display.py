@@ -13,6 +13,7 @@ __all__ = [
     "matrices_html",
     "format_complex",
     "format_poles",
+    "format_matrix_line",
 ]
 
 
@@ -90,6 +91,21 @@ def format_matrix(M: np.ndarray, digits: int = 4, ref: float = 0.0) -> list[str]
     cells = [[f"{v:.{digits}g}" if v != 0 else "0" for v in row] for row in M]
     width = max(len(c) for row in cells for c in row)
     return ["[" + "  ".join(c.rjust(width) for c in row) + "]" for row in cells]
+
+
+def format_matrix_line(M: np.ndarray, digits: int = 3) -> str:
+    """A matrix on one line, round-off (below 1e-12 of its largest entry) shown as 0.
+
+    Examples
+    --------
+    >>> from uio_teach._display import format_matrix_line
+    >>> format_matrix_line([[0.94118, 0.23529], [1e-17, 0]])
+    '[[0.941, 0.235], [0, 0]]'
+    """
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    scale = float(np.max(np.abs(M))) if M.size else 0.0
+    M = np.where(np.abs(M) <= 1e-12 * max(scale, 1e-300), 0.0, M)
+    return "[" + ", ".join("[" + ", ".join(f"{v:.{digits}g}" for v in row) + "]" for row in M) + "]"
 
 
 def matrices_text(title: str, items: Iterable[tuple[str, np.ndarray]], digits: int = 4) -> str:

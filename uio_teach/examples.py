@@ -29,6 +29,7 @@ __all__ = [
     "pa9",
     "missile_autopilot",
     "missile_inputs",
+    "MISSILE_INPUTS",
     "DT_CASE_STUDY_PUBLISHED",
     "PA9_PUBLISHED",
     "MISSILE_PUBLISHED",
@@ -160,8 +161,12 @@ def missile_autopilot() -> Plant:
     )
 
 
+MISSILE_INPUTS = ((10.0, 2.0, 10.0, "cos"), (50.0, 5.0, 100.0, "sin"))
+"""The paper's unknown inputs as ``(amplitude, decay rate, frequency, "cos"/"sin")``."""
+
+
 def missile_inputs():
-    """The paper's unknown inputs ``[v1; v2]`` as one vector signal.
+    """The paper's unknown inputs ``[v1; v2]`` as one vector signal (:data:`MISSILE_INPUTS`).
 
     ``v1(t) = 10 exp(-2t) cos(10t)``, ``v2(t) = 50 exp(-5t) sin(100t)``.
 
@@ -171,9 +176,7 @@ def missile_inputs():
     >>> examples.missile_inputs()
     [10 exp(-2 t) cos(10 t); 50 exp(-5 t) sin(100 t)]
     """
-    return signals.stack(
-        signals.damped_sinusoid(10, 2, 10, "cos"), signals.damped_sinusoid(50, 5, 100, "sin")
-    )
+    return signals.stack(*(signals.damped_sinusoid(*p) for p in MISSILE_INPUTS))
 
 
 MISSILE_PUBLISHED = Published(

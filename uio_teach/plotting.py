@@ -1,8 +1,19 @@
-"""The standard figures of the course: a simulation and an input reconstruction.
+"""The course's drawing: standard figures and the panels, names and labels they are made of.
 
 Drawing code only; the numbers come from :func:`uio_teach.simulate` and
-:func:`uio_teach.reconstruct_input`. Every function returns the
-``matplotlib.figure.Figure`` and accepts an existing figure or axes.
+:func:`uio_teach.reconstruct_input`.
+
+* figures: :func:`plot_response` (states and estimates, error, residual) and
+  :func:`plot_input_estimate`; each returns the ``matplotlib.figure.Figure`` and
+  accepts an existing figure or axes;
+* panels: :func:`plot_error`, :func:`plot_residual` and :func:`plot_channels` draw
+  one line per channel into an axes; :func:`finish_panel` labels and grids it;
+* names: :func:`symbol` (``$e_{1}$``, ``$\\hat{x}_{2}$``), :func:`axis_label` (the error
+  ``e = x - xhat``, the residual ``r = y - C xhat``, an input and its estimate) and
+  :func:`time_label`; :func:`new_figure` makes a figure without pyplot.
+
+The course figures (``uio-teach figures``), the explorers and the book use them,
+so a symbol or a label is written in one place.
 """
 
 from __future__ import annotations
@@ -19,7 +30,23 @@ if TYPE_CHECKING:  # pragma: no cover
     from .reconstruction import InputEstimate
     from .simulation import UIOResponse
 
-__all__ = ["plot_response", "plot_input_estimate", "time_label"]
+__all__ = [
+    "plot_response",
+    "plot_input_estimate",
+    "plot_error",
+    "plot_residual",
+    "plot_channels",
+    "finish_panel",
+    "new_figure",
+    "symbol",
+    "axis_label",
+    "time_label",
+]
+
+_AXIS_LABELS = {
+    "error": r"error $e = x - \hat{x}$",
+    "residual": r"residual $r = y - C\hat{x}$",
+}
 
 
 def time_label(dt: float | bool | None) -> str:
@@ -41,6 +68,207 @@ def time_label(dt: float | bool | None) -> str:
     ('time (s)', 'step k', 'time (s)')
     """
     return "step k" if dt is True else "time (s)"
+
+
+def symbol(letter: str, i: int, *, hat: bool = False) -> str:
+    """The name of channel ``i`` (counted from 0) of a signal, as matplotlib mathtext.
+
+    Parameters
+    ----------
+    letter : str
+        The signal's letter: ``"x"``, ``"e"``, ``"r"``, ``"d"``, ``"v"``...
+    i : int
+        The channel, from 0; it is written from 1.
+    hat : bool, optional
+        The estimate's name, with a hat.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import symbol
+    >>> print(symbol("e", 0), symbol("x", 1, hat=True), symbol("d", 11))
+    $e_{1}$ $\\hat{x}_{2}$ $d_{12}$
+    """
+    name = f"\\hat{{{letter}}}" if hat else letter
+    return f"${name}_{{{i + 1}}}$"
+
+
+def axis_label(what: str, letter: str = "d") -> str:
+    """The label of a panel's vertical axis: the error, the residual, or an input and its estimate.
+
+    Parameters
+    ----------
+    what : {"error", "residual", "input"}
+        The panel.
+    letter : str, optional
+        The input's letter (``"input"`` only).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ValueError
+        An unknown panel.
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import axis_label
+    >>> print(axis_label("error"), "|", axis_label("input", "v"))
+    error $e = x - \\hat{x}$ | $v$ and $\\hat{v}$
+    """
+    if what == "input":
+        return f"${letter}$ and $\\hat{{{letter}}}$"
+    if what not in _AXIS_LABELS:
+        raise ValueError(f"what must be 'error', 'residual' or 'input', got {what!r}")
+    return _AXIS_LABELS[what]
+
+
+def new_figure(width: float = 8.0, height: float = 5.0) -> Figure:
+    """A figure of the object API (no pyplot, no GUI), with constrained layout.
+
+    Parameters
+    ----------
+    width, height : float, optional
+        Size in inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import new_figure
+    >>> new_figure(6, 4).get_size_inches().tolist()
+    [6.0, 4.0]
+    """
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+
+def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
+    """Label a panel's vertical axis, add a light grid and (optionally) the legend.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    ylabel : str
+        The label of its vertical axis.
+    legend : bool, optional
+        Show the legend (upper right, small).
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import finish_panel, new_figure
+    >>> ax = new_figure().subplots()
+    >>> _ = ax.plot([0, 1], [0, 1], label="$e_{1}$")
+    >>> finish_panel(ax, "error")
+    >>> ax.get_ylabel(), ax.get_legend() is not None
+    ('error', True)
+    """
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    if legend:
+        ax.legend(loc="upper right", fontsize="small")
+
+
+def plot_channels(
+    ax: Axes,
+    t: np.ndarray,
+    values: np.ndarray,
+    letter: str,
+    *,
+    discrete: bool = False,
+    **kwargs: Any,
+) -> None:
+    """One line per row of ``values``, coloured ``C0, C1, ...`` and named :func:`symbol`.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    t : numpy.ndarray
+        The time points.
+    values : numpy.ndarray
+        One row per channel.
+    letter : str
+        The signal's letter for the legend.
+    discrete : bool, optional
+        Draw steps (a discrete-time signal).
+    **kwargs
+        Further line properties.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.plotting import new_figure, plot_channels
+    >>> ax = new_figure().subplots()
+    >>> plot_channels(ax, np.arange(3.0), np.zeros((2, 3)), "r")
+    >>> [line.get_label() for line in ax.lines]
+    ['$r_{1}$', '$r_{2}$']
+    """
+    for i, row in enumerate(np.atleast_2d(values)):
+        _line(ax, t, row, discrete, label=symbol(letter, i), color=f"C{i}", **kwargs)
+
+
+def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
+    """The estimation error ``e = x - xhat`` of a simulation, one line per state, labelled.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    response : UIOResponse
+        The result of :func:`uio_teach.simulate`.
+    legend : bool, optional
+        Show the legend.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.plotting import new_figure, plot_error
+    >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
+    >>> ax = new_figure().subplots()
+    >>> plot_error(ax, resp)
+    >>> print(ax.get_ylabel(), len(ax.lines))
+    error $e = x - \\hat{x}$ 3
+    """
+    plot_channels(ax, response.time, response.error, "e", discrete=response.plant.is_discrete)
+    finish_panel(ax, axis_label("error"), legend)
+
+
+def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
+    """The output residual ``r = y - C xhat`` of a simulation, one line per output, labelled.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    response : UIOResponse
+        The result of :func:`uio_teach.simulate`.
+    legend : bool, optional
+        Show the legend.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.plotting import new_figure, plot_residual
+    >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
+    >>> ax = new_figure().subplots()
+    >>> plot_residual(ax, resp)
+    >>> [line.get_label() for line in ax.lines]
+    ['$r_{1}$', '$r_{2}$']
+    """
+    plot_channels(ax, response.time, response.residual, "r", discrete=response.plant.is_discrete)
+    finish_panel(ax, axis_label("residual"), legend)
 
 
 def _figure_and_axes(
@@ -81,18 +309,16 @@ def _actual_and_estimate(
     actual: np.ndarray | None,
     estimate: np.ndarray,
     discrete: bool,
-    symbol: str,
+    letter: str,
     i: int,
 ) -> None:
     """One panel: a signal (coloured) and its estimate (black, dashed), labelled."""
-    name = f"{symbol}_{{{i + 1}}}"
+    name = symbol(letter, i)
     if actual is not None:
-        _line(ax, t, actual, discrete, label=f"${name}$", color=f"C{i}")
-    hat = f"$\\hat{{{symbol}}}_{{{i + 1}}}$"
+        _line(ax, t, actual, discrete, label=name, color=f"C{i}")
+    hat = symbol(letter, i, hat=True)
     _line(ax, t, estimate, discrete, label=hat, color="k", linestyle="--", linewidth=1.0)
-    ax.set_ylabel(f"${name}$")
-    ax.legend(loc="upper right", fontsize="small")
-    ax.grid(True, alpha=0.3)
+    finish_panel(ax, name)
 
 
 def plot_response(
@@ -152,15 +378,9 @@ def plot_response(
     for i, a in enumerate(state_axes):
         _actual_and_estimate(a, t, response.states[i], response.estimates[i], discrete, "x", i)
     state_axes[-1].set_xlabel(xlabel)
-    for i in range(n):
-        _line(ax_err, t, response.error[i], discrete, label=f"$e_{{{i + 1}}}$", color=f"C{i}")
-    ax_err.set_ylabel(r"error $e = x - \hat{x}$")
-    for i in range(plant.p):
-        _line(ax_res, t, response.residual[i], discrete, label=f"$r_{{{i + 1}}}$", color=f"C{i}")
-    ax_res.set_ylabel(r"residual $r = y - C\hat{x}$")
+    plot_error(ax_err, response)
+    plot_residual(ax_res, response)
     for a in (ax_err, ax_res):
-        a.legend(loc="upper right", fontsize="small")
-        a.grid(True, alpha=0.3)
         a.set_xlabel(xlabel)
     if title is None:
         name = plant.name or "plant"

@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import uio_teach as ut
-from uio_teach.explorer import (
+from uio_teach.explorers import (
     DISTURBANCES,
     ExplorerFigure,
     Settings,
@@ -23,7 +23,6 @@ from uio_teach.explorer import (
     compute_frame,
     disturbance_signals,
     expand_poles,
-    luenberger_poles,
     make_scenario,
     missile_scenario,
     pa9_scenario,
@@ -195,26 +194,6 @@ def test_slow_pole_is_noted():
 def test_expand_poles():
     assert expand_poles([-1 - 2j, 0.5]).tolist() == [-1 + 2j, -1 - 2j, 0.5]
     assert expand_poles([]).size == 0
-
-
-def test_luenberger_poles_rule():
-    pa9 = ut.examples.pa9()
-    assert_same(luenberger_poles(pa9, [-1, -2, -3]).real, [-3, -2, -1])
-    # missile, g-inverse: two poles given, four needed; extras at 1.5 and 2 times the fastest
-    missile = ut.examples.missile_autopilot()
-    g = ut.design_ginverse(missile)
-    poles = luenberger_poles(missile, g.poles())
-    assert poles.size == 4
-    np.testing.assert_allclose(sorted(poles.real)[:2], [2 * -105.6, 1.5 * -105.6], rtol=1e-6)
-    # case study: (A, C) leaves 0.5 unobservable, so one 0.5 is taken out
-    case = ut.examples.dt_case_study()
-    assert np.allclose(np.sort(luenberger_poles(case, [0.2, 0.5, 0.5]).real), [0.2, 0.5])
-    # too many: the fastest are dropped
-    assert_same(luenberger_poles(pa9, [-1, -2, -3, -9]).real, [-3, -2, -1])
-    # repeated more often than the two outputs allow: spread, and the design works
-    spread = luenberger_poles(pa9, [-2, -2, -2])
-    assert len(set(np.round(spread.real, 9))) >= 2
-    ut.design_luenberger(pa9, poles=spread)
 
 
 def test_disturbance_types():

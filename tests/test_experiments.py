@@ -1,0 +1,140 @@
+"""The worked experiments: defined once, read by the figures, the explorers and the lab checks."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import uio_teach as ut
+from uio_teach.experiments import CASE_STUDY, MISSILE, PA9, Experiment
+from uio_teach.explorers import case_study_scenario, missile_scenario, pa9_scenario
+from uio_teach.instructor import figures
+from uio_teach.instructor.config import FigureConfig
+
+EXPERIMENTS = {"pa9": PA9, "case-study": CASE_STUDY, "missile": MISSILE}
+
+
+@pytest.mark.parametrize("name", sorted(EXPERIMENTS))
+def test_experiments_are_frozen_and_read_only(name):
+    exp = EXPERIMENTS[name]
+    assert isinstance(exp, Experiment) and exp.name == name
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        exp.initial_state = np.zeros(3)
+    for arr in (exp.timepts, exp.initial_state):
+        with pytest.raises(ValueError, match="read-only"):
+            arr[0] = 42.0
+    assert exp.initial_state.shape == (exp.plant().n,)
+
+
+def test_the_course_numbers():
+    assert PA9.initial_state.tolist() == [1.0, -1.0, 0.5] and PA9.poles == (-1.0, -2.0, -3.0)
+    assert (PA9.duration, PA9.timepts.size) == (10.0, 2001)
+    assert MISSILE.poles == (-100.0, -120.0)
+    np.testing.assert_array_equal(MISSILE.initial_state, ut.examples.MISSILE_PUBLISHED.x0)
+    assert CASE_STUDY.poles is None and CASE_STUDY.timepts.tolist() == list(range(41))
+
+
+def test_pa9_the_uio_ignores_both_disturbances():
+    """The defining property, on the experiment: the same error whatever d."""
+    obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+    runs = [PA9.simulate(obs, d=d) for d in PA9.unknown_inputs.values()]
+    quiet = PA9.simulate(obs, d=None)
+    for run in runs:
+        assert np.abs(run.inputs.d).max() > 0.5
+        np.testing.assert_allclose(run.error, quiet.error, atol=1e-9)
+    assert np.abs(quiet.error[:, 0]).max() > 0.5  # the error starts away from zero
+
+
+def test_case_study_v_is_a_seeded_staircase():
+    v = CASE_STUDY.measurement_disturbance()
+    k = CASE_STUDY.timepts
+    values = v(k)
+    held = values.reshape(-1)[:40].reshape(8, 5)
+    assert np.all(held == held[:, :1]) and len(set(held[:, 0])) == 8
+    assert np.abs(values).max() <= CASE_STUDY.v_amplitude
+    np.testing.assert_array_equal(values, CASE_STUDY.measurement_disturbance()(k))
+    assert not np.array_equal(values, CASE_STUDY.measurement_disturbance(seed=5)(k))
+
+
+def test_missile_observer_starts_at_zero_estimate():
+    plant = MISSILE.plant()
+    pmo = ut.design_pmo(plant, poles=MISSILE.poles)
+    resp = MISSILE.simulate(pmo, timepts=MISSILE.grid(samples=101))
+    np.testing.assert_allclose(resp.estimates[:, 0], 0.0, atol=1e-9)
+    np.testing.assert_allclose(resp.error[:, 0], MISSILE.initial_state, atol=1e-9)
+    np.testing.assert_allclose(resp.inputs.d, np.vstack(MISSILE.v(resp.time)))
+
+
+def test_grid_keeps_the_start_and_refines():
+    assert PA9.grid() is PA9.timepts
+    np.testing.assert_array_equal(PA9.grid(samples=1001), PA9.timepts[::2])
+    np.testing.assert_array_equal(MISSILE.grid(samples=6001, duration=0.3)[-1], 0.3)
+
+
+def test_simulate_overrides_any_keyword():
+    obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+    resp = PA9.simulate(obs, initial_state=[0.0, 0.0, 0.0], d=None)
+    np.testing.assert_allclose(resp.error, 0.0, atol=1e-12)
+
+
+# one place: the figures, explorers and checks read these values --------------------------------
+
+
+def test_changing_an_experiment_changes_the_figures_explorers_and_checks():
+    """One place: a new PA9 initial state reaches the figures, the explorer and a check."""
+    code = """
+import dataclasses
+import numpy as np
+import uio_teach as ut
+from uio_teach import experiments
+experiments.PA9 = dataclasses.replace(experiments.PA9, initial_state=[2.0, 0.0, -1.0])
+from uio_teach.explorers import pa9_scenario
+from uio_teach.instructor.config import FigureConfig
+from uio_teach.instructor.figures import _Runs
+assert pa9_scenario().initial_state.tolist() == [2.0, 0.0, -1.0]
+cfg = FigureConfig()
+assert cfg["pa9.initial_state"] == (2.0, 0.0, -1.0)
+assert _Runs(cfg).pa9["uio_sine"].states[:, 0].tolist() == [2.0, 0.0, -1.0]
+plant = experiments.PA9.plant()
+obs = ut.design_uio(plant, poles=experiments.PA9.poles)
+resp = ut.simulate(plant, obs, experiments.PA9.timepts, d=experiments.PA9.d_sine)
+message = " ".join(ut.checks.pa9_simulation(resp).failures)
+assert "initial_state=[2, 0, -1]" in message, message
+"""
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=300)
+
+
+def test_figure_defaults_are_the_experiments():
+    cfg = FigureConfig()
+    assert cfg["pa9.initial_state"] == tuple(PA9.initial_state)
+    assert [complex(p) for p in cfg["pa9.poles"]] == [complex(p) for p in PA9.poles]
+    assert cfg["pa9.samples"] == PA9.timepts.size and cfg["pa9.duration"] == PA9.duration
+    assert cfg["pa9.sine.amplitude"] == PA9.sine_amplitude
+    assert cfg["pa9.piecewise.times"] == PA9.switch_times
+    assert cfg["case_study.initial_state"] == tuple(CASE_STUDY.initial_state)
+    assert cfg["case_study.steps"] + 1 == CASE_STUDY.timepts.size
+    assert cfg["seed"] == CASE_STUDY.seed
+    assert [complex(p) for p in cfg["missile.pmo_poles"]] == [complex(p) for p in MISSILE.poles]
+    runs = figures._Runs(cfg)
+    np.testing.assert_allclose(runs.missile["pmo"]["response"].estimates[:, 0], 0.0, atol=1e-9)
+
+
+def test_scenarios_read_the_experiments():
+    pa9, case, missile = pa9_scenario(), case_study_scenario(), missile_scenario()
+    np.testing.assert_array_equal(pa9.initial_state, PA9.initial_state)
+    assert pa9.defaults.poles == PA9.poles
+    assert (pa9.defaults.amplitude, pa9.defaults.frequency) == (1.0, 2.0)
+    np.testing.assert_array_equal(case.initial_state, CASE_STUDY.initial_state)
+    np.testing.assert_array_equal(case.timepts, CASE_STUDY.timepts)
+    np.testing.assert_array_equal(missile.initial_state, MISSILE.initial_state)
+    assert missile.defaults.poles == MISSILE.poles
+    # the explorer's default disturbance is the paper's v1, v2
+    from uio_teach.explorers import disturbance_signals
+
+    d, _ = disturbance_signals(missile, missile.defaults)
+    t = missile.timepts
+    np.testing.assert_allclose(np.vstack([f(t) for f in d]), MISSILE.v(t), atol=1e-9)

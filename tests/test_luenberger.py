@@ -1,0 +1,65 @@
+"""The poles of the Luenberger observer set beside an unknown input observer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import uio_teach as ut
+from uio_teach.luenberger import luenberger_poles
+
+
+def assert_same(actual, expected):
+    np.testing.assert_allclose(actual, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_same_poles_when_they_fit():
+    assert_same(luenberger_poles(ut.examples.pa9(), [-1, -2, -3]).real, [-3, -2, -1])
+
+
+def test_too_few_poles_get_faster_real_ones():
+    """Missile, g-inverse: two poles given, four needed; extras at 1.5 and 2 times the fastest."""
+    missile = ut.examples.missile_autopilot()
+    g = ut.design_ginverse(missile)
+    poles = luenberger_poles(missile, g.poles())
+    assert poles.size == 4
+    np.testing.assert_allclose(sorted(poles.real)[:2], [2 * -105.6, 1.5 * -105.6], rtol=1e-6)
+    np.testing.assert_allclose(np.sort_complex(poles)[2:], np.sort_complex(g.poles()), rtol=1e-9)
+
+
+def test_modes_no_gain_moves_are_taken_out():
+    """Case study: (A, C) leaves 0.5 unobservable, so one 0.5 is taken out."""
+    case = ut.examples.dt_case_study()
+    assert np.allclose(np.sort(luenberger_poles(case, [0.2, 0.5, 0.5]).real), [0.2, 0.5])
+
+
+def test_too_many_poles_lose_the_fastest():
+    assert_same(luenberger_poles(ut.examples.pa9(), [-1, -2, -3, -9]).real, [-3, -2, -1])
+
+
+def test_poles_repeated_beyond_the_outputs_are_spread_and_placeable():
+    pa9 = ut.examples.pa9()
+    spread = luenberger_poles(pa9, [-2, -2, -2])
+    assert len(set(np.round(spread.real, 9))) >= 2
+    np.testing.assert_allclose(spread.real, -2, rtol=0.1)
+    placed = ut.design_luenberger(pa9, poles=spread).poles()
+    np.testing.assert_allclose(np.sort_complex(placed), np.sort_complex(spread), rtol=1e-8)
+
+
+DESIGNS = {
+    "pa9": lambda: ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3]),
+    "case-study": lambda: ut.design_pmo(ut.examples.dt_case_study(), method="lmi"),
+    "missile": lambda: ut.design_pmo(ut.examples.missile_autopilot(), poles=[-100, -120]),
+    "missile-ginverse": lambda: ut.design_ginverse(ut.examples.missile_autopilot()),
+}
+
+
+@pytest.mark.parametrize("name", sorted(DESIGNS))
+def test_the_luenberger_observer_gets_every_one_of_these_poles(name):
+    observer = DESIGNS[name]()
+    plant = observer.plant
+    target = luenberger_poles(plant, observer.poles())
+    placed = ut.design_luenberger(plant, poles=target).poles()
+    for p in target:
+        assert np.min(np.abs(placed - p)) <= 1e-6 * max(1.0, abs(p)), (p, placed)
+    assert placed.size == plant.n  # the unobservable modes of (A, C) stay as they are

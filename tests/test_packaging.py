@@ -1,0 +1,170 @@
+"""Packaging: every run-time import is declared and pinned, and the wheel works outside the
+checkout (figures, lab notebooks and the live explorer from any folder)."""
+
+from __future__ import annotations
+
+import ast
+import importlib.metadata
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+
+
+def _name(requirement: str) -> str:
+    """The normalised distribution name of a requirement string (PEP 503)."""
+    bare = re.match(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)", requirement).group(1)
+    return re.sub(r"[-_.]+", "-", bare).lower()
+
+
+def _declared() -> dict[str, set[str]]:
+    project = PYPROJECT["project"]
+    out = {"": {_name(r) for r in project["dependencies"]}}
+    for extra, reqs in project.get("optional-dependencies", {}).items():
+        out[extra] = {_name(r) for r in reqs}
+    return out
+
+
+def _third_party_imports() -> dict[str, set[str]]:
+    """Top-level third-party module -> the package modules that import it."""
+    found: dict[str, set[str]] = {}
+    for path in sorted((ROOT / "uio_teach").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            else:
+                continue
+            for name in names:
+                top = name.split(".")[0]
+                if top in sys.stdlib_module_names or top in ("uio_teach", "__future__"):
+                    continue
+                found.setdefault(top, set()).add(path.relative_to(ROOT).as_posix())
+    return found
+
+
+def test_every_run_time_import_is_declared_in_pyproject():
+    declared = _declared()
+    everything = set().union(*declared.values())
+    distributions = importlib.metadata.packages_distributions()
+    imports = _third_party_imports()
+    assert {"numpy", "control", "matplotlib", "ipywidgets", "jupytext"} <= set(imports)
+    missing = {}
+    for module, users in imports.items():
+        dists = {_name(d) for d in distributions.get(module, [module])}
+        if not dists & everything:
+            missing[module] = sorted(users)
+    assert not missing, f"imported but not declared in pyproject.toml: {missing}"
+
+
+def test_the_instructor_extra_holds_what_only_the_labs_need():
+    declared = _declared()
+    assert {"jupytext", "mdit-py-plugins", "nbformat", "pyyaml", "pybtex"} <= declared["instructor"]
+    assert not declared["instructor"] & declared[""]
+
+
+def test_requirements_pin_every_declared_dependency():
+    pins = {}
+    for line in (ROOT / "requirements.txt").read_text(encoding="utf-8").splitlines():
+        line = line.split("#")[0].strip()
+        if line:
+            name, _, version = line.partition("==")
+            pins[_name(name)] = version
+    for name in set().union(*_declared().values()):
+        assert pins.get(name), f"{name} is declared in pyproject.toml but not pinned"
+
+
+# the wheel, installed away from the checkout ---------------------------------------------------
+
+SOURCES = ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]
+SOURCES += ["_toc.yml", "references.bib"]
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """The wheel built from a copy of the sources, unpacked into a folder of its own."""
+    base = tmp_path_factory.mktemp("wheel")
+    src = base / "src"
+    for name in SOURCES:
+        path = ROOT / name
+        if path.is_dir():
+            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
+        else:
+            src.mkdir(exist_ok=True)
+            shutil.copy2(path, src / name)
+    dist, target = base / "dist", base / "site"
+    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
+    subprocess.run(
+        [*pip, "wheel", "--no-deps", "--no-build-isolation", "-w", dist, src],
+        check=True,
+        timeout=600,
+    )
+    (wheel,) = dist.glob("uio_teach-*.whl")
+    subprocess.run([*pip, "install", "--no-deps", "--target", target, wheel], check=True)
+    # Only the wheel's files and the environment's dependencies are importable: not the
+    # checkout (the current folder is a fresh one, PYTHONPATH names the unpacked wheel).
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(target)
+    env["MPLBACKEND"] = "Agg"
+    work = base / "elsewhere"
+    work.mkdir()
+    return target, work, env
+
+
+def _run(args, installed, **kwargs):
+    _, work, env = installed
+    proc = subprocess.run(
+        args, cwd=work, env=env, capture_output=True, text=True, timeout=600, **kwargs
+    )
+    assert proc.returncode == 0, proc.stderr
+    return proc
+
+
+@pytest.mark.slow
+def test_the_wheel_is_the_package_imported(installed):
+    target = installed[0]
+    proc = _run([sys.executable, "-c", "import uio_teach; print(uio_teach.__file__)"], installed)
+    assert Path(proc.stdout.strip()).is_relative_to(target)
+    assert (target / "uio_teach" / "_course" / "book" / "07_lab_pa9.md").is_file()
+    assert (target / "uio_teach" / "_course" / "references.bib").is_file()
+
+
+@pytest.mark.slow
+def test_the_wheel_lists_the_figures_from_any_folder(installed):
+    target = installed[0]
+    script = target / "bin" / "uio-teach"
+    proc = _run([sys.executable, script, "figures", "--list"], installed)
+    assert proc.stdout.split()[0] == "pa9_sine"
+
+
+@pytest.mark.slow
+def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
+    from uio_teach.instructor.book import BookIndex
+
+    chapter = BookIndex.from_book(ROOT / "book").chapters["07_lab_pa9"]
+    target, work, _ = installed
+    _run([sys.executable, target / "bin" / "uio-teach", "labs", "--out", "labs", "-q"], installed)
+    for version in ("student", "solution"):
+        notebooks = sorted((work / "labs" / version).glob("*.ipynb"))
+        assert [p.name for p in notebooks] == ["07_lab_pa9.ipynb"]
+        assert f"Exercise {chapter}.1" in notebooks[0].read_text(encoding="utf-8")
+
+
+@pytest.mark.slow
+def test_the_wheel_shows_the_pa9_explorer(installed):
+    code = (
+        "import uio_teach.widgets as w, uio_teach; ex = w.pa9_explorer(); "
+        "assert ex.frame is not None and 'text/html' in ex._repr_mimebundle_(); "
+        "print(uio_teach.__file__)"
+    )
+    proc = _run([sys.executable, "-c", code], installed)
+    assert Path(proc.stdout.strip()).is_relative_to(installed[0])

@@ -1,0 +1,34 @@
+"""Checks for the lab of Practical Assignment 9: plain-words feedback on a student's work.
+
+Each function takes what a lab group produced (matrices, a simulation, a
+figure), never raises on a student mistake, and returns a :class:`CheckResult`:
+a list of ✓ / ✗ messages that say what is right, what is not, and how to fix it.
+
+* :func:`pa9_design` -- ``H``, ``T``, ``K1`` (and ``F``, ``K2``): the design
+  equations (8) of the assignment and the stability of ``F``.
+* :func:`pa9_simulation` -- a :func:`~uio_teach.simulate` response with a
+  sinusoidal disturbance: the error does not depend on ``d`` and decays.
+* :func:`pa9_plot` -- a matplotlib figure: labelled axes showing the error
+  ``e`` and the residual ``r``.
+* :func:`pa9_piecewise` -- a response with a piecewise-constant disturbance:
+  the same error as with the sinusoid.
+
+Examples
+--------
+>>> import numpy as np
+>>> import uio_teach as ut
+>>> from uio_teach import checks
+>>> plant = ut.examples.pa9()
+>>> H = plant.E @ np.linalg.pinv(plant.C @ plant.E)
+>>> T = np.eye(3) - H @ plant.C
+>>> K1 = ut.examples.PA9_PUBLISHED.K1
+>>> checks.pa9_design(H, T, K1).passed
+True
+"""
+
+from ._common import CheckResult
+from .design import pa9_design
+from .plots import pa9_plot
+from .responses import pa9_piecewise, pa9_simulation
+
+__all__ = ["CheckResult", "pa9_design", "pa9_simulation", "pa9_plot", "pa9_piecewise"]

@@ -1,0 +1,288 @@
+"""What every lab check shares: the result (:class:`CheckResult`) and small helpers.
+
+Examples
+--------
+>>> from uio_teach.checks import CheckResult
+>>> r = CheckResult("Demo")
+>>> r.add(True, "H has the right shape.")
+>>> r.passed
+True
+"""
+
+from __future__ import annotations
+
+import functools
+import html
+from collections.abc import Callable, Iterable
+from typing import Any, TypeVar
+
+import numpy as np
+
+__all__ = ["CheckResult"]
+
+_SYMBOL = {True: "✓", False: "✗", None: "•"}
+_COLOUR = {True: "#1a7f37", False: "#cf222e", None: "#57606a"}
+
+
+class CheckResult:
+    """The outcome of a check: a list of messages, each marked ✓ (right), ✗ (wrong) or • (note).
+
+    Parameters
+    ----------
+    title : str
+        What was checked.
+    items : iterable of (bool or None, str), optional
+        The verdicts: ``True`` for a passed check, ``False`` for a failed one,
+        ``None`` for a note that does not count either way.
+
+    Attributes
+    ----------
+    title : str
+        What was checked.
+    items : list of (bool or None, str)
+        The verdicts, in the order they were made.
+
+    Notes
+    -----
+    A result is printable (``print(result)``), shows as a coloured list in a
+    notebook, and is truthy exactly when :attr:`passed` is, so ``assert
+    result`` works in a test.
+
+    Examples
+    --------
+    >>> from uio_teach.checks import CheckResult
+    >>> result = CheckResult("demo", [(True, "H is right."), (False, "T is not I - HC.")])
+    >>> result.passed
+    False
+    >>> print(result)
+    demo
+      ✓ H is right.
+      ✗ T is not I - HC.
+      => 1 of 2 checks failed. Start with the first ✗: later ones often follow from it.
+    """
+
+    def __init__(self, title: str, items: Iterable[tuple[bool | None, str]] = ()) -> None:
+        self.title = str(title)
+        self.items: list[tuple[bool | None, str]] = [(ok, str(msg)) for ok, msg in items]
+
+    def add(self, ok: bool | None, message: str) -> None:
+        """Append a verdict.
+
+        Parameters
+        ----------
+        ok : bool or None
+            ``True`` for a passed check (✓), ``False`` for a failed one (✗),
+            ``None`` for a note (•).
+        message : str
+            What was found, in plain words.
+
+        Examples
+        --------
+        >>> from uio_teach.checks import CheckResult
+        >>> result = CheckResult("demo")
+        >>> result.add(True, "H is right.")
+        >>> result.messages
+        ['✓ H is right.']
+        """
+        self.items.append((None if ok is None else bool(ok), str(message)))
+
+    @property
+    def passed(self) -> bool:
+        """True if at least one check was made and none failed."""
+        verdicts = [ok for ok, _ in self.items if ok is not None]
+        return bool(verdicts) and all(verdicts)
+
+    @property
+    def messages(self) -> list[str]:
+        """Every message with its mark (``"✓ ..."``, ``"✗ ..."`` or ``"• ..."``)."""
+        return [f"{_SYMBOL[ok]} {msg}" for ok, msg in self.items]
+
+    @property
+    def failures(self) -> list[str]:
+        """The messages of the failed checks (without the mark)."""
+        return [msg for ok, msg in self.items if ok is False]
+
+    def _verdict(self) -> str:
+        counted = [ok for ok, _ in self.items if ok is not None]
+        failed = counted.count(False)
+        if not counted:
+            return "Nothing could be checked."
+        if failed == 0:
+            return f"All {len(counted)} checks passed."
+        return (
+            f"{failed} of {len(counted)} checks failed. "
+            "Start with the first ✗: later ones often follow from it."
+        )
+
+    def __bool__(self) -> bool:
+        return self.passed
+
+    def __str__(self) -> str:
+        lines = [self.title] + [f"  {m}" for m in self.messages]
+        lines.append(f"  => {self._verdict()}")
+        return "\n".join(lines)
+
+    __repr__ = __str__
+
+    def _repr_html_(self) -> str:
+        rows = "".join(
+            f'<li style="list-style:none;color:{_COLOUR[ok]}">'
+            f"<b>{_SYMBOL[ok]}</b> {html.escape(msg)}</li>"
+            for ok, msg in self.items
+        )
+        colour = _COLOUR[True] if self.passed else _COLOUR[False]
+        return (
+            f'<div class="uio-check"><b>{html.escape(self.title)}</b>'
+            f'<ul style="padding-left:0.5em;margin:0.3em 0">{rows}</ul>'
+            f'<b style="color:{colour}">&rArr; {html.escape(self._verdict())}</b></div>'
+        )
+
+
+_F = TypeVar("_F", bound=Callable[..., CheckResult])
+
+
+def _never_raises(title: str) -> Callable[[_F], _F]:
+    """Turn any unexpected exception of a check into a ✗ message instead of a traceback."""
+
+    def decorate(func: _F) -> _F:
+        @functools.wraps(func)
+        def wrapper(*args: Any, **kwargs: Any) -> CheckResult:
+            try:
+                return func(*args, **kwargs)
+            except Exception as exc:  # a student must never see a traceback here
+                return CheckResult(
+                    title,
+                    [
+                        (
+                            False,
+                            f"the check could not run with these arguments "
+                            f"({type(exc).__name__}: {exc}). Compare your call with the "
+                            f"example in help(checks.{func.__name__}).",
+                        )
+                    ],
+                )
+
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
+
+
+# small helpers --------------------------------------------------------------------------------
+
+
+def _numbers(values: Iterable[float]) -> str:
+    """A list of real numbers as Python source: ``[1, -1, 0.5]``."""
+    return "[" + ", ".join(f"{float(np.real(x)):g}" for x in values) + "]"
+
+
+def _up_to(x: float, what: str) -> str:
+    """`` (up to rounding)`` for a number that should be zero, else `` (<what> 3e-09)``."""
+    return " (up to rounding)" if x <= 1e-12 else f" ({what} {x:.1g})"
+
+
+def _plural(k: int, word: str) -> str:
+    return f"{k} {word}" + ("" if k == 1 or word.endswith("s") else "s")
+
+
+def _maxdiff(X: np.ndarray, Y: np.ndarray) -> tuple[float, tuple[int, ...]]:
+    D = np.abs(np.asarray(X, float) - np.asarray(Y, float))
+    idx = tuple(int(i) for i in np.unravel_index(int(np.argmax(D)), D.shape))
+    return float(D[idx]), idx
+
+
+def _close(X: np.ndarray, Y: np.ndarray, tol: float) -> bool:
+    scale = max(1.0, float(np.max(np.abs(Y))) if np.size(Y) else 1.0)
+    return np.shape(X) == np.shape(Y) and _maxdiff(X, Y)[0] <= tol * scale
+
+
+def _chopped(M: np.ndarray, decimals: int = 2) -> np.ndarray:
+    f = 10.0**decimals
+    return np.trunc(f * np.asarray(M, float)) / f
+
+
+def _looks_two_decimals(X: np.ndarray, exact: np.ndarray) -> bool:
+    """True if ``X`` is ``exact`` rounded or chopped to 2 decimals (but not ``exact`` itself)."""
+    return any(_close(X, Y, 1e-9) for Y in (np.round(exact, 2), _chopped(exact))) and not _close(
+        X, exact, 1e-9
+    )
+
+
+def _read_matrix(
+    result: CheckResult, name: str, value: Any, rows: int, cols: int, what: str
+) -> np.ndarray | None:
+    """``value`` as a ``rows x cols`` float array, or ``None`` after adding a ✗ that says why."""
+    expected = f"a {rows} x {cols} matrix ({what})"
+    if value is None:
+        result.add(False, f"{name} is missing: it must be {expected}.")
+        return None
+    try:
+        arr = np.array(value)
+    except Exception:  # ragged lists and odd objects
+        arr = np.array(None, dtype=object)
+    if arr.dtype == object:
+        result.add(
+            False,
+            f"{name} could not be read as a matrix of numbers: are all its rows of the same "
+            f"length? It must be {expected}.",
+        )
+        return None
+    if np.iscomplexobj(arr):
+        if np.all(np.abs(arr.imag) <= 1e-12 * max(1.0, float(np.max(np.abs(arr))))):
+            arr = arr.real
+        else:
+            result.add(False, f"{name} has complex entries; it must be a real matrix.")
+            return None
+    try:
+        arr = arr.astype(float)
+    except (TypeError, ValueError):
+        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+        result.add(False, f"{name} must hold numbers, got {shown}; it must be {expected}.")
+        return None
+    if arr.ndim == 0 and rows == cols == 1:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1 and arr.size == rows * cols and 1 in (rows, cols):
+        arr = arr.reshape(rows, cols)
+    if arr.ndim != 2:
+        result.add(
+            False,
+            f"{name} is a {arr.ndim}-D array of shape {arr.shape}; it must be {expected}: "
+            "write one inner list per row, e.g. np.array([[1, 2], [3, 4]]).",
+        )
+        return None
+    if arr.shape != (rows, cols):
+        hint = (
+            f" It looks transposed: use {name}.T."
+            if arr.shape == (cols, rows)
+            else f" Check the order of the factors that make {name}."
+        )
+        result.add(False, f"{name} has shape {arr.shape} but must be {expected}.{hint}")
+        return None
+    if not np.all(np.isfinite(arr)):
+        bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+        result.add(False, f"{name}{list(bad)} is {arr[bad]}: every entry must be a finite number.")
+        return None
+    return arr
+
+
+def _get_plant(result: CheckResult, plant: Any):
+    from .. import examples
+    from ..plant import Plant
+
+    if plant is None:
+        return examples.pa9()
+    if not isinstance(plant, Plant):
+        result.add(
+            False,
+            f"plant must be a uio_teach.Plant (e.g. ut.examples.pa9()), got "
+            f"{type(plant).__name__}.",
+        )
+        return None
+    return plant
+
+
+def _stability(F: np.ndarray, discrete: bool) -> tuple[bool, np.ndarray, np.ndarray]:
+    from ..linalg import is_stable, sort_poles
+
+    eig = sort_poles(np.linalg.eigvals(F))
+    ok = is_stable(eig, discrete)
+    return bool(np.all(ok)), eig, eig[~ok]

@@ -1,0 +1,366 @@
+"""Checks of a PA9 simulation: the error does not depend on ``d`` and decays.
+
+:func:`pa9_simulation` takes the response with a sinusoidal disturbance,
+:func:`pa9_piecewise` the one with a piecewise-constant disturbance.
+
+Examples
+--------
+>>> import uio_teach as ut
+>>> from uio_teach.checks import pa9_simulation
+>>> from uio_teach.experiments import PA9
+>>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+>>> pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
+True
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .. import experiments
+from .._display import format_complex, format_poles
+from ._common import (
+    CheckResult,
+    _never_raises,
+    _numbers,
+    _plural,
+    _stability,
+    _up_to,
+)
+
+__all__ = ["pa9_simulation", "pa9_piecewise"]
+
+
+def _read_response(result: CheckResult, response: Any, name: str = "response"):
+    needed = ("time", "states", "error", "residual", "inputs", "plant", "observer")
+    if response is None or not all(hasattr(response, a) for a in needed):
+        got = "None" if response is None else type(response).__name__
+        result.add(
+            False,
+            f"{name} must be the result of ut.simulate(plant, observer, timepts, ...), got {got}.",
+        )
+        return None
+    return response
+
+
+def _disturbance(result: CheckResult, resp) -> np.ndarray | None:
+    if resp.plant.q == 0:
+        result.add(False, "the simulated plant has no unknown input (E has no columns).")
+        return None
+    d = np.asarray(resp.inputs.d, float)
+    if not np.any(d):
+        pa9 = experiments.PA9
+        result.add(
+            False,
+            "d is zero during the whole simulation, so the test says nothing about the "
+            "disturbance: pass one, e.g. ut.simulate(..., "
+            f"d=ut.signals.sinusoid({pa9.sine_amplitude:g}, {pa9.sine_frequency:g})).",
+        )
+        return None
+    return d
+
+
+def _noise_free(result: CheckResult, resp) -> bool:
+    if np.any(np.asarray(resp.inputs.noise)):
+        result.add(
+            False,
+            "the simulation has measurement noise; the error then depends on the noise too, so "
+            "the disturbance test is not clean. Simulate without noise=.",
+        )
+        return False
+    return True
+
+
+def _initial_error(result: CheckResult, resp) -> float:
+    e0 = float(np.max(np.abs(resp.error[:, 0])))
+    if e0 <= 1e-12:
+        result.add(
+            False,
+            "the error is zero at t = 0, so nothing can be seen decaying: start the plant from "
+            f"a nonzero state, e.g. initial_state={_numbers(experiments.PA9.initial_state)}.",
+        )
+    return e0
+
+
+def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
+    """Re-simulate with ``d = 0``; add a ✓/✗ on whether the error is unchanged."""
+    from ..simulation import simulate
+
+    quiet = simulate(
+        resp.plant,
+        resp.observer,
+        resp.time,
+        u=resp.inputs.u if resp.plant.m else None,
+        v=resp.inputs.v if resp.plant.r else None,
+        initial_state=resp.states[:, 0],
+        observer_state=resp.observer_states[:, 0],
+    )
+    diff = float(np.max(np.abs(resp.error - quiet.error)))
+    scale = max(1.0, float(np.max(np.abs(resp.states))))
+    if diff <= 1e-8 * scale:
+        result.add(
+            True,
+            f"the error does not depend on d: simulated again with d = 0, it is the same"
+            f"{_up_to(diff, 'largest difference')}.",
+        )
+        return quiet.error
+    if not resp.observer.decouples:
+        hint = (
+            f" Your observer is a {resp.observer.family}, which ignores d; design a decoupling "
+            "observer with ut.design_uio(plant, ...)."
+        )
+    elif resp.plant != resp.observer.plant:
+        hint = (
+            " The simulated plant is not the plant the observer was designed for: use the same "
+            "plant (the same E) in ut.design_uio and ut.simulate."
+        )
+    else:
+        hint = ""
+    result.add(
+        False,
+        f"the error depends on d: simulated again with d = 0, it changes by up to "
+        f"{diff:.3g}.{hint}",
+    )
+    return None
+
+
+def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool = True) -> None:
+    if e0 <= 1e-12:
+        return
+    e_end = float(np.max(np.abs(resp.error[:, -1])))
+    t0, t1 = float(resp.time[0]), float(resp.time[-1])
+    unit = "" if resp.plant.dt is True else " s"
+    if e_end <= decay * e0:
+        result.add(
+            True,
+            f"the error decays: largest component {e0:.3g} at t = {t0:g}{unit}, "
+            f"{e_end:.2g} at t = {t1:g}{unit}.",
+        )
+        return
+    poles = resp.observer.poles()
+    stable, _, bad = _stability(resp.observer.error_matrix, resp.plant.is_discrete)
+    if not stable:
+        result.add(
+            False,
+            f"the error does not decay: the observer's error dynamics are unstable (pole(s) "
+            f"{format_poles(bad)}). Choose K1 so that F = TA - K1C is stable.",
+        )
+        return
+    if not decoupled:
+        result.add(
+            False,
+            f"the error does not decay: {e_end:.3g} at the end against {e0:.3g} at the start, "
+            "because the disturbance keeps driving it (see above).",
+        )
+        return
+    if resp.plant.is_discrete:
+        rho = float(np.max(np.abs(poles)))
+        need = math.log(decay) / math.log(rho) if 0 < rho < 1 else 1.0
+        need_txt = f"about {math.ceil(need)} steps"
+    else:
+        sigma = float(-np.max(poles.real))
+        need_txt = f"about {math.log(1 / decay) / sigma:.2g} s"
+    result.add(
+        False,
+        f"the error has not decayed yet: {e_end:.3g} at the end against {e0:.3g} at the start. "
+        f"With the slowest error pole {format_complex(poles[np.argmax(poles.real)])} it needs "
+        f"{need_txt} to shrink to {decay:.0%}: simulate longer.",
+    )
+
+
+def _jumps(d: np.ndarray) -> np.ndarray:
+    """Indices ``k`` where some channel of ``d`` changes between samples ``k`` and ``k + 1``."""
+    scale = max(1.0, float(np.max(np.abs(d))))
+    return np.flatnonzero(np.any(np.abs(np.diff(d, axis=1)) > 1e-9 * scale, axis=0))
+
+
+@_never_raises("Practical Assignment 9: the test with a sinusoidal disturbance")
+def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
+    """Check a simulation with a sinusoidal disturbance: does the error ignore ``d`` and decay?
+
+    The checks: the disturbance ``d`` is nonzero and oscillates; the
+    simulation is noise-free and starts with a nonzero error; the error is
+    unchanged when the simulation is run again with ``d = 0`` (the defining
+    property of an unknown input observer); the error has shrunk to
+    ``decay`` times its initial size by the end.
+
+    Parameters
+    ----------
+    response : UIOResponse
+        The result of :func:`uio_teach.simulate`.
+    decay : float, optional
+        The largest final error, relative to the initial one (1 %).
+
+    Returns
+    -------
+    CheckResult
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach import checks
+    >>> from uio_teach.experiments import PA9
+    >>> plant = PA9.plant()
+    >>> obs = ut.design_uio(plant, poles=PA9.poles)
+    >>> checks.pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
+    True
+    >>> luen = ut.design_luenberger(plant, poles=PA9.poles)
+    >>> checks.pa9_simulation(PA9.simulate(luen, d=PA9.d_sine)).passed
+    False
+    """
+    result = CheckResult("Practical Assignment 9: the test with a sinusoidal disturbance")
+    resp = _read_response(result, response)
+    if resp is None:
+        return result
+    d = _disturbance(result, resp)
+    if d is not None:
+        N = d.shape[1]
+        changing = _jumps(d).size / max(1, N - 1)
+        centred = d - d.mean(axis=1, keepdims=True)
+        crossings = int(np.max(np.sum(np.diff(np.sign(centred), axis=1) != 0, axis=1)))
+        if changing < 0.5:
+            result.add(
+                False,
+                "d is piecewise constant, not a sinusoid: use d=ut.signals.sinusoid(amplitude, "
+                "frequency) here (the piecewise-constant test is checked by pa9_piecewise).",
+            )
+        elif crossings < 2:
+            result.add(
+                False,
+                "d does not oscillate within the simulated time: raise its frequency or "
+                "simulate several periods.",
+            )
+        else:
+            result.add(
+                True, f"d oscillates like a sinusoid (it crosses its mean {crossings} times)."
+            )
+    if not _noise_free(result, resp):
+        return result
+    e0 = _initial_error(result, resp)
+    decoupled = _same_without_d(result, resp) is not None
+    _decays(result, resp, e0, decay, decoupled)
+    return result
+
+
+@_never_raises("Practical Assignment 9: the test with a piecewise-constant disturbance")
+def pa9_piecewise(
+    response: Any, sinusoidal: Any = None, *, decay: float = 0.01, max_jumps: float = 0.1
+) -> CheckResult:
+    """Check a simulation with a piecewise-constant disturbance, and compare with the sinusoid.
+
+    The checks: ``d`` is piecewise constant (it jumps at least once, and at
+    no more than ``max_jumps`` of the samples); the error does not depend on
+    ``d`` (simulated again with ``d = 0``); when ``sinusoidal`` is given, the
+    error equals the error of that simulation (same time grid and initial
+    states); the error decays.
+
+    Parameters
+    ----------
+    response : UIOResponse
+        The simulation with the piecewise-constant disturbance.
+    sinusoidal : UIOResponse, optional
+        The simulation with the sinusoidal disturbance, to compare the errors.
+    decay : float, optional
+        The largest final error, relative to the initial one (1 %).
+    max_jumps : float, optional
+        The largest fraction of samples at which ``d`` may change.
+
+    Returns
+    -------
+    CheckResult
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach import checks
+    >>> from uio_teach.experiments import PA9
+    >>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
+    >>> sin = PA9.simulate(obs, d=PA9.d_sine)
+    >>> pw = PA9.simulate(obs, d=PA9.d_piecewise)
+    >>> checks.pa9_piecewise(pw, sinusoidal=sin).passed
+    True
+    >>> checks.pa9_piecewise(sin).failures[0][:35]
+    'd changes at 100% of the time steps'
+    """
+    result = CheckResult("Practical Assignment 9: the test with a piecewise-constant disturbance")
+    resp = _read_response(result, response)
+    if resp is None:
+        return result
+    d = _disturbance(result, resp)
+    if d is not None:
+        jumps = _jumps(d)
+        frac = jumps.size / max(1, d.shape[1] - 1)
+        if jumps.size == 0:
+            result.add(
+                False,
+                "d is constant: a piecewise-constant test needs at least one jump, e.g. "
+                "d=ut.signals.piecewise_constant([0, 4, 7], [1.0, -2.0, 0.5]).",
+            )
+        elif frac > max_jumps:
+            result.add(
+                False,
+                f"d changes at {frac:.0%} of the time steps, so it is not piecewise constant "
+                "(is it still the sinusoid?): use d=ut.signals.piecewise_constant(times, values).",
+            )
+        else:
+            times = ", ".join(f"{resp.time[k + 1]:.3g}" for k in jumps[:6])
+            more = ", ..." if jumps.size > 6 else ""
+            unit = "" if resp.plant.dt is True else " s"
+            result.add(
+                True,
+                f"d is piecewise constant: {_plural(jumps.size, 'jump')} (at t = "
+                f"{times}{more}{unit}).",
+            )
+    if not _noise_free(result, resp):
+        return result
+    e0 = _initial_error(result, resp)
+    decoupled = _same_without_d(result, resp) is not None
+    if sinusoidal is None:
+        result.add(
+            None,
+            "pass sinusoidal=<the response of the sinusoidal test> to check that both "
+            "disturbances give the same error.",
+        )
+    else:
+        other = _read_response(result, sinusoidal, "sinusoidal")
+        if other is not None:
+            _compare(result, resp, other)
+    _decays(result, resp, e0, decay, decoupled)
+    return result
+
+
+def _compare(result: CheckResult, resp, other) -> None:
+    if resp.time.shape != other.time.shape or not np.allclose(resp.time, other.time):
+        result.add(
+            False,
+            "the two simulations use different time points, so their errors cannot be "
+            "compared sample by sample: use the same timepts in both.",
+        )
+        return
+    if not np.allclose(resp.states[:, 0], other.states[:, 0]) or not np.allclose(
+        resp.estimates[:, 0], other.estimates[:, 0]
+    ):
+        result.add(
+            False,
+            "the two simulations start from different states, so their errors differ for that "
+            "reason alone: use the same initial_state (and observer_state) in both.",
+        )
+        return
+    diff = float(np.max(np.abs(resp.error - other.error)))
+    scale = max(1.0, float(np.max(np.abs(resp.states))), float(np.max(np.abs(other.states))))
+    if diff <= 1e-8 * scale:
+        result.add(
+            True,
+            f"the error is the same as with the sinusoidal disturbance"
+            f"{_up_to(diff, 'largest difference')}: the observer does not see which "
+            "disturbance acts.",
+        )
+    else:
+        result.add(
+            False,
+            f"the error differs from the sinusoidal test by up to {diff:.3g}: are both "
+            "simulations made with the same decoupling observer?",
+        )

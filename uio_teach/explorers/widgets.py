@@ -1,0 +1,656 @@
+"""Live explorers: ipywidgets controls wired to :mod:`uio_teach.explorers`.
+
+One explorer per example of the course, and one for any plant::
+
+    import uio_teach as ut
+    ut.widgets.pa9_explorer()            # PA9 decoupling UIO, three movable poles
+    ut.widgets.case_study_explorer()     # discrete case study: one pole, or the LMI bound
+    ut.widgets.missile_explorer()        # missile autopilot: PMO, reconstructed inputs
+    ut.widgets.explorer(plant, "pmo")    # your own plant
+
+Each shows the unknown input observer next to a plain Luenberger observer with
+the same poles: the error, the residual (and, for the missile, the
+reconstructed unknown inputs), a pole map and the applied unknown signals.
+This module only wires controls: the computing and drawing are the pure
+functions of :mod:`uio_teach.explorers`. Every slider has
+``continuous_update=False`` (a slow redraw never queues up), and the figure
+is updated in place and shown as a PNG in an ``ipywidgets.Image``.
+
+In the static book (no kernel) the same object shows pre-computed frames
+with a slider (:mod:`uio_teach.explorers.static`): its
+``_repr_mimebundle_`` holds both the widget view and that HTML, and the
+book prefers the HTML.
+
+Examples
+--------
+>>> from uio_teach.explorers import widgets
+>>> ex = widgets.pa9_explorer(static=False)
+>>> sorted(ex.controls)[:4]
+['amplitude', 'disturbance', 'frequency', 'noise']
+>>> ex.set(**{"pole 1": -4.0})
+>>> ex.settings.poles
+(-4.0, -2.0, -3.0)
+"""
+
+from __future__ import annotations
+
+import cmath
+import html
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import ipywidgets as W
+import numpy as np
+
+from .._display import format_poles
+from ..plant import Plant
+from ._figure import ExplorerFigure
+from .frames import Frame, compute_frame
+from .model import DISTURBANCES, Scenario, Settings
+from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+
+__all__ = ["Explorer", "pa9_explorer", "case_study_explorer", "missile_explorer", "explorer"]
+
+_STYLE = {"description_width": "120px"}
+_WIDTH = "330px"
+
+
+def _nice_step(span: float, parts: int) -> float:
+    raw = span / parts if span > 0 else 0.01
+    exp = 10.0 ** math.floor(math.log10(raw))
+    for m in (5, 2, 1):
+        if m * exp <= raw:
+            return m * exp
+    return exp  # pragma: no cover
+
+
+def _slider(description: str, lo: float, hi: float, value: float, parts: int = 200):
+    step = _nice_step(hi - lo, parts)
+    decimals = max(0, -math.floor(math.log10(step)))
+    return W.FloatSlider(
+        value=float(np.clip(value, lo, hi)),
+        min=lo,
+        max=hi,
+        step=step,
+        description=description,
+        continuous_update=False,
+        readout_format=f".{decimals}f",
+        style=_STYLE,
+        layout=W.Layout(width=_WIDTH),
+    )
+
+
+class _Slot:
+    """The controls of one movable real pole or complex pair."""
+
+    def __init__(self, index: int, kind: str, controls: dict[str, W.FloatSlider]) -> None:
+        self.index = index
+        self.kind = kind
+        self.controls = controls
+
+
+class Explorer:
+    """A live explorer: controls, the figure and messages, wired to :func:`compute_frame`.
+
+    Build one with :func:`pa9_explorer`, :func:`case_study_explorer`,
+    :func:`missile_explorer` or :func:`explorer`. Display it (last line of a
+    cell): with a kernel, the controls act at once; in the static book the
+    pre-computed frames of :func:`uio_teach.explorers.static.static_html`
+    show instead.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to explore.
+    settings : Settings, optional
+        The starting values of the controls (the scenario's defaults).
+    dpi : float
+        Resolution of the live figure.
+    static : bool
+        Include the static frames in the display (needed for the static
+        book; ``False`` displays faster in a live notebook).
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The scenario.
+    controls : dict
+        The control widgets by name: ``"pole 1"`` ... (or, for a complex
+        pair, ``"pole 2 real part"`` and ``"pole 2 frequency"``, in discrete
+        time ``"pole 2 radius"`` and ``"pole 2 angle"``), ``"pattern"`` (how
+        many complex pairs), ``"mode"`` and ``"decay"`` (LMI), ``"disturbance"``,
+        ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``.
+    figure : ExplorerFigure
+        The figure, updated in place.
+    frame : Frame
+        The frame on display.
+    image : ipywidgets.Image
+        The rendered figure.
+    message : ipywidgets.HTML
+        The poles and the messages of the frame.
+    widget : ipywidgets.VBox
+        The whole explorer.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.case_study_explorer(static=False)
+    >>> ex.controls["pole 1"].value = 1.05      # what a student's slider does
+    >>> print(ex.frame.observer_message)
+    this pole makes the PMO unstable: the error grows (pole 1.05 outside the unit circle)
+    >>> ex.set(mode="lmi", decay=0.4)
+    >>> "infeasible" in ex.frame.observer_message
+    True
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        settings: Settings | None = None,
+        *,
+        dpi: float = 90,
+        static: bool = True,
+    ) -> None:
+        self.scenario = scenario
+        self._base = scenario.defaults if settings is None else settings
+        self._static = static
+        self._static_html: str | None = None
+        self._holding = 0
+        self.controls: dict[str, W.Widget] = {}
+        self._slots: list[_Slot] = []
+        self.figure = ExplorerFigure(scenario, dpi=dpi)
+        self.frame: Frame | None = None
+        self.image = W.Image(format="png", layout=W.Layout(width="100%", max_width="900px"))
+        self.message = W.HTML()
+        self._build_controls()
+        self.update()
+
+    # controls -----------------------------------------------------------------------------
+    def _build_controls(self) -> None:
+        sc, base = self.scenario, self._base
+        c = self.controls
+        observer = [W.HTML(f"<b>{html.escape(sc.observer_name)} poles</b>")]
+        self._pole_box = W.VBox()
+        k = sc.movable
+        if k >= 2:
+            pairs = sum(1 for p in base.poles if complex(p).imag)
+            c["pattern"] = W.Dropdown(
+                options=[(self._pattern_label(k, j), j) for j in range(k // 2 + 1)],
+                value=min(pairs, k // 2),
+                description="movable poles",
+                style=_STYLE,
+                layout=W.Layout(width=_WIDTH),
+            )
+            c["pattern"].observe(self._pattern_changed, names="value")
+            observer.append(c["pattern"])
+        self._make_slots(list(base.poles))
+        observer.append(self._pole_box)
+        fixed = sc.fixed_poles
+        if sc.family == "ginverse":
+            text = "set by the observer's structure (no gain to tune)"
+        elif k == 0:
+            text = "none can be moved"
+        else:
+            text = ""
+        if fixed.size:
+            zeros = format_poles(fixed, 3)
+            text += ("; " if text else "") + f"fixed: {zeros} (invariant zeros)"
+        observer.append(W.HTML(f"<small>{html.escape(text)}</small>"))
+        if sc.decay_limits is not None:
+            c["mode"] = W.ToggleButtons(
+                options=[("place poles", "poles"), ("LMI bound", "lmi")],
+                value=base.mode,
+                description="design",
+                style={"description_width": "120px", "button_width": "95px"},
+            )
+            lo, hi = sc.decay_limits
+            label = "radius bound" if sc.discrete else "decay rate"
+            c["decay"] = _slider(label, lo, hi, base.decay, 70)
+            observer[1:1] = [c["mode"]]
+            observer.append(c["decay"])
+        dist = [W.HTML("<b>Disturbance</b>")]
+        c["disturbance"] = W.Dropdown(
+            options=list(DISTURBANCES),
+            value=base.disturbance if base.disturbance in DISTURBANCES else DISTURBANCES[0],
+            description="type",
+            style=_STYLE,
+            layout=W.Layout(width=_WIDTH),
+        )
+        unit = "steps" if sc.discrete else "s"
+        freq = "rad/step" if sc.discrete else "rad/s"
+        c["amplitude"] = _slider("amplitude", *sc.amplitude_limits, base.amplitude, 100)
+        c["frequency"] = _slider(f"frequency ({freq})", *sc.disturbance_frequency_limits,
+                                 base.frequency)  # fmt: skip
+        c["period"] = _slider(f"switching ({unit})", *sc.period_limits, base.period)
+        dist += [c["disturbance"], c["amplitude"], c["frequency"], c["period"]]
+        meas = [W.HTML("<b>Measurement</b>")]
+        c["noise"] = _slider("noise (std)", *sc.noise_limits, base.noise, 100)
+        meas.append(c["noise"])
+        if sc.tau_limits is not None:
+            c["tau"] = _slider(f"filter τ ({unit})", *sc.tau_limits, base.tau, 100)
+            meas += [c["tau"], W.HTML("<small>τ = 0: plain numerical derivative</small>")]
+        for name, control in c.items():
+            if name in ("pattern",) or name.startswith("pole "):
+                continue
+            control.observe(self._changed, names="value")
+        self._show_relevant()
+        boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in (observer, dist, meas)]
+        controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
+        self.widget = W.VBox([controls, self.image, self.message])
+
+    @staticmethod
+    def _pattern_label(k: int, pairs: int) -> str:
+        real = k - 2 * pairs
+        parts = []
+        if real:
+            parts.append(f"{real} real")
+        if pairs:
+            parts.append(f"{pairs} complex pair" + ("s" if pairs > 1 else ""))
+        return " + ".join(parts)
+
+    def _make_slots(self, entries: list[complex]) -> None:
+        """Controls for the movable poles: one slider per real pole, two per complex pair."""
+        sc = self.scenario
+        for slot in self._slots:
+            for name, control in slot.controls.items():
+                control.unobserve(self._changed, names="value")
+                self.controls.pop(name, None)
+        self._slots = []
+        if sc.movable == 0:
+            self._pole_box.children = ()
+            return
+        lo, hi = sc.pole_limits
+        widgets = []
+        for i, p in enumerate(entries, start=1):
+            p = complex(p)
+            if not p.imag:
+                ctl = {f"pole {i}": _slider(f"pole {i}", lo, hi, p.real)}
+                kind = "real"
+            elif sc.discrete:
+                radius, angle = abs(p), math.degrees(abs(cmath.phase(p)))
+                ctl = {
+                    f"pole {i} radius": _slider(f"pole {i} radius", 0.0, hi, radius),
+                    f"pole {i} angle": _slider(f"pole {i} angle (°)", 0.0, 180.0, angle, 180),
+                }
+                kind = "pair"
+            else:
+                f_hi = sc.frequency_limits[1]
+                ctl = {
+                    f"pole {i} real part": _slider(f"pole {i} real part", lo, hi, p.real),
+                    f"pole {i} frequency": _slider(f"pole {i} ± imag", 0.0, f_hi, abs(p.imag)),
+                }
+                kind = "pair"
+            for name, control in ctl.items():
+                control.observe(self._changed, names="value")
+                self.controls[name] = control
+                widgets.append(control)
+            self._slots.append(_Slot(i, kind, ctl))
+        self._pole_box.children = tuple(widgets)
+
+    def _pattern_changed(self, change: dict) -> None:
+        sc = self.scenario
+        pairs = int(change["new"])
+        current = [p for p in self._read_poles() if not complex(p).imag]
+        defaults = [complex(p).real for p in sc.defaults.poles if not complex(p).imag]
+        reals = (current + defaults + [sc.pole_limits[0] / 4] * sc.movable)[
+            : sc.movable - 2 * pairs
+        ]
+        if sc.discrete:
+            pair = cmath.rect(0.5, math.radians(45))
+        else:
+            sigma = min(defaults) if defaults else sc.pole_limits[0] / 4
+            pair = complex(sigma, abs(sigma))
+        with self.hold():
+            self._make_slots([*reals, *([pair] * pairs)])
+
+    def _show_relevant(self) -> None:
+        c = self.controls
+        kind = c["disturbance"].value
+        sine = kind in ("sinusoid", "damped sinusoid")
+        c["frequency"].layout.display = None if sine else "none"
+        c["period"].layout.display = "none" if sine else None
+        if "mode" in c:
+            lmi = c["mode"].value == "lmi"
+            self._pole_box.layout.display = "none" if lmi else None
+            if "pattern" in c:
+                c["pattern"].layout.display = "none" if lmi else None
+            c["decay"].layout.display = None if lmi else "none"
+
+    def _read_poles(self) -> tuple[complex, ...]:
+        poles: list[complex] = []
+        for slot in self._slots:
+            values = [control.value for control in slot.controls.values()]
+            if slot.kind == "real":
+                poles.append(float(values[0]))
+                continue
+            if self.scenario.discrete:
+                p = cmath.rect(values[0], math.radians(values[1]))
+            else:
+                p = complex(values[0], values[1])
+            if abs(p.imag) <= 1e-12 * max(1.0, abs(p)):
+                poles += [float(p.real), float(p.real)]  # a double real pole
+            else:
+                poles.append(p)
+        return tuple(poles)
+
+    @property
+    def settings(self) -> Settings:
+        """The settings the controls show now."""
+        c = self.controls
+        changes: dict[str, Any] = {
+            "poles": self._read_poles() if self.scenario.movable else self._base.poles,
+            "disturbance": c["disturbance"].value,
+            "amplitude": float(c["amplitude"].value),
+            "frequency": float(c["frequency"].value),
+            "period": float(c["period"].value),
+            "noise": float(c["noise"].value),
+        }
+        if "mode" in c:
+            changes["mode"] = c["mode"].value
+            changes["decay"] = float(c["decay"].value)
+        if "tau" in c:
+            changes["tau"] = float(c["tau"].value)
+        return self._base.replace(**changes)
+
+    # updating -----------------------------------------------------------------------------
+    @contextmanager
+    def hold(self) -> Iterator[None]:
+        """Change several controls, then update once.
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.pa9_explorer(static=False)
+        >>> with ex.hold():
+        ...     ex.controls["amplitude"].value = 2.0
+        ...     ex.controls["disturbance"].value = "random steps"
+        >>> ex.frame.settings.amplitude, ex.frame.settings.disturbance
+        (2.0, 'random steps')
+        """
+        self._holding += 1
+        try:
+            yield
+        finally:
+            self._holding -= 1
+            if not self._holding:
+                self.update()
+
+    def set(self, **values: Any) -> None:
+        """Set controls by name (as a student would), then update once.
+
+        Parameters
+        ----------
+        **values
+            New values by control name; a name with spaces is passed with
+            ``**{"pole 1": -2.0}``.
+
+        Raises
+        ------
+        KeyError
+            No control of that name.
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.missile_explorer(static=False)
+        >>> ex.set(tau=0.0, noise=0.1)
+        >>> ex.frame.messages[-1]
+        'the numerical derivative amplifies the noise: try a filter time constant tau > 0'
+        """
+        with self.hold():
+            if "pattern" in values:
+                self.controls["pattern"].value = values.pop("pattern")
+            for name, value in values.items():
+                if name not in self.controls:
+                    raise KeyError(f"no control {name!r}; the controls are {sorted(self.controls)}")
+                self.controls[name].value = value
+
+    def _changed(self, change: dict) -> None:
+        if not self._holding:
+            self.update()
+
+    def update(self) -> None:
+        """Recompute the frame for the controls' values and redraw the figure in place.
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.pa9_explorer(static=False)
+        >>> ex.update()
+        >>> bytes(ex.image.value[:4])
+        b'\\x89PNG'
+        """
+        self._show_relevant()
+        try:
+            frame = compute_frame(self.scenario, self.settings)
+            self.figure.update(frame)
+            self.image.value = self.figure.to_png(colors=128)
+        except Exception as exc:  # pragma: no cover - compute_frame already turns errors into text
+            self.message.value = (
+                f'<span style="color:#c0392b">could not update the picture: '
+                f"{html.escape(str(exc))}</span>"
+            )
+            return
+        self.frame = frame
+        self.message.value = _message_html(frame)
+
+    # display ------------------------------------------------------------------------------
+    def static_html(self) -> str:
+        """The static frames of this explorer (computed once, on first use).
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.case_study_explorer(static=False)
+        >>> ex.static_html().count('data-k="')
+        24
+        """
+        if self._static_html is None:
+            from .static import static_html
+
+            self._static_html = static_html(self.scenario, self._base)
+        return self._static_html
+
+    def _repr_mimebundle_(self, **kwargs: Any) -> dict[str, Any]:
+        data = dict(self.widget._repr_mimebundle_(**kwargs) or {})
+        data["text/plain"] = (
+            f"{self.scenario.title} explorer ({self.scenario.observer_name} and Luenberger "
+            "observer): run in Jupyter with a Python kernel to use the controls"
+        )
+        if self._static:
+            data["text/html"] = self.static_html()
+        return data
+
+    def __repr__(self) -> str:
+        return f"<Explorer {self.scenario.title!r}: {self.scenario.observer_name}>"
+
+
+def _message_html(frame: Frame) -> str:
+    name = html.escape(frame.scenario.observer_name)
+    lines = []
+    if frame.poles.size:
+        lines.append(f"{name} poles: {format_poles(frame.poles, 3)}")
+    if frame.luenberger_poles.size:
+        lines.append(f"Luenberger poles: {format_poles(frame.luenberger_poles, 3)}")
+    text = "<br>".join(html.escape(line) for line in lines)
+    notes = "".join(f"<li>{html.escape(m)}</li>" for m in frame.all_messages)
+    if notes:
+        text += f'<ul style="color:#c0392b;margin:0.2em 0">{notes}</ul>'
+    return f'<div style="font-size:0.9em">{text}</div>'
+
+
+def pa9_explorer(*, static: bool = True) -> Explorer:
+    """Explore the PA9 decoupling UIO against a Luenberger observer.
+
+    Three movable poles (real, or one complex pair and a real pole), the
+    disturbance type, amplitude, frequency or switching period, and the
+    measurement noise. See :func:`uio_teach.explorers.pa9_scenario`.
+
+    Parameters
+    ----------
+    static : bool
+        Include the static book's frames in the display.
+
+    Returns
+    -------
+    Explorer
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.pa9_explorer(static=False)
+    >>> ex.set(pattern=1)                    # one real pole and one complex pair
+    >>> sorted(n for n in ex.controls if n.startswith("pole"))
+    ['pole 1', 'pole 2 frequency', 'pole 2 real part']
+    """
+    return Explorer(pa9_scenario(), static=static)
+
+
+def case_study_explorer(*, static: bool = True) -> Explorer:
+    """Explore the discrete case study: one movable pole, or the LMI's radius bound.
+
+    The two fixed poles at 0.5 are the invariant zeros; in ``"LMI bound"``
+    mode the gain comes from the LMI, infeasible below radius 0.5. See
+    :func:`uio_teach.explorers.case_study_scenario`.
+
+    Parameters
+    ----------
+    static : bool
+        Include the static book's frames in the display.
+
+    Returns
+    -------
+    Explorer
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.case_study_explorer(static=False)
+    >>> ex.set(mode="lmi", decay=0.8)
+    >>> bool(abs(ex.frame.poles).max() <= 0.8 + 1e-6)
+    True
+    """
+    return Explorer(case_study_scenario(), static=static)
+
+
+def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Explorer:
+    """Explore the missile autopilot: the observer, its residual and the reconstructed inputs.
+
+    Two movable poles of the projection-operator observer (the other two
+    are fixed at the invariant zeros), the unknown inputs (by default the
+    paper's damped sinusoids), noise and the reconstruction filter's time
+    constant. See :func:`uio_teach.explorers.missile_scenario`.
+
+    Parameters
+    ----------
+    observer_family : {"pmo", "ginverse"}
+        The projection-operator observer, or the g-inverse observer (whose
+        poles are fixed: the main control is then the amplitude).
+    static : bool
+        Include the static book's frames in the display.
+
+    Returns
+    -------
+    Explorer
+
+    Raises
+    ------
+    ValueError
+        An unknown observer family.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.missile_explorer(static=False)
+    >>> ex.frame.input_estimate.estimates.shape
+    (2, 1001)
+    """
+    if observer_family not in ("pmo", "ginverse"):
+        raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
+    scenario = missile_scenario()
+    if observer_family == "ginverse":
+        import dataclasses
+
+        scenario = dataclasses.replace(
+            scenario,
+            family="ginverse",
+            static_control="amplitude",
+            static_values=(0.0, 5.0, 10.0, 20.0, 40.0),
+            _cache={},
+        )
+    return Explorer(scenario, static=static)
+
+
+def explorer(
+    plant: Plant,
+    observer_family: str = "uio",
+    *,
+    poles: Any = None,
+    timepts: Any = None,
+    initial_state: Any = None,
+    u: Any = None,
+    reconstruct: bool = False,
+    static: bool = True,
+) -> Explorer:
+    """Explore your own plant: an unknown input observer against a Luenberger observer.
+
+    Default poles, time window and control ranges come from
+    :func:`uio_teach.explorers.make_scenario`. If no unknown input observer
+    exists for the plant, the explorer says why (and still shows the
+    Luenberger observer).
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant.
+    observer_family : {"uio", "pmo", "ginverse"}
+        The observer design.
+    poles : array_like, optional
+        The movable poles to start from (one entry per complex pair).
+    timepts : array_like, optional
+        The simulation grid.
+    initial_state : array_like, optional
+        The plant's initial state.
+    u : callable, optional
+        The known input.
+    reconstruct : bool
+        Also reconstruct the unknown input (``E`` of full column rank).
+    static : bool
+        Include the static book's frames in the display.
+
+    Returns
+    -------
+    Explorer
+
+    Raises
+    ------
+    ValueError
+        ``plant`` is not a :class:`~uio_teach.Plant` or an unknown family.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.explorer(ut.examples.missile_autopilot(), "ginverse", static=False)
+    >>> [n for n in ex.controls if n.startswith("pole")]
+    []
+    >>> ex.frame.luenberger_poles.size
+    4
+    """
+    scenario = make_scenario(
+        plant,
+        observer_family,
+        poles=poles,
+        timepts=timepts,
+        initial_state=initial_state,
+        u=u,
+        reconstruct=reconstruct,
+        name=(plant.name or "plant").replace(" ", "-"),
+    )
+    return Explorer(scenario, static=static)

@@ -1,0 +1,311 @@
+"""The book as data: page titles, labels, equation and exercise numbers, the bibliography.
+
+:class:`BookIndex` reads what the book's pages define so that the lab
+notebooks can write cross-references out as text ("equation (3.2)", "(De et
+al., 2014)"). The table of contents is read with PyYAML, the bibliography with
+pybtex (both come with the book's toolchain and with the ``instructor`` extra).
+:func:`default_book_dir` finds the chapters in a source checkout or in the copy
+installed with the package.
+
+Examples
+--------
+>>> from uio_teach.instructor.book import BookIndex, default_book_dir
+>>> index = BookIndex.from_book(default_book_dir())
+>>> index.chapters["07_lab_pa9"] > index.chapters["02_toolbox"] > index.chapters["01_introduction"]
+True
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["BookIndex", "default_book_dir", "PACKAGED_COURSE"]
+
+PACKAGED_COURSE = Path(__file__).resolve().parents[1] / "_course"
+"""Where an installed wheel keeps ``book/*.md``, ``_toc.yml`` and ``references.bib``."""
+
+_DIRECTIVE = re.compile(r"^(?P<fence>`{3,}|:{3,})\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*?)\s*$")
+_OPTION = re.compile(r"^:(?P<key>[\w-]+):[ \t]*(?P<value>.*?)\s*$")
+_HEADING = re.compile(r"^(?P<hashes>#{1,6})[ \t]+(?P<text>.*?)\s*#*\s*$")
+_TARGET = re.compile(r"^\((?P<label>[^)\s]+)\)=\s*$")
+_LABELLED_MATH = re.compile(r"\$\$(?P<body>.+?)\$\$[ \t]*\((?P<label>[\w:.-]+)\)", re.DOTALL)
+
+
+def _fence_states(lines: Sequence[str]) -> list[bool]:
+    """For each line: True if it is a fence line or inside a code block (no Markdown there).
+
+    Directive fences (```` ```{exercise} ````) nest and their bodies are Markdown;
+    plain fences (```` ```python ````) and code directives hold code.
+    """
+    stack: list[tuple[str, bool]] = []
+    states = []
+    for line in lines:
+        m = re.match(r"^(`{3,}|~{3,}|:{3,})(.*)$", line.strip())
+        if m:
+            fence, rest = m.group(1), m.group(2).strip()
+            top = stack[-1][0] if stack else ""
+            if stack and not rest and fence[0] == top[0] and len(fence) >= len(top):
+                stack.pop()
+            else:
+                d = re.match(r"^\{([\w:.-]+)\}", rest)
+                code = d is None or d.group(1) in ("code-cell", "code", "code-block", "math")
+                stack.append((fence, code))
+            states.append(True)
+            continue
+        states.append(any(code for _, code in stack))
+    return states
+
+
+def _read_front_matter_free(text: str) -> str:
+    """The text without its YAML front matter."""
+    if text.startswith("---"):
+        end = text.find("\n---", 3)
+        if end >= 0:
+            return text[end + 4 :]
+    return text
+
+
+def _strip_braces(text: str) -> str:
+    return " ".join(text.replace("{", "").replace("}", "").split())
+
+
+def _parse_bib(text: str) -> dict[str, dict[str, str]]:
+    """BibTeX entries read by pybtex: ``{key: {field: value}}`` (braces removed from values).
+
+    The authors come back as one ``"Last, First and Last, First"`` string.
+    """
+    from pybtex.database import parse_string
+
+    entries: dict[str, dict[str, str]] = {}
+    for key, entry in parse_string(text, "bibtex").entries.items():
+        fields = {name.lower(): _strip_braces(value) for name, value in entry.fields.items()}
+        for role, persons in entry.persons.items():
+            fields[role.lower()] = " and ".join(_strip_braces(str(p)) for p in persons)
+        entries[key] = fields
+    return entries
+
+
+@dataclass
+class BookIndex:
+    """What the book's pages define, so that cross-references can be written out as text.
+
+    Attributes
+    ----------
+    titles : dict
+        Page stem -> page title (its first ``#`` heading).
+    chapters : dict
+        Page stem -> chapter number (numbered parts of ``_toc.yml``).
+    sections : dict
+        Section label -> (page stem, heading text).
+    equations : dict
+        Equation label -> (page stem, number within the page).
+    exercises : dict
+        Exercise label -> (page stem, number within the page).
+    bib : dict
+        Citation key -> BibTeX fields.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.book import BookIndex, default_book_dir
+    >>> index = BookIndex.from_book(default_book_dir())
+    >>> index.chapters["01_introduction"], "08_api" in index.chapters   # numbered parts only
+    (1, False)
+    >>> index.cite("p", "de2014comparison")
+    '(De et al., 2014)'
+    """
+
+    titles: dict[str, str] = field(default_factory=dict)
+    chapters: dict[str, int] = field(default_factory=dict)
+    sections: dict[str, tuple[str, str]] = field(default_factory=dict)
+    equations: dict[str, tuple[str, int]] = field(default_factory=dict)
+    exercises: dict[str, tuple[str, int]] = field(default_factory=dict)
+    bib: dict[str, dict[str, str]] = field(default_factory=dict)
+
+    @classmethod
+    def from_book(cls, book_dir: str | os.PathLike[str] | None) -> BookIndex:
+        """Scan ``book_dir/*.md``, ``_toc.yml`` and ``references.bib`` (in its parent).
+
+        Parameters
+        ----------
+        book_dir : str or path-like, optional
+            The folder of the chapters; ``None`` gives an empty index.
+
+        Returns
+        -------
+        BookIndex
+
+        Examples
+        --------
+        >>> from uio_teach.instructor.book import BookIndex
+        >>> BookIndex.from_book(None).titles
+        {}
+        """
+        index = cls()
+        if book_dir is None or not Path(book_dir).is_dir():
+            return index
+        book = Path(book_dir)
+        for page in sorted(book.glob("*.md")):
+            index._scan_page(page.stem, page.read_text(encoding="utf-8"))
+        root = book.parent
+        index._read_toc(root / "_toc.yml", root)
+        bib = root / "references.bib"
+        if bib.is_file():
+            index.bib = _parse_bib(bib.read_text(encoding="utf-8"))
+        return index
+
+    def _scan_page(self, stem: str, text: str) -> None:
+        text = _read_front_matter_free(text)
+        lines = text.splitlines()
+        pending: list[str] = []
+        exercise_count = 0
+        verbatim = _fence_states(lines)
+        for i, line in enumerate(lines):
+            stripped = line.strip()
+            d = _DIRECTIVE.match(stripped)
+            if d and d.group("name") == "exercise":
+                exercise_count += 1
+                for opt in lines[i + 1 : i + 8]:
+                    o = _OPTION.match(opt.strip())
+                    if not o:
+                        break
+                    if o.group("key") == "label":
+                        self.exercises[o.group("value")] = (stem, exercise_count)
+            if verbatim[i]:
+                continue
+            target = _TARGET.match(stripped)
+            if target:
+                pending.append(target.group("label"))
+                continue
+            heading = _HEADING.match(line)
+            if heading:
+                title = heading.group("text")
+                if len(heading.group("hashes")) == 1 and stem not in self.titles:
+                    self.titles[stem] = title
+                for label in pending:
+                    self.sections[label] = (stem, title)
+            if stripped:
+                pending = []
+        body = "\n".join(lines)
+        found = [(m.start(), m.group("label")) for m in _LABELLED_MATH.finditer(body)]
+        for m in re.finditer(r"^(`{3,}|:{3,})\{math\}.*\n((?::[\w-]+:.*\n)*)", body, re.M):
+            label = re.search(r"^:label:\s*(\S+)", m.group(2), re.M)
+            if label:
+                found.append((m.start(), label.group(1)))
+        for number, (_, label) in enumerate(sorted(found), start=1):
+            self.equations[label] = (stem, number)
+
+    def _read_toc(self, toc: Path, root: Path) -> None:
+        if not toc.is_file():
+            return
+        try:
+            import yaml
+
+            data = yaml.safe_load(toc.read_text(encoding="utf-8")) or {}
+        except Exception:  # a broken toc only costs the chapter numbers
+            return
+        number = 0
+        parts = data.get("parts") or [{"chapters": data.get("chapters") or []}]
+        for part in parts:
+            if not isinstance(part, dict) or not part.get("numbered"):
+                continue
+            for chapter in part.get("chapters") or []:
+                if isinstance(chapter, dict) and "file" in chapter:
+                    number += 1
+                    self.chapters[Path(str(chapter["file"])).stem] = number
+
+    # references as text -------------------------------------------------------------------------
+    def number(self, stem: str, k: int) -> str:
+        """``"7.2"`` for item 2 of chapter 7, ``"2"`` on an unnumbered page.
+
+        Parameters
+        ----------
+        stem : str
+            Page stem.
+        k : int
+            Number within the page.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> from uio_teach.instructor.book import BookIndex
+        >>> BookIndex(chapters={"07_lab": 7}).number("07_lab", 2)
+        '7.2'
+        """
+        chapter = self.chapters.get(stem)
+        return f"{chapter}.{k}" if chapter else str(k)
+
+    def page(self, stem: str, here: str) -> str:
+        """A page as text: ``chapter 3, *Title*`` (just ``*Title*`` if unnumbered)."""
+        title = self.titles.get(stem, stem)
+        if stem == here:
+            return "this chapter"
+        chapter = self.chapters.get(stem)
+        return f"chapter {chapter}, *{title}*" if chapter else f"*{title}*"
+
+    def cite(self, kind: str, keys: str) -> str:
+        """A citation as text: ``kind`` ``"p"`` gives (Author, year), ``"t"`` Author (year).
+
+        Parameters
+        ----------
+        kind : str
+            ``"p"`` (parenthetical) or ``"t"`` (textual).
+        keys : str
+            Comma-separated BibTeX keys.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> from uio_teach.instructor.book import BookIndex
+        >>> index = BookIndex(bib={"k": {"author": "Hui, S. and Zak, S. H.", "year": "2005"}})
+        >>> index.cite("t", "k"), index.cite("p", "k")
+        ('Hui and Zak (2005)', '(Hui and Zak, 2005)')
+        """
+        parts = []
+        for key in (k.strip() for k in keys.split(",")):
+            entry = self.bib.get(key)
+            if entry is None:
+                parts.append((f"[{key}]", ""))
+                continue
+            who = entry.get("key") or entry.get("title", key)
+            if entry.get("author"):
+                names = [n.strip() for n in entry["author"].split(" and ")]
+                last = [n.split(",")[0] if "," in n else n.split()[-1] for n in names]
+                who = " and ".join(last) if len(last) <= 2 else f"{last[0]} et al."
+            parts.append((who, entry.get("year", "")))
+        if kind.startswith("t"):
+            return "; ".join(f"{w} ({y})" if y else w for w, y in parts)
+        return "(" + "; ".join(f"{w}, {y}" if y else w for w, y in parts) + ")"
+
+
+def default_book_dir() -> Path:
+    """The book's chapters: ``book/`` of a checkout, else the copy installed with the package.
+
+    A wheel carries the chapters, ``_toc.yml`` and ``references.bib`` in
+    ``uio_teach/_course/`` (``PACKAGED_COURSE``), so the labs can be
+    written from any folder; ``./book`` is the last resort.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.book import default_book_dir
+    >>> default_book_dir().name
+    'book'
+    """
+    checkout = Path(__file__).resolve().parents[2]
+    for root in (checkout, PACKAGED_COURSE):
+        if (root / "book").is_dir() and (root / "_toc.yml").is_file():
+            return root / "book"
+    return Path.cwd() / "book"

@@ -1,0 +1,368 @@
+"""The instructor's command line: ``uio-teach figures`` and ``uio-teach labs``.
+
+Run it as ``python -m uio_teach ...`` or, once the package is installed, as
+``uio-teach ...``. :func:`main` takes the arguments as a list and returns the
+exit status, so it can also be called from Python (and from tests):
+
+* 0: everything was written;
+* 1: something could not be made or written (one line on stderr says what);
+* 2: a usage or configuration error (one line on stderr names the option or
+  key).
+
+Examples
+--------
+>>> from uio_teach.instructor.cli import main
+>>> main(["figures", "--list"])  # doctest: +ELLIPSIS
+pa9_sine ...
+0
+>>> main(["figures", "--only", "pa9_sin", "--out", "unused"])  # doctest: +ELLIPSIS
+2
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from collections.abc import Sequence
+from typing import TextIO
+
+__all__ = ["main", "build_parser"]
+
+PROG = "uio-teach"
+
+_MAIN_DESCRIPTION = """\
+Instructor tools of the course "Unknown Input Observers".
+
+Two commands:
+  figures   regenerate every figure of the course (and Table II of the missile paper)
+  labs      write the lab notebooks, a student version and a solution version
+
+Run `uio-teach COMMAND --help` for the options of each command.
+"""
+
+_MAIN_EPILOG = """\
+examples:
+  uio-teach figures --out handout/figures
+  uio-teach figures --out handout/figures --config term.toml --format pdf
+  uio-teach labs --out handout/labs
+
+exit status:
+  0 everything was written, 1 something could not be made or written,
+  2 a usage or configuration error.
+"""
+
+_FIGURES_DESCRIPTION = """\
+Regenerate the figures of the course into one folder:
+
+  * Practical Assignment 9: the error and the residual of the decoupling
+    observer under a sinusoidal and under a piecewise-constant disturbance,
+    the states with their estimates, and the contrast with a Luenberger
+    observer that has the same poles;
+  * the discrete-time case study: states, estimates, error and residual with
+    both unknown signals active, and the error norm on a log scale;
+  * the missile autopilot: the estimates of the projection-operator observer
+    (PMO) and of the g-inverse observer, their errors, the reconstructed
+    unknown inputs v1 and v2, and Table II (catch times within 2 % of the
+    signal's peak, next to the paper's) as missile_table2.csv and .md.
+
+The files are named after the figures (`--list`), e.g. DIR/pa9_sine.png.
+The same command gives byte-identical files: the noise is seeded and no time
+stamp is written into PNG, PDF or SVG files.
+
+The parameters that change from one term to the next (disturbances, observer
+poles, noise level, seed, matplotlib style) are read from a TOML file given
+with --config; every key is optional. `--print-config` prints all the keys
+with their defaults and a comment each: save it as a starting point.
+"""
+
+_FIGURES_EPILOG = """\
+examples:
+  uio-teach figures --list
+  uio-teach figures --out figures
+  uio-teach figures --out figures --only pa9_sine pa9_piecewise --format svg
+  uio-teach figures --print-config > term.toml     # edit, then:
+  uio-teach figures --out figures --config term.toml --dpi 200
+
+a configuration file (term.toml):
+  seed = 7
+  [pa9]
+  poles = [-2.0, -3.0, -4.0]        # complex poles as strings: "-1+1j", "-1-1j"
+  [pa9.sine]
+  amplitude = 0.5
+  frequency = 3.0                   # rad/s
+  [pa9.piecewise]
+  times = [0.0, 3.0, 6.0]
+  values = [1.0, -2.0, 0.5]
+
+exit status:
+  0 all figures written, 1 a figure or the output folder failed,
+  2 a usage or configuration error (unknown key, wrong type, wrong pole count,
+  unstable pole).
+"""
+
+_LABS_DESCRIPTION = """\
+Write every lab of the book (book/*lab*.md, MyST notebooks) as two Jupyter
+notebooks, with empty outputs:
+
+  DIR/student/<lab>.ipynb   each solution replaced by a cell starting with
+                            `# TODO: Exercise <number> (<label>)`; check cells
+                            kept, the instructor notes left out
+  DIR/solution/<lab>.ipynb  complete, for marking: solution cells tagged
+                            `solution`, check cells tagged `check`
+
+In the student version a TODO cell sets the names that the later check cells
+use to None, so the notebook runs from top to bottom and each check says what
+is still missing.
+"""
+
+_LABS_EPILOG = """\
+examples:
+  uio-teach labs --out handout/labs
+  uio-teach labs --out handout/labs --source book/07_lab_pa9.md
+
+exit status:
+  0 all notebooks written, 1 a lab could not be read or written, 2 a usage
+  error.
+"""
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    def __init__(self, prog: str) -> None:
+        super().__init__(prog, max_help_position=30, width=88)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``uio-teach`` (with the ``figures`` and ``labs`` commands).
+
+    Returns
+    -------
+    argparse.ArgumentParser
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.cli import build_parser
+    >>> args = build_parser().parse_args(["figures", "--out", "figs", "--format", "svg"])
+    >>> args.command, args.out, args.format, args.dpi
+    ('figures', 'figs', 'svg', 150)
+    """
+    from .. import __version__
+    from .output import FORMATS
+
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description=_MAIN_DESCRIPTION,
+        epilog=_MAIN_EPILOG,
+        formatter_class=_Formatter,
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    fig = commands.add_parser(
+        "figures",
+        help="regenerate every figure of the course",
+        description=_FIGURES_DESCRIPTION,
+        epilog=_FIGURES_EPILOG,
+        formatter_class=_Formatter,
+    )
+    fig.add_argument("--out", metavar="DIR", help="output folder (created if needed)")
+    fig.add_argument(
+        "--format",
+        choices=FORMATS,
+        default="png",
+        help="image format (default: png); tables are always .csv and .md",
+    )
+    fig.add_argument(
+        "--only",
+        nargs="+",
+        action="extend",
+        metavar="NAME",
+        help="make only these figures (names from --list)",
+    )
+    fig.add_argument(
+        "--dpi", type=_positive_int, default=150, metavar="N", help="resolution (default: 150)"
+    )
+    fig.add_argument(
+        "--config", metavar="FILE", help="TOML file with this term's parameters (see below)"
+    )
+    fig.add_argument(
+        "--list", action="store_true", help="name every figure with a one-line description"
+    )
+    fig.add_argument(
+        "--print-config",
+        action="store_true",
+        help="print the default configuration (every key, commented) and exit",
+    )
+    fig.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+
+    labs = commands.add_parser(
+        "labs",
+        help="write the lab notebooks (student and solution versions)",
+        description=_LABS_DESCRIPTION,
+        epilog=_LABS_EPILOG,
+        formatter_class=_Formatter,
+    )
+    labs.add_argument("--out", metavar="DIR", required=True, help="output folder")
+    labs.add_argument(
+        "--book",
+        metavar="DIR",
+        help="the book's chapters (default: book/ of a checkout, else the installed copy)",
+    )
+    labs.add_argument(
+        "--source",
+        nargs="+",
+        action="extend",
+        metavar="FILE",
+        help="convert these lab chapters only (default: every *lab*.md of the book)",
+    )
+    labs.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    return parser
+
+
+def _error(command: str, message: str, stream: TextIO | None = None) -> None:
+    text = " ".join(str(message).split())
+    print(f"{PROG} {command}: error: {text}", file=stream or sys.stderr)
+
+
+def _figures(args: argparse.Namespace) -> int:
+    from . import figures
+
+    if args.list:
+        width = max(len(name) for name in figures.FIGURES)
+        for name, spec in figures.FIGURES.items():
+            print(f"{name:<{width}}  {spec.description}")
+        return 0
+    if args.print_config:
+        sys.stdout.write(figures.default_config_toml())
+        return 0
+    if not args.out:
+        _error("figures", "--out DIR is required (or use --list or --print-config)")
+        return 2
+    for name in args.only or []:
+        if name not in figures.FIGURES:
+            _error("figures", figures.unknown_figure_message(name))
+            return 2
+    try:
+        config = figures.load_config(args.config)
+    except figures.ConfigError as err:
+        _error("figures", str(err))
+        return 2
+    try:
+        out = figures.prepare_output_dir(args.out)
+    except OSError as err:
+        _error("figures", str(err))
+        return 1
+
+    import matplotlib
+
+    matplotlib.use("Agg")  # no display needed, and the same pixels everywhere
+
+    start = time.perf_counter()
+
+    def progress(index: int, total: int, result: figures.FigureResult) -> None:
+        if not result.ok:
+            _error("figures", f"{result.name} failed: {result.error}")
+        elif not args.quiet:
+            files = ", ".join(os.fspath(p) for p in result.paths)
+            count = f"[{index:>{len(str(total))}}/{total}]"
+            print(f"{count} {result.name}: {files} ({result.seconds:.1f} s)")
+            sys.stdout.flush()
+
+    results = figures.generate(
+        out, args.only, fmt=args.format, dpi=args.dpi, config=config, progress=progress
+    )
+    elapsed = time.perf_counter() - start
+    failed = [r.name for r in results if not r.ok]
+    files = sum(len(r.paths) for r in results)
+    done = len(results) - len(failed)
+    summary = f"{done} of {len(results)} figures ({files} files) written to {os.fspath(out)}"
+    summary += f" in {elapsed:.1f} s"
+    if failed:
+        _error("figures", f"{summary}; failed: {', '.join(failed)}")
+        return 1
+    if not args.quiet:
+        print(summary)
+    return 0
+
+
+def _labs(args: argparse.Namespace) -> int:
+    from . import labs
+
+    start = time.perf_counter()
+
+    def progress(index: int, total: int, result: labs.LabResult) -> None:
+        if not args.quiet:
+            print(
+                f"[{index}/{total}] {result.source.name}: {os.fspath(result.student)} "
+                f"({result.todo_cells} TODO cells), {os.fspath(result.solution)}"
+            )
+
+    try:
+        results = labs.write_labs(args.out, args.source, book_dir=args.book, progress=progress)
+    except ImportError as err:
+        missing = err.name or str(err)
+        _error(
+            "labs",
+            f"the lab notebooks need {missing}, which is not installed: "
+            "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)",
+        )
+        return 1
+    except (labs.LabError, OSError) as err:
+        _error("labs", str(err))
+        return 1
+    if not args.quiet:
+        elapsed = time.perf_counter() - start
+        n = len(results)
+        plural = "s" if n != 1 else ""
+        print(
+            f"{n} lab{plural} written to {os.fspath(args.out)}: {n} student and {n} solution "
+            f"notebook{plural} in {elapsed:.1f} s"
+        )
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``uio-teach`` with the arguments ``argv`` (default: the command line).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments after the program name; ``sys.argv[1:]`` by default.
+
+    Returns
+    -------
+    int
+        The exit status: 0 success, 1 failure, 2 usage or configuration error.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from uio_teach.instructor.cli import main
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     main(["figures", "--out", tmp, "--only", "case_error", "--dpi", "40", "-q"])
+    0
+    """
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # --help, --version and usage errors
+        code = exit_.code
+        return code if isinstance(code, int) else (0 if code is None else 2)
+    try:
+        if args.command == "figures":
+            return _figures(args)
+        return _labs(args)
+    except KeyboardInterrupt:
+        _error(args.command, "interrupted")
+        return 130

@@ -1,0 +1,489 @@
+"""The figures' configuration: a schema of the keys an instructor may change, read from TOML.
+
+The parameters that change from one term to the next (disturbance amplitude and
+frequency, switching times and levels, observer poles, noise level, seed,
+matplotlib style) live in a TOML file read by :func:`load_config` into a
+validated, read-only :class:`FigureConfig`; :func:`default_config_toml` prints
+the defaults, with a comment per key. The defaults of the worked experiments
+come from :mod:`uio_teach.experiments`.
+
+Examples
+--------
+>>> from uio_teach.instructor.config import FigureConfig
+>>> FigureConfig()["pa9.poles"]
+((-1+0j), (-2+0j), (-3+0j))
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import tomllib
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from .._display import format_poles
+from ..experiments import CASE_STUDY, MISSILE, PA9
+
+__all__ = ["ConfigError", "FigureConfig", "load_config", "default_config_toml"]
+
+
+class ConfigError(ValueError):
+    """A configuration file that cannot be used; the message is one line and names the key."""
+
+
+@dataclass(frozen=True)
+class _Option:
+    kind: str  # "int", "float", "floats", "poles", "str"
+    default: Any
+    help: str
+    minimum: float | None = None  # inclusive lower bound (numbers)
+    positive: bool = False  # strictly positive (numbers)
+    length: int | None = None  # exact length (lists)
+    optional: bool = False  # may be absent (default None)
+
+
+_SCHEMA: dict[str, _Option] = {
+    "seed": _Option(
+        "int",
+        CASE_STUDY.seed,
+        "seed of every random number: PA9's measurement noise, the case study's v",
+    ),
+    "style": _Option(
+        "str",
+        "default",
+        "matplotlib style: a name of matplotlib.style.available or a .mplstyle file",
+    ),
+    "pa9.poles": _Option("poles", list(PA9.poles), "UIO poles (also the Luenberger poles)"),
+    "pa9.duration": _Option("float", PA9.duration, "simulated time in s", positive=True),
+    "pa9.samples": _Option("int", PA9.timepts.size, "number of time points", minimum=2),
+    "pa9.initial_state": _Option(
+        "floats", PA9.initial_state.tolist(), "plant state x(0)", length=3
+    ),
+    "pa9.noise": _Option(
+        "float", 0.0, "standard deviation of the measurement noise (0: none)", minimum=0.0
+    ),
+    "pa9.sine.amplitude": _Option("float", PA9.sine_amplitude, "d(t) = amplitude sin(frequency t)"),
+    "pa9.sine.frequency": _Option(
+        "float", PA9.sine_frequency, "angular frequency in rad/s", positive=True
+    ),
+    "pa9.piecewise.times": _Option(
+        "floats", list(PA9.switch_times), "switching times in s, increasing", minimum=0.0
+    ),
+    "pa9.piecewise.values": _Option(
+        "floats", list(PA9.switch_values), "the level held from each switching time"
+    ),
+    "case_study.poles": _Option(
+        "poles",
+        None,
+        "the one movable pole, e.g. [0.2]; absent: the LMI gain of the case study",
+        optional=True,
+    ),
+    "case_study.steps": _Option(
+        "int", int(CASE_STUDY.duration), "number of steps k = 0 ... steps", minimum=2
+    ),
+    "case_study.initial_state": _Option(
+        "floats", CASE_STUDY.initial_state.tolist(), "plant state x[0]", length=3
+    ),
+    "case_study.u2.amplitude": _Option(
+        "float", CASE_STUDY.u2_amplitude, "u2[k] = amplitude sin(frequency k)"
+    ),
+    "case_study.u2.frequency": _Option(
+        "float", CASE_STUDY.u2_frequency, "angular frequency in rad per step", positive=True
+    ),
+    "case_study.v.amplitude": _Option(
+        "float",
+        CASE_STUDY.v_amplitude,
+        "v: a random staircase, levels uniform in [-amplitude, amplitude]",
+        minimum=0,
+    ),
+    "case_study.v.hold": _Option(
+        "int", CASE_STUDY.v_hold, "steps each level of v is held", minimum=1
+    ),
+    "missile.pmo_poles": _Option(
+        "poles", list(MISSILE.poles), "PMO poles (the paper's are not given; see chapter 5)"
+    ),
+    "missile.duration": _Option("float", 0.3, "simulated time in s", positive=True),
+    "missile.samples": _Option("int", 6001, "number of time points", minimum=2),
+}
+
+_DISCRETE_POLES = {"case_study.poles"}
+_SECTION_HELP = {
+    "pa9": "Practical Assignment 9: the decoupling observer and its lab",
+    "pa9.sine": "the sinusoidal disturbance",
+    "pa9.piecewise": "the piecewise-constant disturbance (0 before the first switching time)",
+    "case_study": "the discrete-time case study (projection-operator observer)",
+    "case_study.u2": "the unknown state input",
+    "case_study.v": "the measurement disturbance",
+    "missile": "the missile autopilot of De, Banerjee and Das (2014)",
+}
+
+
+def _flatten(table: Mapping[str, Any], prefix: str = "") -> Iterable[tuple[str, Any]]:
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            if name in _SECTION_HELP:
+                yield from _flatten(value, name + ".")
+            else:
+                yield name, value
+        else:
+            yield name, value
+
+
+def _describe(value: Any) -> str:
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    return f"{type(value).__name__} {value!r}"
+
+
+def _number(key: str, value: Any, what: str = "a number") -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(f"{key}: expected {what}, got {_describe(value)}")
+    if not math.isfinite(value):
+        raise ConfigError(f"{key}: expected a finite number, got {value}")
+    return float(value)
+
+
+def _bounds(key: str, opt: _Option, x: float) -> None:
+    if opt.positive and x <= 0:
+        raise ConfigError(f"{key}: must be > 0, got {x:g}")
+    if opt.minimum is not None and x < opt.minimum:
+        raise ConfigError(f"{key}: must be >= {opt.minimum:g}, got {x:g}")
+
+
+def _pole(key: str, value: Any) -> complex:
+    if isinstance(value, str):
+        try:
+            z = complex(value.replace(" ", "").replace("i", "j"))
+        except ValueError:
+            raise ConfigError(
+                f"{key}: cannot read the pole {value!r}; write a number, or a string such as "
+                "'-1+2j' for a complex pole"
+            ) from None
+        if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+            raise ConfigError(f"{key}: poles must be finite, got {value!r}")
+        return z
+    return complex(_number(key, value, "a number or a string such as '-1+2j'"))
+
+
+def _check_value(key: str, opt: _Option, value: Any) -> Any:
+    if opt.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{key}: expected an integer, got {_describe(value)}")
+        _bounds(key, opt, value)
+        return int(value)
+    if opt.kind == "float":
+        x = _number(key, value)
+        _bounds(key, opt, x)
+        return x
+    if opt.kind == "str":
+        if not isinstance(value, str):
+            raise ConfigError(f"{key}: expected a string, got {_describe(value)}")
+        return value
+    if not isinstance(value, list):
+        raise ConfigError(f"{key}: expected a list, e.g. {opt.default!r}, got {_describe(value)}")
+    if not value:
+        raise ConfigError(f"{key}: the list is empty")
+    if opt.kind == "floats":
+        xs = [_number(f"{key}[{i}]", v) for i, v in enumerate(value)]
+        for x in xs:
+            _bounds(key, opt, x)
+        if opt.length is not None and len(xs) != opt.length:
+            raise ConfigError(f"{key}: expected {opt.length} numbers, got {len(xs)}")
+        return tuple(xs)
+    # poles
+    poles = tuple(_pole(f"{key}[{i}]", v) for i, v in enumerate(value))
+    discrete = key in _DISCRETE_POLES
+    for z in poles:
+        if discrete and not abs(z) < 1:
+            raise ConfigError(
+                f"{key}: the pole {format_poles([z], 6)} is unstable: a discrete-time observer "
+                "needs |pole| < 1"
+            )
+        if not discrete and not z.real < 0:
+            raise ConfigError(
+                f"{key}: the pole {format_poles([z], 6)} is unstable: a continuous-time "
+                "observer needs a negative real part"
+            )
+    return poles
+
+
+class FigureConfig(Mapping[str, Any]):
+    """The validated parameters of the figures: a read-only mapping from dotted keys to values.
+
+    Build it with :func:`load_config` (from a TOML file) or
+    :meth:`from_dict` (from a nested dict, as TOML would give); keys that are
+    not given keep their defaults. Numbers are floats, lists are tuples,
+    poles are complex.
+
+    Parameters
+    ----------
+    values : mapping, optional
+        Dotted keys (``"pa9.sine.amplitude"``) to already validated values;
+        the defaults fill the rest. Use :meth:`from_dict` for unvalidated data.
+    source : str
+        Where the values came from (used in error messages).
+
+    Attributes
+    ----------
+    source : str
+        Where the values came from.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import FigureConfig
+    >>> cfg = FigureConfig.from_dict({"pa9": {"sine": {"amplitude": 3}}})
+    >>> cfg["pa9.sine.amplitude"], cfg["pa9.sine.frequency"]
+    (3.0, 2.0)
+    >>> [p.real for p in cfg["pa9.poles"]]
+    [-1.0, -2.0, -3.0]
+    """
+
+    def __init__(self, values: Mapping[str, Any] | None = None, source: str = "defaults") -> None:
+        merged = {}
+        for key, opt in _SCHEMA.items():
+            merged[key] = _check_value(key, opt, opt.default) if opt.default is not None else None
+        merged.update(values or {})
+        self._values = MappingProxyType(merged)
+        self.source = source
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> FigureConfig:
+        """Validate a nested dict (the parsed TOML) and fill in the defaults.
+
+        Parameters
+        ----------
+        data : mapping
+            Tables and keys as in the TOML file, e.g.
+            ``{"pa9": {"poles": [-2, -3, -4]}}``.
+        source : str
+            Name of the origin, put in front of error messages.
+
+        Returns
+        -------
+        FigureConfig
+
+        Raises
+        ------
+        ConfigError
+            An unknown key, a value of the wrong type, a bad length, an
+            unstable pole, or poles an observer cannot have (wrong count,
+            missing conjugate, ...). The message is one line.
+
+        Examples
+        --------
+        >>> from uio_teach.instructor.config import FigureConfig, ConfigError
+        >>> try:
+        ...     FigureConfig.from_dict({"pa9": {"poles": [1, -2, -3]}}, source="term.toml")
+        ... except ConfigError as err:
+        ...     print(str(err).split(": a ")[0])
+        term.toml: pa9.poles: the pole 1 is unstable
+        """
+        try:
+            values = {}
+            for key, value in _flatten(data):
+                if key in _SECTION_HELP:
+                    raise ConfigError(f"{key}: expected a table [{key}], got {_describe(value)}")
+                if key not in _SCHEMA:
+                    raise ConfigError(_unknown_key(key, isinstance(value, dict)))
+                values[key] = _check_value(key, _SCHEMA[key], value)
+            cfg = cls(values, source)
+            cfg._check_relations()
+            cfg._check_designs()
+        except ConfigError as err:
+            raise ConfigError(f"{source}: {err}") from None
+        return cfg
+
+    def _check_relations(self) -> None:
+        times, values = self["pa9.piecewise.times"], self["pa9.piecewise.values"]
+        if len(times) != len(values):
+            raise ConfigError(
+                f"pa9.piecewise: times and values must have the same length, got {len(times)} "
+                f"and {len(values)}"
+            )
+        if any(b <= a for a, b in zip(times, times[1:], strict=False)):
+            raise ConfigError(f"pa9.piecewise.times: must be strictly increasing, got {times}")
+        style = self["style"]
+        import matplotlib.style
+
+        if style not in matplotlib.style.available and style != "default":
+            path = Path(style)
+            if not (path.suffix == ".mplstyle" and path.is_file()):
+                close = difflib.get_close_matches(style, matplotlib.style.available, 1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise ConfigError(
+                    f"style: {style!r} is neither a matplotlib style nor a .mplstyle file{hint}"
+                )
+
+    def _check_designs(self) -> None:
+        """Design every observer once, so that bad poles are reported before any work."""
+        for key in ("pa9.poles", "case_study.poles", "missile.pmo_poles"):
+            try:
+                _design(self, key)
+            except ConfigError as err:
+                raise ConfigError(f"{key}: {err}") from None
+            except ValueError as err:
+                text = " ".join(str(err).split())
+                text = text.removeprefix("poles: ")
+                raise ConfigError(f"{key}: {text}") from None
+
+    def __getitem__(self, key: str) -> Any:
+        return self._values[key]
+
+    def __iter__(self):
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __repr__(self) -> str:
+        changed = {k: v for k, v in self.items() if v != FigureConfig._defaults().get(k)}
+        return f"FigureConfig(source={self.source!r}, changed={changed})"
+
+    @staticmethod
+    def _defaults() -> dict[str, Any]:
+        return {
+            k: (None if o.default is None else _check_value(k, o, o.default))
+            for k, o in _SCHEMA.items()
+        }
+
+
+def _unknown_key(key: str, table: bool = False) -> str:
+    see = "`uio-teach figures --print-config` lists every key"
+    if table:
+        close = difflib.get_close_matches(key, list(_SECTION_HELP), 1, 0.5)
+        hint = f" (did you mean [{close[0]}]?)" if close else ""
+        return f"unknown table [{key}]{hint}; {see}"
+    close = difflib.get_close_matches(key, list(_SCHEMA) + list(_SECTION_HELP), 1, 0.6)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    return f"unknown key {key!r}{hint}; {see}"
+
+
+def load_config(path: str | os.PathLike[str] | None = None) -> FigureConfig:
+    """Read and validate a TOML configuration file (``None``: the defaults).
+
+    Parameters
+    ----------
+    path : str or path-like, optional
+        The TOML file. Every key is optional; see :func:`default_config_toml`.
+
+    Returns
+    -------
+    FigureConfig
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, is not valid TOML, or has a bad value (the
+        message is one line, starting with the file name).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.config import load_config
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = pathlib.Path(tmp) / "term.toml"
+    ...     _ = path.write_text("[pa9.sine]\\namplitude = 0.5\\n")
+    ...     load_config(path)["pa9.sine.amplitude"]
+    0.5
+    """
+    if path is None:
+        return FigureConfig()
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"{name}: no such file") from None
+    except OSError as err:
+        raise ConfigError(f"{name}: cannot read it ({err.strerror or err})") from None
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{name}: not valid TOML: {' '.join(str(err).split())}") from None
+    return FigureConfig.from_dict(data, source=name)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def default_config_toml() -> str:
+    """The default configuration as a commented TOML file, a starting point for a new term.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import tomllib
+    >>> from uio_teach.instructor.config import FigureConfig, default_config_toml
+    >>> text = default_config_toml()
+    >>> print(text.splitlines()[0])
+    # Configuration of `uio-teach figures`. Every key is optional: delete what you do not change.
+    >>> FigureConfig.from_dict(tomllib.loads(text)) == FigureConfig()
+    True
+    """
+    lines = [
+        "# Configuration of `uio-teach figures`. Every key is optional: delete what you do not "
+        "change.",
+        '# Complex poles are strings, e.g. poles = ["-1+1j", "-1-1j", -2].',
+        "",
+    ]
+    section = ""
+    for key, opt in _SCHEMA.items():
+        table, _, name = key.rpartition(".")
+        if table != section:
+            section = table
+            lines += ["", f"[{table}]  # {_SECTION_HELP[table]}"]
+        if opt.default is None:
+            lines.append(f"# {name} = [0.2]  # {opt.help}")
+        else:
+            lines.append(f"{name} = {_toml_value(opt.default)}  # {opt.help}")
+    return "\n".join(lines) + "\n"
+
+
+def _design(cfg: Mapping[str, Any], key: str):
+    """The observer that ``key`` configures (validated poles in, observer out)."""
+    import uio_teach as ut
+
+    poles = cfg[key]
+    if key == "pa9.poles":
+        plant = ut.examples.pa9()
+        _expect_count(key, poles, ut.check_existence(plant).movable)
+        return ut.design_uio(plant, poles=list(poles))
+    if key == "case_study.poles":
+        plant = ut.examples.dt_case_study()
+        if poles is None:
+            return ut.design_pmo(plant, method="lmi")
+        _expect_count(key, poles, ut.check_existence(plant).movable)
+        return ut.design_pmo(plant, poles=list(poles))
+    if key == "missile.pmo_poles":
+        plant = ut.examples.missile_autopilot()
+        _expect_count(key, poles, ut.check_existence(plant).movable)
+        return ut.design_pmo(plant, poles=list(poles))
+    raise KeyError(key)  # pragma: no cover
+
+
+def _expect_count(key: str, poles: Sequence[complex], movable: int) -> None:
+    if len(poles) != movable:
+        raise ConfigError(
+            f"expected {movable} pole{'s' if movable != 1 else ''} (the movable poles of this "
+            f"observer), got {len(poles)}"
+        )
