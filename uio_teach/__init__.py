@@ -31,7 +31,7 @@ from .detection import (
 )
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
-from .lmi import LMIInfeasibleError, LMIResult, lmi_gain
+from .lmi import LMIError, LMIInfeasibleError, LMIResult, LMISolverError, lmi_gain
 from .observers import (
     PMO,
     UIO,
@@ -47,7 +47,8 @@ from .observers import (
 )
 from .plant import Plant
 from .reconstruction import InputEstimate, catch_time, reconstruct_input
-from .simulation import SimulationInputs, UIOResponse, simulate
+from .simulation import SimulationInputs, SimulationOverflowError, UIOResponse, simulate
+from .verify import PlacementAccuracyError, PlacementAccuracyWarning
 
 __version__ = "0.1.0"
 
@@ -93,6 +94,11 @@ __all__ = [
     "lmi_gain",
     "LMIResult",
     "LMIInfeasibleError",
+    "LMIError",
+    "LMISolverError",
+    "PlacementAccuracyError",
+    "PlacementAccuracyWarning",
+    "SimulationOverflowError",
     "design_uio",
     "design_pmo",
     "design_ginverse",
