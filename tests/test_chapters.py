@@ -153,8 +153,8 @@ def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path) -> None:
     )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    chapter = BOOK / "04_case_study.md"
-    target = tmp_path / "04_case_study.ipynb"
+    chapter = BOOK / "case_study.md"
+    target = tmp_path / "case_study.ipynb"
     module.write_notebook(chapter, target)
     notebook = nbformat.read(target, as_version=4)
     nbformat.validate(notebook)

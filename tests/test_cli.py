@@ -378,9 +378,9 @@ def test_generate_rejects_bad_arguments(tmp_path):
 
 
 def test_the_sample_configurations_in_the_docs_are_valid(tmp_path):
-    page = (Path(__file__).parents[1] / "book" / "09_instructors.md").read_text()
+    page = (Path(__file__).parents[1] / "book" / "instructors.md").read_text()
     sample = re.search(r"```toml\n(.*?)```", page, re.DOTALL).group(1)
-    cfg = figures.FigureConfig.from_dict(tomllib.loads(sample), source="09_instructors.md")
+    cfg = figures.FigureConfig.from_dict(tomllib.loads(sample), source="instructors.md")
     assert cfg["pa9.poles"] == (complex(-1, 1), complex(-1, -1), -3)
     assert cfg["missile.pmo_poles"] == (-100, -150)
     help_text = cli.build_parser()._subparsers._group_actions[0].choices["figures"].epilog

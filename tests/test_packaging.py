@@ -134,7 +134,7 @@ def test_the_wheel_is_the_package_imported(installed):
     target = installed[0]
     proc = _run([sys.executable, "-c", "import uio_teach; print(uio_teach.__file__)"], installed)
     assert Path(proc.stdout.strip()).is_relative_to(target)
-    assert (target / "uio_teach" / "_course" / "book" / "07_lab_pa9.md").is_file()
+    assert (target / "uio_teach" / "_course" / "book" / "lab_pa9.md").is_file()
     assert (target / "uio_teach" / "_course" / "references.bib").is_file()
 
 
@@ -150,12 +150,12 @@ def test_the_wheel_lists_the_figures_from_any_folder(installed):
 def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
     from uio_teach.instructor.book import BookIndex
 
-    chapter = BookIndex.from_book(ROOT / "book").chapters["07_lab_pa9"]
+    chapter = BookIndex.from_book(ROOT / "book").chapters["lab_pa9"]
     target, work, _ = installed
     _run([sys.executable, target / "bin" / "uio-teach", "labs", "--out", "labs", "-q"], installed)
     for version in ("student", "solution"):
         notebooks = sorted((work / "labs" / version).glob("*.ipynb"))
-        assert [p.name for p in notebooks] == ["07_lab_pa9.ipynb"]
+        assert [p.name for p in notebooks] == ["lab_pa9.ipynb"]
         assert f"Exercise {chapter}.1" in notebooks[0].read_text(encoding="utf-8")
 
 

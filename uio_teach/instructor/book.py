@@ -11,7 +11,7 @@ Examples
 --------
 >>> from uio_teach.instructor.book import BookIndex, default_book_dir
 >>> index = BookIndex.from_book(default_book_dir())
->>> index.chapters["07_lab_pa9"] > index.chapters["02_toolbox"] > index.chapters["01_introduction"]
+>>> index.chapters["lab_pa9"] > index.chapters["toolbox"] > index.chapters["introduction"]
 True
 """
 
@@ -112,7 +112,7 @@ class BookIndex:
     --------
     >>> from uio_teach.instructor.book import BookIndex, default_book_dir
     >>> index = BookIndex.from_book(default_book_dir())
-    >>> index.chapters["01_introduction"], "08_api" in index.chapters   # numbered parts only
+    >>> index.chapters["introduction"], "api" in index.chapters   # numbered parts only
     (1, False)
     >>> index.cite("p", "de2014comparison")
     '(De et al., 2014)'

@@ -120,7 +120,7 @@ is still missing.
 _LABS_EPILOG = """\
 examples:
   uio-teach labs --out handout/labs
-  uio-teach labs --out handout/labs --source book/07_lab_pa9.md
+  uio-teach labs --out handout/labs --source book/lab_pa9.md
 
 exit status:
   0 all notebooks written, 1 a lab could not be read or written, 2 a usage

@@ -1,7 +1,7 @@
 """Turn the book's lab chapters into Jupyter notebooks: a student version and a solution version.
 
 A lab chapter is a MyST Markdown notebook in ``book/`` whose file name contains
-``lab`` (``07_lab_pa9.md``). Its solutions live inside sphinx-exercise blocks,
+``lab`` (``lab_pa9.md``). Its solutions live inside sphinx-exercise blocks,
 ``{solution-start} <label>`` ... ``{solution-end}``, and/or in code cells
 tagged ``solution``. From the one source, :func:`make_notebook` builds:
 
@@ -601,7 +601,7 @@ def find_labs(book_dir: str | os.PathLike[str]) -> list[Path]:
     --------
     >>> from uio_teach.instructor.labs import default_book_dir, find_labs
     >>> [p.name for p in find_labs(default_book_dir())][:1]
-    ['07_lab_pa9.md']
+    ['lab_pa9.md']
     """
     return sorted(p for p in Path(book_dir).glob(LAB_PATTERN) if p.is_file())
 
