@@ -109,7 +109,15 @@ def test_hidden_checks_still_run() -> None:
 
 # --- every chapter opens with its goals and closes with a summary and exercises -----------------
 
-COURSE_CHAPTERS = sorted(BOOK.glob("0[1-6]_*.md"))
+def course_chapters() -> list[Path]:
+    """The chapters of the numbered part of ``_toc.yml``, labs excepted, in reading order."""
+    toc = yaml.safe_load((BOOK.parent / "_toc.yml").read_text(encoding="utf-8"))
+    part = next(p for p in toc["parts"] if p.get("numbered"))
+    files = [BOOK.parent / f"{entry['file']}.md" for entry in part["chapters"]]
+    return [path for path in files if not path.name.startswith("lab_")]
+
+
+COURSE_CHAPTERS = course_chapters()
 
 
 @pytest.mark.parametrize("chapter", COURSE_CHAPTERS, ids=[path.name for path in COURSE_CHAPTERS])
