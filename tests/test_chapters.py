@@ -109,6 +109,7 @@ def test_hidden_checks_still_run() -> None:
 
 # --- every chapter opens with its goals and closes with a summary and exercises -----------------
 
+
 def course_chapters() -> list[Path]:
     """The chapters of the numbered part of ``_toc.yml``, labs excepted, in reading order."""
     toc = yaml.safe_load((BOOK.parent / "_toc.yml").read_text(encoding="utf-8"))
