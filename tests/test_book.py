@@ -426,3 +426,17 @@ def test_chapter_page_links_its_notebook(page: str, built_book: Path) -> None:
     with_outputs = [i for i, cell in enumerate(code) if cell.outputs or cell.execution_count]
     assert not with_outputs, f"{target.name}: code cells with outputs: {with_outputs}"
     assert notebook.metadata.get("kernelspec", {}).get("name") == "python3"
+
+
+def test_landing_page_and_readme_list_the_chapters_in_reading_order() -> None:
+    """The landing page and the README name every page of _toc.yml in the order of the contents."""
+    toc = [page.split("/")[-1] for page in PAGES if page != "book/index"]
+    index = (ROOT / "book" / "index.md").read_text(encoding="utf-8")
+    linked = [name for name in re.findall(r"\{doc\}`(?:[^`<]*<)?([\w/]+)>?`", index)]
+    in_order = [name for name in dict.fromkeys(linked) if name in toc]
+    assert in_order == toc, f"book/index.md lists {in_order}, the contents say {toc}"
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    chapters = [name for name in toc if name not in {"references", "status"}]
+    named = re.findall(r"`(\w+)\.md`", readme)
+    in_order = [name for name in dict.fromkeys(named) if name in chapters]
+    assert in_order == chapters, f"README.md lists {in_order}, the contents say {chapters}"

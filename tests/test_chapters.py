@@ -110,15 +110,21 @@ def test_hidden_checks_still_run() -> None:
 # --- every chapter opens with its goals and closes with a summary and exercises -----------------
 
 
-def course_chapters() -> list[Path]:
-    """The chapters of the numbered part of ``_toc.yml``, labs excepted, in reading order."""
-    toc = yaml.safe_load((BOOK.parent / "_toc.yml").read_text(encoding="utf-8"))
-    part = next(p for p in toc["parts"] if p.get("numbered"))
-    files = [BOOK.parent / f"{entry['file']}.md" for entry in part["chapters"]]
+def course_chapters(root: Path = BOOK.parent) -> list[Path]:
+    """The chapters of the part "The course" of ``_toc.yml``, in reading order, but the lab."""
+    toc = yaml.safe_load((root / "_toc.yml").read_text(encoding="utf-8"))
+    part = next(part for part in toc["parts"] if part.get("caption") == "The course")
+    files = [root / f"{entry['file']}.md" for entry in part["chapters"]]
     return [path for path in files if not path.name.startswith("lab_")]
 
 
 COURSE_CHAPTERS = course_chapters()
+
+
+def test_course_chapters_are_found() -> None:
+    names = [path.stem for path in COURSE_CHAPTERS]
+    assert names[:2] == ["introduction", "toolbox"] and "fault_detection" in names, names
+    assert all(path.is_file() for path in COURSE_CHAPTERS)
 
 
 @pytest.mark.parametrize("chapter", COURSE_CHAPTERS, ids=[path.name for path in COURSE_CHAPTERS])
@@ -175,3 +181,104 @@ def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path) -> None:
     assert any("remove-cell" in cell.metadata.get("tags", []) for cell in code)
     assert notebook.metadata["kernelspec"]["name"] == "python3"
     assert "jupytext" not in notebook.metadata
+
+
+# --- the prose states the worked experiments' numbers -------------------------------------------
+# The chapters read each experiment from `uio_teach.experiments`; where their text states one of
+# its numbers, the sentence is rebuilt here from the experiment, so that changing the experiment
+# fails this test instead of leaving the text false.
+
+
+def _num(value: float) -> str:
+    return f"{float(value):g}"
+
+
+def _prose_claims() -> list[tuple[str, str]]:
+    from uio_teach.experiments import CASE_STUDY, MISSILE, PA9
+
+    x0_pa9 = PA9.initial_state
+    poles_pa9 = ", ".join(_num(p) for p in PA9.poles)
+    sine = "" if PA9.sine_amplitude == 1 else f"{_num(PA9.sine_amplitude)} "
+    sin_pa9 = f"{sine}\\sin {_num(PA9.sine_frequency)}t"
+    jumps = [_num(t) for t in PA9.switch_times[1:]]
+    jumps_text = f"$t = {jumps[0]}$, " + ", ".join(f"${t}$" for t in jumps[1:-1])
+    jumps_text = jumps_text.rstrip(", ") + f" and ${jumps[-1]}$ s"
+    x0_case = ", ".join(_num(x) for x in CASE_STUDY.initial_state)
+    (a1, r1, w1, k1), (a2, r2, w2, k2) = MISSILE.v_parameters
+    x0_missile = MISSILE.initial_state
+    poles_missile = sorted(MISSILE.poles)  # the pole for x1 is the faster one
+    return [
+        # introduction: the PA9 experiment's poles, start and sinusoid
+        ("introduction.md", f"error poles $\\{{{poles_pa9}\\}}$, those of the PA9 experiment"),
+        ("introduction.md", f"the sinusoid $d(t) = {sine}\\sin({_num(PA9.sine_frequency)}t)$"),
+        ("introduction.md", f"$\\omega = {_num(PA9.sine_frequency)}$ rad/s"),
+        (
+            "introduction.md",
+            "the PA9 experiment's $x(0) = [" + ",\\ ".join(_num(x) for x in x0_pa9) + "]^\\top$",
+        ),
+        ("introduction.md", f"twice the experiment's {_num(PA9.duration)} s"),
+        # PA9
+        ("pa9.md", "start the plant at $x_0 = [" + ", ".join(_num(x) for x in x0_pa9) + "]^\\top$"),
+        ("pa9.md", f"the run lasts {_num(PA9.duration)} s, on {PA9.timepts.size} time points"),
+        ("pa9.md", f"**(i) Sinusoidal disturbance** $d(t) = {sin_pa9}$"),
+        ("pa9.md", f"**(ii) Piecewise-constant disturbance**, jumping at {jumps_text}"),
+        ("pa9.md", f"gains that place $\\{{{poles_pa9}\\}}$"),
+        ("toolbox.md", f"the gain $K_1$ places the poles $\\{{{poles_pa9}\\}}$"),
+        # case study
+        (
+            "case_study.md",
+            f"$u_2[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
+        ),
+        (
+            "case_study.md",
+            f"drawn uniformly in $[-{_num(CASE_STUDY.v_amplitude)}, "
+            f"{_num(CASE_STUDY.v_amplitude)}]$, every {CASE_STUDY.v_hold} steps",
+        ),
+        ("case_study.md", f"$x[0] = [{x0_case}]^\\top$"),
+        ("case_study.md", f"the steps $k = 0, 1, \\dots, {int(CASE_STUDY.duration)}$"),
+        # missile
+        (
+            "missile.md",
+            "x_0 = \\begin{bmatrix} "
+            + " \\\\ ".join(_num(x) for x in x0_missile)
+            + " \\end{bmatrix}",
+        ),
+        (
+            "missile.md",
+            f"v_1(t) = {_num(a1)}\\, e^{{-{_num(r1)}t}} \\{k1}({_num(w1)} t), \\qquad "
+            f"v_2(t) = {_num(a2)}\\, e^{{-{_num(r2)}t}} \\{k2}({_num(w2)} t)",
+        ),
+        (
+            "missile.md",
+            f"A grid of {MISSILE.timepts.size:,} points over {_num(MISSILE.duration)} s".replace(
+                ",", " "
+            ),
+        ),
+        (
+            "missile.md",
+            f"pole ${_num(poles_missile[0])}$ for $x_1$ and ${_num(poles_missile[1])}$ for $x_2$",
+        ),
+        ("missile.md", f"the error ${_num(x0_missile[0])}\\,e^{{-l_1 t}}$"),
+        # fault detection: the PA9 experiment again
+        ("fault_detection.md", f"the UIO with poles $\\{{{poles_pa9}\\}}$"),
+        ("fault_detection.md", f"over the same {_num(PA9.duration)} s"),
+        ("fault_detection.md", f"the disturbance $d(t) = {sin_pa9}$"),
+    ]
+
+
+def test_prose_states_the_experiments_numbers() -> None:
+    """Every number the text gives for an experiment is the experiment's."""
+    from uio_teach.experiments import PA9
+
+    # the known input of PA9 has no parameters: the text describes it as u = [1, 0.5 sin t]
+    assert str(PA9.inputs) == "[1 step(t - 0); 0.5 sin(1 t)]"
+    missing = []
+    texts: dict[str, str] = {}
+    for name, phrase in _prose_claims():
+        if name not in texts:
+            texts[name] = " ".join((BOOK / name).read_text(encoding="utf-8").split())
+        if " ".join(phrase.split()) not in texts[name]:
+            missing.append(f"{name}: {phrase!r}")
+    assert not missing, "text that no longer states the experiment's value:\n" + "\n".join(missing)
+    for name in ("pa9.md", "fault_detection.md"):
+        assert "$u = [1,\\ 0.5 \\sin t]^\\top$" in texts[name], name
