@@ -377,6 +377,8 @@ def test_response_fields_are_consistent():
     assert run.plant is plant and run.observer is obs
     text = repr(run)
     assert "PMO" in text and "case study" in text and "20 samples" in text
+    # a discrete run is read in steps, not seconds
+    assert "steps k = 0 ... 19" in text and "t = " not in text
 
 
 def test_observer_state_sets_the_first_estimate():

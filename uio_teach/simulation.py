@@ -204,12 +204,18 @@ class UIOResponse:
 
     def __repr__(self) -> str:
         t = self.time
-        unit = "" if self.plant.dt is True else " s"
+        if self.plant.is_discrete:
+            # a discrete run counts steps; the sampling period is said only when it is known
+            dt = self.plant.dt
+            period = "" if dt is True else f" of {dt:g} s"
+            span = f"steps k = 0 ... {t.size - 1}{period}"
+        else:
+            span = f"t = {t[0]:g} ... {t[-1]:g} s"
         e0 = float(np.max(np.abs(self.error[:, 0])))
         e1 = float(np.max(np.abs(self.error[:, -1])))
         return (
             f"UIOResponse({self.observer.family} on {self.plant!r},\n"
-            f"            {t.size} samples, t = {t[0]:g} ... {t[-1]:g}{unit}, "
+            f"            {t.size} samples, {span}, "
             f"max|error| {e0:.3g} at start, {e1:.3g} at end)"
         )
 
