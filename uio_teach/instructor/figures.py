@@ -53,14 +53,30 @@ from ..plotting import (
     symbol,
     time_label,
 )
-from .config import ConfigError, FigureConfig, _design, default_config_toml, load_config
-from .output import FORMATS, OutputError, prepare_output_dir, save_figure
+from .config import (
+    ConfigError,
+    FigureConfig,
+    _design,
+    check_dpi,
+    default_config_toml,
+    load_config,
+)
+from .output import (
+    FORMATS,
+    MANIFEST,
+    OutputError,
+    StagedFolder,
+    prepare_output_dir,
+    save_figure,
+    write_manifest,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
 __all__ = [
     "FORMATS",
+    "MANIFEST",
     "FIGURES",
     "FigureSpec",
     "FigureResult",
@@ -71,6 +87,7 @@ __all__ = [
     "default_config_toml",
     "prepare_output_dir",
     "save_figure",
+    "check_dpi",
     "generate",
 ]
 
@@ -521,19 +538,26 @@ def generate(
 ) -> list[FigureResult]:
     """Make the figures ``names`` (all by default) into the folder ``out``.
 
-    A figure that fails is reported in its :class:`FigureResult` and the
-    others are still made.
+    All or nothing: the files are written into a temporary folder beside
+    ``out`` and swapped in only when every figure was made, together with a
+    :data:`~uio_teach.instructor.output.MANIFEST` (the configuration as used
+    and its hash, the versions, each file's SHA-256). The new folder replaces
+    the old one whole, so no file of an earlier run is left. A figure that
+    fails is reported in its :class:`FigureResult` and the others are still
+    tried, but then nothing is written and an existing ``out`` is left exactly
+    as it was (as after an exception or Ctrl-C).
 
     Parameters
     ----------
     out : str or path-like
-        Output folder (created if needed).
+        Output folder: created, or replaced if it holds an earlier output
+        (a manifest of uio-teach) or nothing.
     names : sequence of str, optional
         Names from :data:`FIGURES`; all of them by default.
     fmt : {"png", "pdf", "svg"}
         Image format (tables are always ``.csv`` and ``.md``).
     dpi : int
-        Resolution.
+        Resolution, within :data:`~uio_teach.instructor.config.DPI_RANGE`.
     config : FigureConfig, optional
         The parameters; the defaults when omitted.
     progress : callable, optional
@@ -543,14 +567,16 @@ def generate(
     Returns
     -------
     list of FigureResult
-        One per requested name, in the order of :data:`FIGURES`.
+        One per requested name, in the order of :data:`FIGURES`; the paths
+        are those in ``out``.
 
     Raises
     ------
     ValueError
-        An unknown name, format or a non-positive ``dpi``.
+        An unknown name or format, or a ``dpi`` out of range.
     uio_teach.instructor.output.OutputError
-        ``out`` cannot be created or written to.
+        ``out`` cannot be created or written to, or is a folder that does not
+        look like an earlier output (not empty, no manifest).
 
     Examples
     --------
@@ -565,36 +591,42 @@ def generate(
 
     if fmt not in FORMATS:
         raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    if isinstance(dpi, bool) or not isinstance(dpi, int) or dpi <= 0:
-        raise ValueError(f"dpi must be a positive integer, got {dpi!r}")
+    dpi = check_dpi(dpi)
     wanted = list(FIGURES) if names is None else list(dict.fromkeys(names))
     unknown = [n for n in wanted if n not in FIGURES]
     if unknown:
         raise ValueError(unknown_figure_message(unknown[0]))
     wanted = [n for n in FIGURES if n in wanted]
-    folder = prepare_output_dir(out)
+    target = Path(out)
     cfg = config if config is not None else FigureConfig()
     runs = _Runs(cfg)
     results: list[FigureResult] = []
-    for index, name in enumerate(wanted, start=1):
-        spec = FIGURES[name]
-        start = time.perf_counter()
-        try:
-            with matplotlib.style.context(cfg["style"]):
-                if spec.table:
-                    paths = tuple(spec.draw(runs, folder))
-                else:
-                    fig = spec.draw(runs)
-                    paths = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
-            result = FigureResult(name, paths, time.perf_counter() - start)
-        except Exception as exc:  # one figure failing must not stop the others
-            message = " ".join(str(exc).split()) or "no message"
-            result = FigureResult(
-                name, (), time.perf_counter() - start, f"{type(exc).__name__}: {message}"
-            )
-        results.append(result)
-        if progress is not None:
-            progress(index, len(wanted), result)
+    with StagedFolder(target, "figures") as stage:
+        folder = stage.path
+        for index, name in enumerate(wanted, start=1):
+            spec = FIGURES[name]
+            start = time.perf_counter()
+            try:
+                with matplotlib.style.context(cfg["style"]):
+                    if spec.table:
+                        made = tuple(spec.draw(runs, folder))
+                    else:
+                        fig = spec.draw(runs)
+                        made = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
+                paths = tuple(target / path.name for path in made)
+                result = FigureResult(name, paths, time.perf_counter() - start)
+            except Exception as exc:  # one figure failing must not stop the others
+                message = " ".join(str(exc).split()) or "no message"
+                result = FigureResult(
+                    name, (), time.perf_counter() - start, f"{type(exc).__name__}: {message}"
+                )
+            results.append(result)
+            if progress is not None:
+                progress(index, len(wanted), result)
+        if all(r.ok for r in results):
+            options = {"figures": wanted, "format": fmt, "dpi": dpi, "config_file": cfg.source}
+            write_manifest(folder, command="uio-teach figures", config=cfg, options=options)
+            stage.commit()
     return results
 
 
