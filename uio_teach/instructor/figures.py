@@ -46,12 +46,15 @@ import numpy as np
 from .._display import format_poles
 from ..experiments import CASE_STUDY, MISSILE, PA9
 from ..plotting import (
+    _zero_to_rounding,
     finish_panel,
     new_figure,
     plot_error,
     plot_residual,
+    residual_colors,
     symbol,
     time_label,
+    with_unit,
 )
 from .config import (
     ConfigError,
@@ -210,7 +213,7 @@ def _pa9_disturbance(runs: _Runs, which: str) -> Figure:
     ax_d.plot(t, resp.inputs.d[0], color="k")
     formula = repr(d)
     ax_d.set_title(f"d(t) = {formula if len(formula) <= 80 else formula[:77] + '...'}")
-    finish_panel(ax_d, "disturbance $d$", legend=False)
+    finish_panel(ax_d, with_unit("disturbance $d$"), legend=False)
     plot_error(ax_e, resp)
     plot_residual(ax_r, resp)
     ax_r.set_xlabel(time_label(resp.plant.dt))
@@ -248,9 +251,14 @@ def _pa9_luenberger(runs: _Runs) -> Figure:
         ):
             ax = axes[row, col]
             values = getattr(sine, what)
+            colors = (
+                residual_colors(sine.plant.C)
+                if what == "residual"
+                else [f"C{i}" for i in range(values.shape[0])]
+            )
             for i in range(values.shape[0]):
-                ax.plot(sine.time, values[i], color=f"C{i}", label=symbol(sym, i))
-                ax.plot(steps.time, getattr(steps, what)[i], color=f"C{i}", linestyle="--")
+                ax.plot(sine.time, values[i], color=colors[i], label=symbol(sym, i))
+                ax.plot(steps.time, getattr(steps, what)[i], color=colors[i], linestyle="--")
             finish_panel(ax, label)
         axes[0, col].set_title(name)
         axes[1, col].set_xlabel(time_label(r["plant"].dt))
@@ -282,7 +290,7 @@ def _case_error(runs: _Runs) -> Figure:
     if rho > 0:
         ax.semilogy(k, norm[0] * rho**k, "--", label=rf"$\|e[0]\|\,{rho:.3g}^k$")
     ax.set_xlabel(time_label(True))  # the case study counts steps k
-    finish_panel(ax, r"$\|e[k]\|_2$")
+    finish_panel(ax, with_unit(r"$\|e[k]\|_2$"))
     ax.set_title("Case study: the estimation error ignores both unknown signals")
     return fig
 
@@ -298,7 +306,7 @@ def _missile_states(runs: _Runs, name: str, label: str, figs: str) -> Figure:
         ax.plot(t, free.states[i], color="tab:green", label=f"{symbol('x', i)} without $v$")
         hat = symbol("x", i, hat=True)
         ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=hat)
-        finish_panel(ax, symbol("x", i))
+        finish_panel(ax, with_unit(symbol("x", i)))
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle(
@@ -320,10 +328,15 @@ def _missile_error(runs: _Runs) -> Figure:
     fig = new_figure(9.0, 6.0)
     axes = fig.subplots(2, 2, sharex=True)
     for i, ax in enumerate(axes.flat):
+        errors = []
         for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", "--")):
             resp = m[name]["response"]
             ax.plot(resp.time, resp.error[i], linestyle=style, label=label)
-        finish_panel(ax, rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$")
+            errors.append(resp.error[i])
+        finish_panel(ax, with_unit(rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$"))
+        # a measured state is estimated exactly: its error is rounding noise, shown on zero
+        scale = float(np.max(np.abs(m["pmo"]["response"].states[i])))
+        _zero_to_rounding(ax, np.array(errors), scale)
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle("Missile autopilot: estimation error of both observers")
@@ -342,7 +355,7 @@ def _missile_inputs(runs: _Runs) -> Figure:
             est = m[name]["inputs"].estimates[i]
             hat = symbol("v", i, hat=True)
             ax.plot(t, est, color="k", linestyle=style, lw=1.2, label=f"{hat} {label}")
-        finish_panel(ax, symbol("v", i))
+        finish_panel(ax, with_unit(symbol("v", i)))
         lim = 1.3 * float(np.max(np.abs(actual[i])))
         ax.set_ylim(-lim, lim)
     axes[-1].set_xlabel(time_label(m["plant"].dt))

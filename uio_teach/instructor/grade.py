@@ -13,7 +13,8 @@
    per cell and for the whole notebook (the process is killed when it is
    over); a cell that raises or loops is recorded and the next cells still
    run;
-4. reads the verdict of every cell tagged ``check``: a small cell added after
+4. reads the verdict of every cell tagged ``check`` (not those of the
+   instructor notes, tagged ``instructor`` too): a small cell added after
    each one records the results of :func:`uio_teach.checks.collected`, and a
    last added cell prints them as JSON between two marker lines. Results made
    outside the check cells (an exercise that shows a failing check on purpose)
@@ -253,14 +254,15 @@ def _lab_of(nb: Any, path: Path, registry: Mapping[str, Any]) -> tuple[str, str]
     name_lab, name_group = group_from_name(path)
     lab, group = lab or name_lab, group or name_group
     if not lab:
-        stem = path.stem
+        source = meta.get("source") if isinstance(meta, Mapping) else None
+        stem = Path(str(source)).stem if source else path.stem
         for lab_id, record in registry.items():
             chapter = _record_field(record, "chapter", "source", "source_name")
             if chapter is not None and Path(str(chapter)).stem == stem:
                 lab = lab_id
                 break
         else:
-            lab = stem
+            lab = stem.removeprefix("lab_")
     return lab, group
 
 
@@ -292,7 +294,7 @@ def _prepare(nb: Any, params: dict[str, Any] | None) -> tuple[Any, int]:
         if _is_code(cell) and "parameters" in _tags(cell) and params is not None:
             cell.source = f"PARAMS = {json.dumps(params)}"
             has_params = True
-        if _is_code(cell) and "check" in _tags(cell):
+        if _is_code(cell) and "check" in _tags(cell) and "instructor" not in _tags(cell):
             checks += 1
             cells.append(nbformat.v4.new_code_cell("_uio_checks.clear_collected()"))
             cells.append(cell)

@@ -211,7 +211,7 @@ def library_versions() -> dict[str, str]:
 
 def _jsonable(value: Any) -> Any:
     if isinstance(value, complex):
-        return format(value.real, "g") if value.imag == 0 else str(value).strip("()")
+        return value.real if value.imag == 0 else str(value).strip("()")
     if isinstance(value, (tuple, list)):
         return [_jsonable(v) for v in value]
     if isinstance(value, Mapping):
