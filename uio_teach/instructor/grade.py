@@ -15,10 +15,11 @@
    run;
 4. reads the verdict of every cell tagged ``check`` (not those of the
    instructor notes, tagged ``instructor`` too): a small cell added after
-   each one records the results of :func:`uio_teach.checks.collected`, and a
-   last added cell prints them as JSON between two marker lines. Results made
-   outside the check cells (an exercise that shows a failing check on purpose)
-   do not count.
+   each one records (and prints) the results of
+   :func:`uio_teach.checks.collected`, and a last added cell prints them all
+   as JSON between two marker lines. Results made outside the check cells (an
+   exercise that shows a failing check on purpose) do not count. A run killed
+   at the time limit is graded on the check cells that ran.
 
 The checks a lab must produce come from the lab registry
 (``uio_teach.instructor.labs.LABS``, the ``check_ids`` of each lab) when it
@@ -69,6 +70,8 @@ __all__ = [
 
 BEGIN = "<<<uio-teach grade: results>>>"
 """The line before the JSON of the check results in the executed copy."""
+CELL = "<<<uio-teach grade: check cell>>>"
+"""The line before the JSON of one check cell's results (read when a run is cut short)."""
 END = "<<<uio-teach grade: end>>>"
 """The line after it."""
 
@@ -104,6 +107,9 @@ class Submission:
         The check ids this lab must produce.
     seconds : float
         Time spent running it.
+    feedback_file : pathlib.Path or None
+        The feedback text, once :func:`write_gradebook` wrote it (named after
+        the submission; after its folder too when two submissions share a name).
 
     Examples
     --------
@@ -124,6 +130,7 @@ class Submission:
     params: dict[str, Any] | None = None
     expected: tuple[str, ...] = ()
     seconds: float = 0.0
+    feedback_file: Path | None = None
 
     def verdicts(self) -> dict[str, bool]:
         """Check id -> passed: ran at least once, and passed every time it ran."""
@@ -300,9 +307,11 @@ def _prepare(nb: Any, params: dict[str, Any] | None) -> tuple[Any, int]:
             cells.append(cell)
             cells.append(
                 nbformat.v4.new_code_cell(
-                    f"_uio_grade.append({{'cell': {checks}, 'results': "
-                    "[r.to_dict() for r in _uio_checks.collected()]})\n"
-                    "_uio_checks.clear_collected()"
+                    f"_uio_entry = {{'cell': {checks}, 'results': "
+                    "[r.to_dict() for r in _uio_checks.collected()]}\n"
+                    "_uio_grade.append(_uio_entry)\n"
+                    "_uio_checks.clear_collected()\n"
+                    f"print({CELL!r})\nprint(_uio_json.dumps(_uio_entry))\nprint({END!r})"
                 )
             )
         else:
@@ -322,9 +331,12 @@ def _prepare(nb: Any, params: dict[str, Any] | None) -> tuple[Any, int]:
     return nb, checks
 
 
-def _parse(executed: Any) -> tuple[list[dict[str, Any]] | None, list[str]]:
-    """The recorded results (None if the last cell did not run) and the cells' errors."""
-    errors = []
+def _parse(
+    executed: Any,
+) -> tuple[list[dict[str, Any]] | None, list[dict[str, Any]], list[str]]:
+    """The results of the last cell (None if it did not run), of each check cell, the errors."""
+    errors: list[str] = []
+    partial: list[dict[str, Any]] = []
     found = None
     user_cell = 0
     for cell in executed.cells:
@@ -339,15 +351,25 @@ def _parse(executed: Any) -> tuple[list[dict[str, Any]] | None, list[str]]:
                 evalue = " ".join(str(out.get("evalue", "")).split())
                 if len(evalue) > 200:
                     evalue = evalue[:197] + "..."
-                errors.append(f"{where} raised {out.get('ename', 'an error')}: {evalue}")
-            if out.get("output_type") == "stream" and BEGIN in out.get("text", ""):
-                text = out["text"]
-                body = text.split(BEGIN, 1)[1].split(END, 1)[0]
-                try:
-                    found = json.loads(body)
-                except ValueError:
-                    found = None
-    return found, errors
+                if out.get("ename") in ("KeyboardInterrupt", "TimeoutError"):
+                    errors.append(
+                        f"{where} was interrupted: it ran longer than the time limit of a cell"
+                    )
+                else:
+                    errors.append(f"{where} raised {out.get('ename', 'an error')}: {evalue}")
+            text = out.get("text", "") if out.get("output_type") == "stream" else ""
+            for marker in (CELL, BEGIN):
+                if ours and marker in text:
+                    body = text.split(marker, 1)[1].split(END, 1)[0]
+                    try:
+                        data = json.loads(body)
+                    except ValueError:
+                        continue
+                    if marker == BEGIN:
+                        found = data
+                    else:
+                        partial.append(data)
+    return found, partial, errors
 
 
 def _run_copy(path: Path, cell_timeout: float, timeout: float) -> tuple[str, Any, str]:
@@ -452,15 +474,17 @@ def _grade_one(
     sub.status = status
     if note:
         sub.errors.append(note)
-    found = None
+    found, partial = None, []
     if executed is not None:
-        found, errors = _parse(executed)
+        found, partial, errors = _parse(executed)
         sub.errors += errors
         if errors and sub.status == "ok":
             sub.status = "error"
-    if found is None and sub.status == "ok":
-        sub.status = "error"
-        sub.errors.append("the notebook did not run to its end")
+    if found is None:
+        found = partial  # cut short: what the check cells that ran recorded
+        if sub.status == "ok":
+            sub.status = "error"
+            sub.errors.append("the notebook did not run to its end")
     for entry in found or []:
         for result in entry.get("results", []):
             check_id = result.get("check_id") or result.get("title") or "unnamed check"
@@ -514,13 +538,13 @@ def write_gradebook(
     folder.mkdir(exist_ok=True)
     used: set[str] = set()
     for sub in submissions:
-        stem = Path(sub.file).stem
-        name, n = f"{stem}.txt", 1
-        while name in used:
-            n += 1
-            name = f"{stem}-{n}.txt"
+        path = Path(sub.file)
+        candidates = [path.stem, f"{path.parent.name}_{path.stem}"]
+        candidates += [f"{path.stem}-{n}" for n in range(2, len(submissions) + 2)]
+        name = next(f"{c}.txt" for c in candidates if f"{c}.txt" not in used)
         used.add(name)
-        (folder / name).write_text(sub.feedback(), encoding="utf-8")
+        sub.feedback_file = folder / name
+        sub.feedback_file.write_text(sub.feedback(), encoding="utf-8")
     return out, folder
 
 
@@ -620,11 +644,17 @@ def _execute(src: str, dst: str, cell_timeout: float, pid_file: str) -> int:
         if pid:
             Path(pid_file).write_text(str(pid))
 
+    def save(**_: Any) -> None:  # so that a run killed at the time limit still tells something
+        part = dst + ".part"
+        nbformat.write(nb, part)
+        os.replace(part, dst)
+
     client.on_notebook_start = started
+    client.on_cell_executed = save
     try:
         client.execute()
     finally:
-        nbformat.write(nb, dst)
+        save()
     return 0
 
 
