@@ -275,6 +275,9 @@ BAD_CONFIGS = {
     "negative noise": ("[pa9]\nnoise = -0.1\n", "pa9.noise: must be >= 0"),
     "unknown style": ('style = "ggplott"\n', "did you mean 'ggplot'"),
     "not TOML": ("[pa9\n", "not valid TOML"),
+    "negative seed": ("seed = -1\n", "seed: must be >= 0, got -1"),
+    "too many samples": ("[pa9]\nsamples = 1000000000000\n", "pa9.samples: must be <= 200000"),
+    "pole repeated too often": ("[pa9]\npoles = [-1, -1, -1]\n", "-1 is repeated 3 times"),
     "table as value": ("pa9 = 3\n", "pa9: expected a table"),
 }
 

@@ -305,12 +305,7 @@ def _check_value(key: str, opt: _Option, value: Any) -> Any:
     # poles
     poles = tuple(_pole(f"{key}[{i}]", v) for i, v in enumerate(value))
     discrete = key in _DISCRETE_POLES
-    for i, z in enumerate(poles):
-        if z in poles[:i]:
-            raise ConfigError(
-                f"{key}: the pole {format_poles([z], 6)} is given twice; the poles must be "
-                "distinct (a repeated pole cannot be placed by the course's designs)"
-            )
+    for z in poles:
         if not discrete and abs(z) > MAX_POLE:
             raise ConfigError(
                 f"{key}: the pole {format_poles([z], 6)} is faster than {MAX_POLE:g} rad/s, "
