@@ -102,6 +102,17 @@ def time_label(dt: float | bool | None) -> str:
 def with_unit(label: str, unit: str = UNIT) -> str:
     """A vertical-axis label with its unit: ``"$x_{1}$ (model units)"``.
 
+    Parameters
+    ----------
+    label : str
+        The label.
+    unit : str, optional
+        The unit (default :data:`UNIT`).
+
+    Returns
+    -------
+    str
+
     Examples
     --------
     >>> from uio_teach.plotting import symbol, with_unit

@@ -176,6 +176,15 @@ class Submission:
 def group_from_name(path: str | os.PathLike[str]) -> tuple[str, str]:
     """The lab and group of a file named ``<lab>_<group>.ipynb`` (``("", "")`` otherwise).
 
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    (str, str)
+
     Examples
     --------
     >>> from uio_teach.instructor.grade import group_from_name
@@ -500,7 +509,14 @@ def write_gradebook(
 
     Columns: ``file``, ``lab``, ``group``, ``status``, one per check id (✓ or
     ✗; empty for a check of another lab), ``total`` (checks passed) and
-    ``out_of``. Both are written to temporary files first and moved in place.
+    ``out_of``. The CSV is written to a temporary file first and moved in place.
+
+    Parameters
+    ----------
+    submissions : sequence of Submission
+        The grades.
+    out : str or path-like
+        The CSV.
 
     Returns
     -------

@@ -170,6 +170,15 @@ def prepare_output_dir(out: str | os.PathLike[str]) -> Path:
 def sha256_file(path: str | os.PathLike[str]) -> str:
     """The SHA-256 of a file's bytes, as 64 hexadecimal digits.
 
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    str
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -189,6 +198,11 @@ def sha256_file(path: str | os.PathLike[str]) -> str:
 
 def library_versions() -> dict[str, str]:
     """The versions of Python, uio-teach and the libraries the figures depend on.
+
+    Returns
+    -------
+    dict
+        Name -> version (``"not installed"`` for a missing library).
 
     Examples
     --------
@@ -286,6 +300,15 @@ def write_manifest(
 def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
     """The manifest of an earlier run in ``folder``, or ``None`` if it has none (or not ours).
 
+    Parameters
+    ----------
+    folder : str or path-like
+        The folder.
+
+    Returns
+    -------
+    dict or None
+
     Examples
     --------
     >>> import tempfile
@@ -337,7 +360,7 @@ class StagedFolder:
     ...     with StagedFolder(target) as stage:
     ...         _ = (stage.path / "a.txt").write_text("new")
     ...         print(target.exists())
-    ...         stage.commit()
+    ...         _ = stage.commit()
     ...     print(sorted(p.name for p in target.iterdir()))
     False
     ['a.txt']
@@ -392,6 +415,17 @@ def check_output_folder(target: str | os.PathLike[str]) -> None:
 
     It may if it does not exist, is an empty folder, or holds an earlier
     output (a :data:`MANIFEST` of uio-teach).
+
+    Parameters
+    ----------
+    target : str or path-like
+        The output folder.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, or a folder that is not empty and has no
+        manifest of uio-teach.
 
     Examples
     --------
