@@ -107,7 +107,7 @@ def with_unit(label: str, unit: str = UNIT) -> str:
     label : str
         The label.
     unit : str, optional
-        The unit (default :data:`UNIT`).
+        The unit (default ``UNIT``).
 
     Returns
     -------
@@ -373,7 +373,7 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
     """The output residual ``r = y - C xhat`` of a simulation, one line per output, labelled.
 
     A channel that measures one state has that state's colour in
-    :func:`plot_error` (:func:`residual_colors`). A residual that is zero to
+    :func:`plot_error` (``residual_colors``). A residual that is zero to
     rounding is drawn on zero, and the panel says so.
 
     Parameters

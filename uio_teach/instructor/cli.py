@@ -70,9 +70,16 @@ Regenerate the figures of the course into one folder:
     unknown inputs v1 and v2, and Table II (catch times within 2 % of the
     signal's peak, next to the paper's) as missile_table2.csv and .md.
 
-The files are named after the figures (`--list`), e.g. DIR/pa9_sine.png.
-The same command gives byte-identical files: the noise is seeded and no time
-stamp is written into PNG, PDF or SVG files.
+The files are named after the figures (`--list`), e.g. DIR/pa9_sine.png,
+with DIR/manifest.json (the configuration as used and its hash, the versions,
+each file's SHA-256). The same command gives byte-identical files: the noise
+is seeded and no time stamp is written into PNG, PDF or SVG files.
+
+All or nothing: the files are written into a temporary folder beside DIR,
+which replaces DIR only when every figure was made. A failed or interrupted
+run leaves DIR as it was; a good run leaves only its own files (with --only,
+just those figures). DIR is replaced only if it is empty or holds an earlier
+output (its manifest.json); any other folder is left alone (exit status 1).
 
 The parameters that change from one term to the next (disturbances, observer
 poles, noise level, seed, matplotlib style) are read from a TOML file given
@@ -100,9 +107,9 @@ a configuration file (term.toml):
   values = [1.0, -2.0, 0.5]
 
 exit status:
-  0 all figures written, 1 a figure or the output folder failed,
-  2 a usage or configuration error (unknown key, wrong type, wrong pole count,
-  unstable pole).
+  0 all figures written, 1 a figure or the output folder failed (nothing
+  written), 2 a usage or configuration error (unknown key, wrong type, a value
+  out of its range, wrong pole count, unstable pole), one line per problem.
 """
 
 _LABS_DESCRIPTION = """\

@@ -553,7 +553,7 @@ def generate(
 
     All or nothing: the files are written into a temporary folder beside
     ``out`` and swapped in only when every figure was made, together with a
-    :data:`~uio_teach.instructor.output.MANIFEST` (the configuration as used
+    manifest, ``manifest.json`` (the configuration as used
     and its hash, the versions, each file's SHA-256). The new folder replaces
     the old one whole, so no file of an earlier run is left. A figure that
     fails is reported in its :class:`FigureResult` and the others are still
@@ -570,7 +570,7 @@ def generate(
     fmt : {"png", "pdf", "svg"}
         Image format (tables are always ``.csv`` and ``.md``).
     dpi : int
-        Resolution, within :data:`~uio_teach.instructor.config.DPI_RANGE`.
+        Resolution, within ``DPI_RANGE`` (20 to 1200).
     config : FigureConfig, optional
         The parameters; the defaults when omitted.
     progress : callable, optional
