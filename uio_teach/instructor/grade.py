@@ -458,9 +458,9 @@ def _grade_one(
         nb = nbformat.reads(path.read_bytes().decode("utf-8"), as_version=4)
     except Exception as exc:
         reason = " ".join(str(exc).split())[:200] or type(exc).__name__
-        return Submission(
-            os.fspath(path), "", "", "unreadable", errors=[f"not a notebook: {reason}"]
-        )
+        lab, group = group_from_name(path)
+        note = f"not a notebook: {reason}"
+        return Submission(os.fspath(path), lab, group, "unreadable", errors=[note])
     lab, group = _lab_of(nb, path, registry)
     sub = Submission(os.fspath(path), lab, group, "ok")
     params = None
