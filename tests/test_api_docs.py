@@ -21,6 +21,7 @@ SUBPACKAGE_API = (
     "instructor.config",
     "instructor.figures",
     "instructor.output",
+    "instructor.grade",
     "instructor.labs",
     "instructor.book",
 )

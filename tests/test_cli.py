@@ -7,6 +7,7 @@ Most tests call :func:`uio_teach.cli.main` in-process (fast); one runs
 from __future__ import annotations
 
 import csv
+import os
 import re
 import shutil
 import subprocess
@@ -28,7 +29,7 @@ TABLES = [name for name, spec in figures.FIGURES.items() if spec.table]
 
 
 def expected_files(names: list[str], fmt: str = "png") -> set[str]:
-    out = set()
+    out = {figures.MANIFEST}
     for name in names:
         if figures.FIGURES[name].table:
             out |= {f"{name}.csv", f"{name}.md"}
@@ -110,7 +111,10 @@ def test_help_exits_0_and_reads_like_a_manual(argv, capsys):
 def test_usage_errors_exit_2(capsys):
     assert cli.main([]) == 2
     assert cli.main(["figures", "--format", "gif", "--out", "x"]) == 2
-    assert cli.main(["figures", "--dpi", "0", "--out", "x"]) == 2
+    for dpi in ("0", "1", "19", "1201", "100000", "-5", "1.5", "many"):
+        code, _, err = run(["figures", "--dpi", dpi, "--out", "x"], capsys)
+        assert code == 2 and "--dpi" in err and "Traceback" not in err, dpi
+    assert not Path("x").exists()
     code, _, err = run(["figures"], capsys)
     assert code == 2 and "--out" in err
     code, _, err = run(["figures", "--out", "x", "--only", "pa9_sin"], capsys)
@@ -129,7 +133,7 @@ def test_running_figures_creates_every_file(two_runs):
     assert code == 0
     made = {p.name for p in folder.iterdir()}
     assert made == expected_files(ALL)
-    for name in made:
+    for name in made - {figures.MANIFEST}:
         path = folder / name
         assert path.stat().st_size > (200 if name.startswith(tuple(TABLES)) else 5000), name
         if name.endswith(".png"):
@@ -176,7 +180,9 @@ def test_only_restricts_and_progress_lines_and_summary(tmp_path, capsys):
     lines = out.strip().splitlines()
     assert lines[0].startswith("[1/2] case_error: ") and lines[0].endswith(" s)")
     assert lines[1].startswith("[2/2] missile_table2: ")
-    assert lines[2].startswith(f"2 of 2 figures (3 files) written to {tmp_path} in ")
+    assert lines[2].startswith(
+        f"2 of 2 figures (3 files) and {figures.MANIFEST} written to {tmp_path} in "
+    )
 
 
 def test_dpi_sets_the_pixel_size(tmp_path):
@@ -269,6 +275,9 @@ BAD_CONFIGS = {
     "negative noise": ("[pa9]\nnoise = -0.1\n", "pa9.noise: must be >= 0"),
     "unknown style": ('style = "ggplott"\n', "did you mean 'ggplot'"),
     "not TOML": ("[pa9\n", "not valid TOML"),
+    "negative seed": ("seed = -1\n", "seed: must be >= 0, got -1"),
+    "too many samples": ("[pa9]\nsamples = 1000000000000\n", "pa9.samples: must be <= 200000"),
+    "pole repeated too often": ("[pa9]\npoles = [-1, -1, -1]\n", "-1 is repeated 3 times"),
     "table as value": ("pa9 = 3\n", "pa9: expected a table"),
 }
 
@@ -347,25 +356,28 @@ def test_an_unwritable_out_fails_with_a_clear_message(tmp_path, capsys):
     assert code == 1 and "is a file, not a folder" in err and err.count("\n") == 1
 
 
-def test_a_failing_figure_is_reported_and_the_others_are_still_made(tmp_path, capsys, monkeypatch):
+def test_a_failing_figure_is_reported_and_nothing_is_written(tmp_path, capsys, monkeypatch):
     def broken(runs):
         raise RuntimeError("the plotter ran out of ink\nsecond line")
 
     specs = dict(figures.FIGURES)
     specs["pa9_sine"] = figures.FigureSpec("pa9_sine", "broken on purpose", broken)
     monkeypatch.setattr(figures, "FIGURES", MappingProxyType(specs))
-    code, out, err = run(
-        ["figures", "--out", str(tmp_path), "--only", "pa9_sine", "case_error"], capsys
+    out = tmp_path / "figs"
+    code, stdout, err = run(
+        ["figures", "--out", str(out), "--only", "pa9_sine", "case_error"], capsys
     )
     assert code == 1
-    assert (tmp_path / "case_error.png").is_file() and not (tmp_path / "pa9_sine.png").exists()
+    assert not out.exists()  # the figure that worked is not left alone in a new folder
+    assert os.listdir(tmp_path) == []  # and no temporary folder is left beside it
     lines = err.strip().splitlines()
     assert lines[0] == (
         "uio-teach figures: error: pa9_sine failed: RuntimeError: the plotter ran out of ink "
         "second line"
     )
-    assert "1 of 2 figures" in lines[1] and lines[1].endswith("failed: pa9_sine")
-    assert "[2/2] case_error" in out
+    assert lines[1].startswith("uio-teach figures: error: 1 of 2 figures made, failed: pa9_sine")
+    assert lines[1].endswith("nothing was written, " + str(out) + " not created")
+    assert "[2/2] case_error" in stdout
 
 
 def test_generate_rejects_bad_arguments(tmp_path):

@@ -216,7 +216,10 @@ def test_input_estimate_fields_and_plot():
     assert "filtered" in text and "tau=0.001" in text and "q=2" in text
     fig = est.plot()
     assert len(fig.axes) == 2
-    assert sorted(ax.get_ylabel() for ax in fig.axes) == ["$d_{1}$", "$d_{2}$"]
+    assert sorted(ax.get_ylabel() for ax in fig.axes) == [
+        "$d_{1}$ (model units)",
+        "$d_{2}$ (model units)",
+    ]
     assert fig.axes[-1].get_xlabel() == "time (s)"
     line_true, line_est = fig.axes[0].get_lines()
     np.testing.assert_array_equal(line_est.get_ydata(), est.estimates[0])

@@ -432,8 +432,8 @@ def test_discrete_plant_with_unspecified_period_takes_any_uniform_spacing():
     np.testing.assert_allclose(b.estimates, a.estimates, atol=1e-13)
     fig = b.plot()
     assert {ax.get_xlabel() for ax in fig.axes} - {""} == {"step k"}
-    fig_a = a.plot()
-    assert {ax.get_xlabel() for ax in fig_a.axes} - {""} == {"time (s)"}
+    fig_a = a.plot()  # a sampling period of 1 counts steps too
+    assert {ax.get_xlabel() for ax in fig_a.axes} - {""} == {"step k"}
     plt.close("all")
 
 
@@ -449,12 +449,12 @@ def test_plot_draws_states_error_and_residual():
     fig = run.plot()
     assert len(fig.axes) == plant.n + 2
     labels = sorted(ax.get_ylabel() for ax in fig.axes)
-    assert labels[:4] == ["$x_{1}$", "$x_{2}$", "$x_{3}$", "$x_{4}$"]
+    assert labels[:4] == [f"$x_{{{i}}}$ (model units)" for i in range(1, 5)]
     assert any(label.startswith("error") for label in labels)
     assert any(label.startswith("residual") for label in labels)
     assert {ax.get_xlabel() for ax in fig.axes} - {""} == {"time (s)"}
     # each state panel shows the state and its estimate
-    state_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "$x_{3}$")
+    state_ax = next(ax for ax in fig.axes if ax.get_ylabel() == "$x_{3}$ (model units)")
     lines = state_ax.get_lines()
     np.testing.assert_array_equal(lines[0].get_ydata(), run.states[2])
     np.testing.assert_array_equal(lines[1].get_ydata(), run.estimates[2])

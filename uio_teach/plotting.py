@@ -12,6 +12,18 @@ Drawing code only; the numbers come from :func:`uio_teach.simulate` and
   ``e = x - xhat``, the residual ``r = y - C xhat``, an input and its estimate) and
   :func:`time_label`; :func:`new_figure` makes a figure without pyplot.
 
+Conventions that make the figures say only true things:
+
+* units: the course's models (PA9, the case study, the missile paper) give no physical
+  units, so state, input and disturbance axes say "(model units)"; the time axis says
+  "time (s)" for continuous time and "step k" for a discrete-time plant counted in steps;
+* colours: channel ``i`` of the error is ``C{i}``; a residual channel that measures one
+  state (a row of ``C`` with one nonzero entry, e.g. ``r2 = e3`` in PA9) takes that
+  state's colour, the others colours no state uses;
+* rounding: a panel whose curves are zero up to rounding (``1e-12`` next to signals of
+  size 1) is not blown up to fill the axes: its range is at least a thousandth of the
+  signals' size, so the curves lie on zero, and the panel says "zero to rounding".
+
 The course figures (``uio-teach figures``), the explorers and the book use them,
 so a symbol or a label is written in one place.
 """
@@ -41,7 +53,18 @@ __all__ = [
     "symbol",
     "axis_label",
     "time_label",
+    "with_unit",
+    "residual_colors",
+    "UNIT",
 ]
+
+UNIT = "model units"
+"""The unit of states, inputs and disturbances: the course's models give no physical units."""
+
+_ROUNDING = 1e-9
+"""Relative size below which a panel's values are called zero to rounding."""
+_MIN_SPAN = 1e-3
+"""The smallest half-range of a panel, relative to the size of the signals it derives from."""
 
 _AXIS_LABELS = {
     "error": r"error $e = x - \hat{x}$",
@@ -50,7 +73,11 @@ _AXIS_LABELS = {
 
 
 def time_label(dt: float | bool | None) -> str:
-    """The label of the time axis: ``"time (s)"``, or ``"step k"`` when ``dt=True``.
+    """The label of the time axis: ``"time (s)"``, or ``"step k"`` for a plant counted in steps.
+
+    A discrete-time plant with ``dt=True`` or a sampling period of 1 (the
+    case study's unit step) is counted in steps ``k``; one with another
+    sampling period is plotted against time in seconds.
 
     Parameters
     ----------
@@ -64,10 +91,101 @@ def time_label(dt: float | bool | None) -> str:
     Examples
     --------
     >>> from uio_teach.plotting import time_label
-    >>> time_label(None), time_label(True), time_label(0.1)
-    ('time (s)', 'step k', 'time (s)')
+    >>> time_label(None), time_label(True), time_label(1.0), time_label(0.1)
+    ('time (s)', 'step k', 'step k', 'time (s)')
     """
-    return "step k" if dt is True else "time (s)"
+    if dt is True or (dt is not None and dt is not False and float(dt) == 1.0):
+        return "step k"
+    return "time (s)"
+
+
+def with_unit(label: str, unit: str = UNIT) -> str:
+    """A vertical-axis label with its unit: ``"$x_{1}$ (model units)"``.
+
+    Parameters
+    ----------
+    label : str
+        The label.
+    unit : str, optional
+        The unit (default ``UNIT``).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import symbol, with_unit
+    >>> with_unit(symbol("x", 0))
+    '$x_{1}$ (model units)'
+    """
+    return f"{label} ({unit})"
+
+
+def residual_colors(C: np.ndarray) -> list[str]:
+    """The colour of each residual channel: that of the state its row of ``C`` measures.
+
+    Row ``i`` of ``C`` with a single nonzero entry, in column ``j``, makes
+    ``r_i`` a multiple of ``e_j`` (without noise), so it gets the colour
+    ``C{j}`` of ``e_j``; other rows get colours after those of the states.
+
+    Parameters
+    ----------
+    C : array_like
+        The output matrix, ``p x n``.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import residual_colors
+    >>> residual_colors([[1, 0, 0], [0, 0, 1]])  # PA9: r1 = e1, r2 = e3
+    ['C0', 'C2']
+    >>> residual_colors([[0, 2, 1], [1, 0, 0]])  # the case study: r1 mixes e2 and e3
+    ['C3', 'C0']
+    """
+    C = np.atleast_2d(np.asarray(C, dtype=float))
+    n = C.shape[1]
+    colours, spare = [], n
+    for row in C:
+        nonzero = np.flatnonzero(row)
+        if nonzero.size == 1:
+            colours.append(f"C{int(nonzero[0])}")
+        else:
+            colours.append(f"C{spare}")
+            spare += 1
+    return colours
+
+
+def _zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
+    """Keep rounding noise on zero: a half-range of at least ``_MIN_SPAN * scale``.
+
+    ``scale`` is the size of the signals ``values`` derive from (the states for
+    an error, the outputs for a residual). Returns True, and writes "zero to
+    rounding" in the panel, when every value is below ``_ROUNDING * scale``.
+    """
+    values = np.asarray(values, dtype=float)
+    if not scale > 0 or values.size == 0 or not np.all(np.isfinite(values)):
+        return False
+    peak = float(np.max(np.abs(values)))
+    half = _MIN_SPAN * scale
+    if peak < half:
+        low, high = ax.get_ylim()
+        if high - low < 2 * half:
+            ax.set_ylim(-half, half)
+    if peak <= _ROUNDING * scale:
+        ax.text(
+            0.02,
+            0.9,
+            f"zero to rounding (largest {peak:.0e})" if peak > 0 else "zero",
+            transform=ax.transAxes,
+            fontsize="small",
+            va="top",
+        )
+        return True
+    return False
 
 
 def symbol(letter: str, i: int, *, hat: bool = False) -> str:
@@ -202,7 +320,8 @@ def plot_channels(
     discrete : bool, optional
         Draw steps (a discrete-time signal).
     **kwargs
-        Further line properties.
+        Further line properties; ``colors`` (a list, one per row) replaces
+        the colours ``C0, C1, ...``.
 
     Examples
     --------
@@ -213,12 +332,17 @@ def plot_channels(
     >>> [line.get_label() for line in ax.lines]
     ['$r_{1}$', '$r_{2}$']
     """
+    colors = kwargs.pop("colors", None)
     for i, row in enumerate(np.atleast_2d(values)):
-        _line(ax, t, row, discrete, label=symbol(letter, i), color=f"C{i}", **kwargs)
+        color = colors[i] if colors is not None else f"C{i}"
+        _line(ax, t, row, discrete, label=symbol(letter, i), color=color, **kwargs)
 
 
 def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     """The estimation error ``e = x - xhat`` of a simulation, one line per state, labelled.
+
+    An error that is zero to rounding (relative to the states) is drawn on
+    zero, and the panel says so.
 
     Parameters
     ----------
@@ -242,10 +366,15 @@ def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     """
     plot_channels(ax, response.time, response.error, "e", discrete=response.plant.is_discrete)
     finish_panel(ax, axis_label("error"), legend)
+    _zero_to_rounding(ax, response.error, _size(response.states))
 
 
 def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     """The output residual ``r = y - C xhat`` of a simulation, one line per output, labelled.
+
+    A channel that measures one state has that state's colour in
+    :func:`plot_error` (``residual_colors``). A residual that is zero to
+    rounding is drawn on zero, and the panel says so.
 
     Parameters
     ----------
@@ -267,8 +396,23 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
     >>> [line.get_label() for line in ax.lines]
     ['$r_{1}$', '$r_{2}$']
     """
-    plot_channels(ax, response.time, response.residual, "r", discrete=response.plant.is_discrete)
+    plot_channels(
+        ax,
+        response.time,
+        response.residual,
+        "r",
+        discrete=response.plant.is_discrete,
+        colors=residual_colors(response.plant.C),
+    )
     finish_panel(ax, axis_label("residual"), legend)
+    _zero_to_rounding(ax, response.residual, _size(response.outputs))
+
+
+def _size(values: np.ndarray) -> float:
+    """The size of a signal: its largest finite magnitude (0 if none)."""
+    values = np.asarray(values, dtype=float)
+    finite = np.abs(values[np.isfinite(values)])
+    return float(finite.max()) if finite.size else 0.0
 
 
 def _figure_and_axes(
@@ -318,7 +462,7 @@ def _actual_and_estimate(
         _line(ax, t, actual, discrete, label=name, color=f"C{i}")
     hat = symbol(letter, i, hat=True)
     _line(ax, t, estimate, discrete, label=hat, color="k", linestyle="--", linewidth=1.0)
-    finish_panel(ax, name)
+    finish_panel(ax, with_unit(name))
 
 
 def plot_response(
@@ -360,8 +504,8 @@ def plot_response(
     >>> resp = ut.simulate(plant, ut.design_uio(plant, poles=[-1, -2, -3]),
     ...                    np.linspace(0, 5, 501), initial_state=[1, 0, 0])
     >>> fig = plot_response(resp)
-    >>> len(fig.axes), sorted(ax.get_ylabel() for ax in fig.axes)[:3]
-    (5, ['$x_{1}$', '$x_{2}$', '$x_{3}$'])
+    >>> len(fig.axes), sorted(ax.get_ylabel() for ax in fig.axes)[:2]
+    (5, ['$x_{1}$ (model units)', '$x_{2}$ (model units)'])
     >>> sorted({ax.get_xlabel() for ax in fig.axes} - {''})
     ['time (s)']
     """
@@ -427,7 +571,7 @@ def plot_input_estimate(
     ...                    np.linspace(0, 5, 501), d=ut.signals.sinusoid())
     >>> fig = plot_input_estimate(ut.reconstruct_input(plant, resp))
     >>> fig.axes[0].get_ylabel()
-    '$d_{1}$'
+    '$d_{1}$ (model units)'
     """
     q = estimate.estimates.shape[0]
     t = estimate.time

@@ -26,9 +26,17 @@ Examples
 True
 """
 
-from ._common import CheckResult
+from ._common import CheckResult, clear_collected, collected
 from .design import pa9_design
 from .plots import pa9_plot
 from .responses import pa9_piecewise, pa9_simulation
 
-__all__ = ["CheckResult", "pa9_design", "pa9_simulation", "pa9_plot", "pa9_piecewise"]
+__all__ = [
+    "CheckResult",
+    "collected",
+    "clear_collected",
+    "pa9_design",
+    "pa9_simulation",
+    "pa9_plot",
+    "pa9_piecewise",
+]

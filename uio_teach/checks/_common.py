@@ -18,7 +18,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["CheckResult"]
+__all__ = ["CheckResult", "collected", "clear_collected"]
 
 _SYMBOL = {True: "✓", False: "✗", None: "•"}
 _COLOUR = {True: "#1a7f37", False: "#cf222e", None: "#57606a"}
@@ -34,6 +34,9 @@ class CheckResult:
     items : iterable of (bool or None, str), optional
         The verdicts: ``True`` for a passed check, ``False`` for a failed one,
         ``None`` for a note that does not count either way.
+    check_id : str, optional
+        A stable name of the check (``"pa9.design"``), the column of a
+        gradebook; the check functions set it.
 
     Attributes
     ----------
@@ -41,6 +44,8 @@ class CheckResult:
         What was checked.
     items : list of (bool or None, str)
         The verdicts, in the order they were made.
+    check_id : str or None
+        The check's stable name.
 
     Notes
     -----
@@ -61,9 +66,15 @@ class CheckResult:
       => 1 of 2 checks failed. Start with the first ✗: later ones often follow from it.
     """
 
-    def __init__(self, title: str, items: Iterable[tuple[bool | None, str]] = ()) -> None:
+    def __init__(
+        self,
+        title: str,
+        items: Iterable[tuple[bool | None, str]] = (),
+        check_id: str | None = None,
+    ) -> None:
         self.title = str(title)
         self.items: list[tuple[bool | None, str]] = [(ok, str(msg)) for ok, msg in items]
+        self.check_id = check_id
 
     def add(self, ok: bool | None, message: str) -> None:
         """Append a verdict.
@@ -114,6 +125,25 @@ class CheckResult:
             "Start with the first ✗: later ones often follow from it."
         )
 
+    def to_dict(self) -> dict[str, Any]:
+        """The result as JSON-compatible data: ``check_id``, ``title``, ``passed``, ``items``.
+
+        Each item is ``{"ok": True, False or None, "message": str}``.
+
+        Examples
+        --------
+        >>> from uio_teach.checks import CheckResult
+        >>> CheckResult("demo", [(True, "H is right.")], check_id="pa9.design").to_dict()
+        {'check_id': 'pa9.design', 'title': 'demo', 'passed': True, 'items': [{'ok': True, \
+'message': 'H is right.'}]}
+        """
+        return {
+            "check_id": self.check_id,
+            "title": self.title,
+            "passed": self.passed,
+            "items": [{"ok": ok, "message": msg} for ok, msg in self.items],
+        }
+
     def __bool__(self) -> bool:
         return self.passed
 
@@ -140,17 +170,69 @@ class CheckResult:
 
 _F = TypeVar("_F", bound=Callable[..., CheckResult])
 
+_COLLECTED: list[CheckResult] = []
+_LAB_PREFIXES = ("case_study", "missile", "pa9")
 
-def _never_raises(title: str) -> Callable[[_F], _F]:
-    """Turn any unexpected exception of a check into a ✗ message instead of a traceback."""
+
+def collected() -> list[CheckResult]:
+    """Every result the check functions returned in this process, in order.
+
+    A grader runs a notebook and reads this list at the end (see
+    :func:`clear_collected`).
+
+    Returns
+    -------
+    list of CheckResult
+        A copy; the results themselves are shared.
+
+    Examples
+    --------
+    >>> from uio_teach import checks
+    >>> checks.clear_collected()
+    >>> _ = checks.pa9_design(None, None, None)
+    >>> [(r.check_id, r.passed) for r in checks.collected()]
+    [('pa9.design', False)]
+    """
+    return list(_COLLECTED)
+
+
+def clear_collected() -> None:
+    """Forget the results :func:`collected` returns.
+
+    Examples
+    --------
+    >>> from uio_teach import checks
+    >>> checks.clear_collected()
+    >>> checks.collected()
+    []
+    """
+    _COLLECTED.clear()
+
+
+def _default_check_id(name: str) -> str:
+    """``pa9_design`` -> ``pa9.design``: the lab's id, a dot, the rest of the function's name."""
+    for prefix in _LAB_PREFIXES:
+        if name.startswith(prefix + "_"):
+            return f"{prefix}.{name[len(prefix) + 1 :]}"
+    return name
+
+
+def _never_raises(title: str, check_id: str | None = None) -> Callable[[_F], _F]:
+    """Turn any unexpected exception of a check into a ✗ message instead of a traceback.
+
+    The result gets ``check_id`` (default: from the function's name, ``pa9_design`` ->
+    ``pa9.design``) and is recorded for :func:`collected`.
+    """
 
     def decorate(func: _F) -> _F:
+        ident = check_id or _default_check_id(func.__name__)
+
         @functools.wraps(func)
         def wrapper(*args: Any, **kwargs: Any) -> CheckResult:
             try:
-                return func(*args, **kwargs)
+                result = func(*args, **kwargs)
             except Exception as exc:  # a student must never see a traceback here
-                return CheckResult(
+                result = CheckResult(
                     title,
                     [
                         (
@@ -161,6 +243,11 @@ def _never_raises(title: str) -> Callable[[_F], _F]:
                         )
                     ],
                 )
+            if isinstance(result, CheckResult):
+                if result.check_id is None:
+                    result.check_id = ident
+                _COLLECTED.append(result)
+            return result
 
         return wrapper  # type: ignore[return-value]
 

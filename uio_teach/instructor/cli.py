@@ -1,4 +1,4 @@
-"""The instructor's command line: ``uio-teach figures`` and ``uio-teach labs``.
+"""The instructor's command line: ``uio-teach figures``, ``uio-teach labs`` and ``uio-teach grade``.
 
 Run it as ``python -m uio_teach ...`` or, once the package is installed, as
 ``uio-teach ...``. :func:`main` takes the arguments as a list and returns the
@@ -26,6 +26,7 @@ import os
 import sys
 import time
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TextIO
 
 __all__ = ["main", "build_parser"]
@@ -35,9 +36,10 @@ PROG = "uio-teach"
 _MAIN_DESCRIPTION = """\
 Instructor tools of the course "Unknown Input Observers".
 
-Two commands:
+Three commands:
   figures   regenerate every figure of the course (and Table II of the missile paper)
   labs      write the lab notebooks, a student version and a solution version
+  grade     run the notebooks the groups handed in and write a gradebook (CSV)
 
 Run `uio-teach COMMAND --help` for the options of each command.
 """
@@ -47,6 +49,7 @@ examples:
   uio-teach figures --out handout/figures
   uio-teach figures --out handout/figures --config term.toml --format pdf
   uio-teach labs --out handout/labs
+  uio-teach grade submissions/*.ipynb --out grades.csv
 
 exit status:
   0 everything was written, 1 something could not be made or written,
@@ -67,9 +70,16 @@ Regenerate the figures of the course into one folder:
     unknown inputs v1 and v2, and Table II (catch times within 2 % of the
     signal's peak, next to the paper's) as missile_table2.csv and .md.
 
-The files are named after the figures (`--list`), e.g. DIR/pa9_sine.png.
-The same command gives byte-identical files: the noise is seeded and no time
-stamp is written into PNG, PDF or SVG files.
+The files are named after the figures (`--list`), e.g. DIR/pa9_sine.png,
+with DIR/manifest.json (the configuration as used and its hash, the versions,
+each file's SHA-256). The same command gives byte-identical files: the noise
+is seeded and no time stamp is written into PNG, PDF or SVG files.
+
+All or nothing: the files are written into a temporary folder beside DIR,
+which replaces DIR only when every figure was made. A failed or interrupted
+run leaves DIR as it was; a good run leaves only its own files (with --only,
+just those figures). DIR is replaced only if it is empty or holds an earlier
+output (its manifest.json); any other folder is left alone (exit status 1).
 
 The parameters that change from one term to the next (disturbances, observer
 poles, noise level, seed, matplotlib style) are read from a TOML file given
@@ -97,9 +107,9 @@ a configuration file (term.toml):
   values = [1.0, -2.0, 0.5]
 
 exit status:
-  0 all figures written, 1 a figure or the output folder failed,
-  2 a usage or configuration error (unknown key, wrong type, wrong pole count,
-  unstable pole).
+  0 all figures written, 1 a figure or the output folder failed (nothing
+  written), 2 a usage or configuration error (unknown key, wrong type, a value
+  out of its range, wrong pole count, unstable pole), one line per problem.
 """
 
 _LABS_DESCRIPTION = """\
@@ -128,6 +138,37 @@ exit status:
 """
 
 
+_GRADE_DESCRIPTION = """\
+Grade the lab notebooks the groups handed in. Each one is run on a copy (the
+submission is only read), in a fresh kernel, with its stored outputs cleared,
+so only what its code does now counts. With --groups-from, the cell tagged
+`parameters` is replaced by the group's parameters from the answer key (the
+group comes from the notebook's metadata, else from a name like pa9_g03.ipynb).
+The cells tagged `check` are re-run and their verdicts recorded; a cell that
+raises or runs too long is noted and the rest still runs, and a notebook over
+the time limit is killed and graded as it stands.
+
+Writes FILE (one row per submission: file, lab, group, status, one column per
+check with ✓ or ✗, total and out_of) and FILE's stem + _feedback/, one text
+per submission with every check message and error.
+
+GRADING RUNS THE STUDENTS' CODE with your permissions: it can read and delete
+what you can. Run it in a container or as a user that owns nothing else (see
+the instructors' page of the book).
+"""
+
+_GRADE_EPILOG = """\
+examples:
+  uio-teach grade handed_in/*.ipynb --out grades.csv
+  uio-teach grade handed_in/*.ipynb --out grades.csv --groups-from labs/answer_key.csv
+  uio-teach grade handed_in/*.ipynb --out grades.csv --timeout 600 --cell-timeout 120
+
+exit status:
+  0 every submission graded (whatever its grade), 1 the gradebook could not be
+  written, 2 a usage error (no such submission, unreadable answer key).
+"""
+
+
 class _Formatter(argparse.RawDescriptionHelpFormatter):
     def __init__(self, prog: str) -> None:
         super().__init__(prog, max_help_position=30, width=88)
@@ -141,6 +182,32 @@ def _positive_int(text: str) -> int:
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
     return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text}")
+    return value
+
+
+def _dpi(text: str) -> int:
+    from .config import DPI_RANGE, ConfigError, check_dpi
+
+    try:
+        value = int(text)
+    except ValueError:
+        low, high = DPI_RANGE
+        raise argparse.ArgumentTypeError(
+            f"expected an integer between {low} and {high}, got {text!r}"
+        ) from None
+    try:
+        return check_dpi(value)
+    except ConfigError as err:
+        raise argparse.ArgumentTypeError(str(err).removeprefix("dpi: ")) from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -158,6 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     ('figures', 'figs', 'svg', 150)
     """
     from .. import __version__
+    from .config import DPI_RANGE
     from .output import FORMATS
 
     parser = argparse.ArgumentParser(
@@ -191,7 +259,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="make only these figures (names from --list)",
     )
     fig.add_argument(
-        "--dpi", type=_positive_int, default=150, metavar="N", help="resolution (default: 150)"
+        "--dpi",
+        type=_dpi,
+        default=150,
+        metavar="N",
+        help=f"resolution, {DPI_RANGE[0]} to {DPI_RANGE[1]} (default: 150)",
     )
     fig.add_argument(
         "--config", metavar="FILE", help="TOML file with this term's parameters (see below)"
@@ -227,6 +299,36 @@ def build_parser() -> argparse.ArgumentParser:
         help="convert these lab chapters only (default: every *lab*.md of the book)",
     )
     labs.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+
+    grade = commands.add_parser(
+        "grade",
+        help="run handed-in notebooks and write a gradebook (runs the students' code)",
+        description=_GRADE_DESCRIPTION,
+        epilog=_GRADE_EPILOG,
+        formatter_class=_Formatter,
+    )
+    grade.add_argument("submissions", nargs="+", metavar="NOTEBOOK", help="submitted .ipynb files")
+    grade.add_argument("--out", metavar="FILE", required=True, help="the gradebook CSV to write")
+    grade.add_argument(
+        "--groups-from",
+        metavar="KEY",
+        help="answer_key.csv of `uio-teach labs --groups`: run each with its group's parameters",
+    )
+    grade.add_argument(
+        "--timeout",
+        type=_positive_float,
+        default=300.0,
+        metavar="S",
+        help="seconds a notebook may run in all (default: 300)",
+    )
+    grade.add_argument(
+        "--cell-timeout",
+        type=_positive_float,
+        default=60.0,
+        metavar="S",
+        help="seconds a cell may run before it is interrupted (default: 60)",
+    )
+    grade.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     return parser
 
 
@@ -256,10 +358,14 @@ def _figures(args: argparse.Namespace) -> int:
     try:
         config = figures.load_config(args.config)
     except figures.ConfigError as err:
-        _error("figures", str(err))
+        for problem in err.problems:
+            _error("figures", problem)
         return 2
+    from .output import check_output_folder
+
+    out = args.out
     try:
-        out = figures.prepare_output_dir(args.out)
+        check_output_folder(out)
     except OSError as err:
         _error("figures", str(err))
         return 1
@@ -279,18 +385,27 @@ def _figures(args: argparse.Namespace) -> int:
             print(f"{count} {result.name}: {files} ({result.seconds:.1f} s)")
             sys.stdout.flush()
 
-    results = figures.generate(
-        out, args.only, fmt=args.format, dpi=args.dpi, config=config, progress=progress
-    )
+    try:
+        results = figures.generate(
+            out, args.only, fmt=args.format, dpi=args.dpi, config=config, progress=progress
+        )
+    except OSError as err:
+        _error("figures", str(err) if isinstance(err, figures.OutputError) else f"{out}: {err}")
+        return 1
     elapsed = time.perf_counter() - start
     failed = [r.name for r in results if not r.ok]
     files = sum(len(r.paths) for r in results)
     done = len(results) - len(failed)
-    summary = f"{done} of {len(results)} figures ({files} files) written to {os.fspath(out)}"
-    summary += f" in {elapsed:.1f} s"
     if failed:
-        _error("figures", f"{summary}; failed: {', '.join(failed)}")
+        left = "left as it was" if os.path.isdir(out) else "not created"
+        _error(
+            "figures",
+            f"{done} of {len(results)} figures made, failed: {', '.join(failed)}; nothing was "
+            f"written, {os.fspath(out)} {left}",
+        )
         return 1
+    summary = f"{done} of {len(results)} figures ({files} files) and {figures.MANIFEST} "
+    summary += f"written to {os.fspath(out)} in {elapsed:.1f} s"
     if not args.quiet:
         print(summary)
     return 0
@@ -332,6 +447,58 @@ def _labs(args: argparse.Namespace) -> int:
     return 0
 
 
+def _grade(args: argparse.Namespace) -> int:
+    from . import grade
+
+    missing = [p for p in args.submissions if not os.path.isfile(p)]
+    if missing:
+        _error("grade", f"no such submission: {', '.join(missing)}")
+        return 2
+    start = time.perf_counter()
+
+    def progress(index: int, total: int, sub: grade.Submission) -> None:
+        if not args.quiet:
+            verdicts = sub.verdicts()
+            print(
+                f"[{index}/{total}] {sub.file}: lab {sub.lab or '?'}, group {sub.group or '?'}, "
+                f"{sub.total} of {len(verdicts)} checks passed, {sub.status} "
+                f"({sub.seconds:.1f} s)"
+            )
+            sys.stdout.flush()
+
+    try:
+        results = grade.grade(
+            args.submissions,
+            args.out,
+            answer_key=args.groups_from,
+            timeout=args.timeout,
+            cell_timeout=args.cell_timeout,
+            progress=progress,
+        )
+    except ImportError as err:
+        _error(
+            "grade",
+            f"grading needs {err.name or err}, which is not installed: "
+            "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)",
+        )
+        return 1
+    except grade.GradeError as err:
+        _error("grade", str(err))
+        return 2
+    except OSError as err:
+        _error("grade", f"cannot write the gradebook {args.out}: {err.strerror or err}")
+        return 1
+    if not args.quiet:
+        elapsed = time.perf_counter() - start
+        out = Path(args.out)
+        feedback = out.with_name(f"{out.stem}_feedback")
+        print(
+            f"{len(results)} submission{'s' if len(results) != 1 else ''} graded in "
+            f"{elapsed:.1f} s: {out}, feedback in {feedback}"
+        )
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``uio-teach`` with the arguments ``argv`` (default: the command line).
 
@@ -362,6 +529,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "figures":
             return _figures(args)
+        if args.command == "grade":
+            return _grade(args)
         return _labs(args)
     except KeyboardInterrupt:
         _error(args.command, "interrupted")

@@ -29,11 +29,61 @@ from typing import Any
 from .._display import format_poles
 from ..experiments import CASE_STUDY, MISSILE, PA9
 
-__all__ = ["ConfigError", "FigureConfig", "load_config", "default_config_toml"]
+__all__ = [
+    "ConfigError",
+    "FigureConfig",
+    "load_config",
+    "default_config_toml",
+    "check_dpi",
+    "DPI_RANGE",
+    "MAX_SAMPLES",
+]
 
 
 class ConfigError(ValueError):
-    """A configuration file that cannot be used; the message is one line and names the key."""
+    """A configuration that cannot be used: one line per problem, each naming its key.
+
+    Parameters
+    ----------
+    *problems : str
+        One message per problem (the first is the exception's message when
+        there is only one).
+
+    Attributes
+    ----------
+    problems : list of str
+        Every problem found, one line each, in the order of the file.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import ConfigError
+    >>> err = ConfigError("seed: must be >= 0, got -1", "pa9.samples: must be <= 200000")
+    >>> print(err)
+    seed: must be >= 0, got -1
+    pa9.samples: must be <= 200000
+    >>> err.problems[1]
+    'pa9.samples: must be <= 200000'
+    """
+
+    def __init__(self, *problems: str) -> None:
+        self.problems = [" ".join(str(p).split()) for p in problems]
+        super().__init__("\n".join(self.problems))
+
+
+MAX_SEED = 2**32 - 1
+"""The largest seed (numpy's legacy seeds and most tools take 32 bits)."""
+MAX_SAMPLES = 200_000
+"""The most time points of a continuous-time run (3 states: a few MB per signal)."""
+MAX_STEPS = 100_000
+"""The most steps of the discrete-time case study."""
+MAX_DURATION = 10_000.0
+"""The longest simulated time, in s."""
+MAX_VALUE = 1e6
+"""The largest magnitude of an amplitude, a level, a noise level or an initial state entry."""
+MAX_POLE = 1e5
+"""The largest magnitude of a continuous-time pole (faster ones need a finer grid than allowed)."""
+DPI_RANGE = (20, 1200)
+"""The resolutions ``uio-teach figures --dpi`` accepts (both ends included)."""
 
 
 @dataclass(frozen=True)
@@ -42,6 +92,7 @@ class _Option:
     default: Any
     help: str
     minimum: float | None = None  # inclusive lower bound (numbers)
+    maximum: float | None = None  # inclusive upper bound (numbers; |x| for "floats"/"float")
     positive: bool = False  # strictly positive (numbers)
     length: int | None = None  # exact length (lists)
     optional: bool = False  # may be absent (default None)
@@ -52,6 +103,8 @@ _SCHEMA: dict[str, _Option] = {
         "int",
         CASE_STUDY.seed,
         "seed of every random number: PA9's measurement noise, the case study's v",
+        minimum=0,
+        maximum=MAX_SEED,
     ),
     "style": _Option(
         "str",
@@ -59,23 +112,42 @@ _SCHEMA: dict[str, _Option] = {
         "matplotlib style: a name of matplotlib.style.available or a .mplstyle file",
     ),
     "pa9.poles": _Option("poles", list(PA9.poles), "UIO poles (also the Luenberger poles)"),
-    "pa9.duration": _Option("float", PA9.duration, "simulated time in s", positive=True),
-    "pa9.samples": _Option("int", PA9.timepts.size, "number of time points", minimum=2),
+    "pa9.duration": _Option(
+        "float", PA9.duration, "simulated time in s", positive=True, maximum=MAX_DURATION
+    ),
+    "pa9.samples": _Option(
+        "int", PA9.timepts.size, "number of time points", minimum=2, maximum=MAX_SAMPLES
+    ),
     "pa9.initial_state": _Option(
-        "floats", PA9.initial_state.tolist(), "plant state x(0)", length=3
+        "floats", PA9.initial_state.tolist(), "plant state x(0)", length=3, maximum=MAX_VALUE
     ),
     "pa9.noise": _Option(
-        "float", 0.0, "standard deviation of the measurement noise (0: none)", minimum=0.0
+        "float",
+        0.0,
+        "standard deviation of the measurement noise (0: none)",
+        minimum=0.0,
+        maximum=MAX_VALUE,
     ),
-    "pa9.sine.amplitude": _Option("float", PA9.sine_amplitude, "d(t) = amplitude sin(frequency t)"),
+    "pa9.sine.amplitude": _Option(
+        "float", PA9.sine_amplitude, "d(t) = amplitude sin(frequency t)", maximum=MAX_VALUE
+    ),
     "pa9.sine.frequency": _Option(
-        "float", PA9.sine_frequency, "angular frequency in rad/s", positive=True
+        "float",
+        PA9.sine_frequency,
+        "angular frequency in rad/s, below the time grid's Nyquist frequency",
+        positive=True,
     ),
     "pa9.piecewise.times": _Option(
-        "floats", list(PA9.switch_times), "switching times in s, increasing", minimum=0.0
+        "floats",
+        list(PA9.switch_times),
+        "switching times in s, increasing, within the duration",
+        minimum=0.0,
     ),
     "pa9.piecewise.values": _Option(
-        "floats", list(PA9.switch_values), "the level held from each switching time"
+        "floats",
+        list(PA9.switch_values),
+        "the level held from each switching time",
+        maximum=MAX_VALUE,
     ),
     "case_study.poles": _Option(
         "poles",
@@ -84,31 +156,51 @@ _SCHEMA: dict[str, _Option] = {
         optional=True,
     ),
     "case_study.steps": _Option(
-        "int", int(CASE_STUDY.duration), "number of steps k = 0 ... steps", minimum=2
+        "int",
+        int(CASE_STUDY.duration),
+        "number of steps k = 0 ... steps",
+        minimum=2,
+        maximum=MAX_STEPS,
     ),
     "case_study.initial_state": _Option(
-        "floats", CASE_STUDY.initial_state.tolist(), "plant state x[0]", length=3
+        "floats",
+        CASE_STUDY.initial_state.tolist(),
+        "plant state x[0]",
+        length=3,
+        maximum=MAX_VALUE,
     ),
     "case_study.u2.amplitude": _Option(
-        "float", CASE_STUDY.u2_amplitude, "u2[k] = amplitude sin(frequency k)"
+        "float",
+        CASE_STUDY.u2_amplitude,
+        "u2[k] = amplitude sin(frequency k)",
+        maximum=MAX_VALUE,
     ),
     "case_study.u2.frequency": _Option(
-        "float", CASE_STUDY.u2_frequency, "angular frequency in rad per step", positive=True
+        "float",
+        CASE_STUDY.u2_frequency,
+        "angular frequency in rad per step, at most pi",
+        positive=True,
+        maximum=math.pi,
     ),
     "case_study.v.amplitude": _Option(
         "float",
         CASE_STUDY.v_amplitude,
         "v: a random staircase, levels uniform in [-amplitude, amplitude]",
         minimum=0,
+        maximum=MAX_VALUE,
     ),
     "case_study.v.hold": _Option(
-        "int", CASE_STUDY.v_hold, "steps each level of v is held", minimum=1
+        "int", CASE_STUDY.v_hold, "steps each level of v is held", minimum=1, maximum=MAX_STEPS
     ),
     "missile.pmo_poles": _Option(
         "poles", list(MISSILE.poles), "PMO poles (the paper's are not given; see chapter 5)"
     ),
-    "missile.duration": _Option("float", 0.3, "simulated time in s", positive=True),
-    "missile.samples": _Option("int", 6001, "number of time points", minimum=2),
+    "missile.duration": _Option(
+        "float", 0.3, "simulated time in s", positive=True, maximum=MAX_DURATION
+    ),
+    "missile.samples": _Option(
+        "int", 6001, "number of time points", minimum=2, maximum=MAX_SAMPLES
+    ),
 }
 
 _DISCRETE_POLES = {"case_study.poles"}
@@ -160,6 +252,14 @@ def _bounds(key: str, opt: _Option, x: float) -> None:
         raise ConfigError(f"{key}: must be > 0, got {x:g}")
     if opt.minimum is not None and x < opt.minimum:
         raise ConfigError(f"{key}: must be >= {opt.minimum:g}, got {x:g}")
+    if opt.maximum is not None:
+        if opt.kind == "int" or opt.minimum is not None or opt.positive:
+            if x > opt.maximum:
+                raise ConfigError(f"{key}: must be <= {opt.maximum:g}, got {x:g}")
+        elif abs(x) > opt.maximum:
+            raise ConfigError(
+                f"{key}: must be between -{opt.maximum:g} and {opt.maximum:g}, got {x:g}"
+            )
 
 
 def _pole(key: str, value: Any) -> complex:
@@ -205,6 +305,12 @@ def _check_value(key: str, opt: _Option, value: Any) -> Any:
     # poles
     poles = tuple(_pole(f"{key}[{i}]", v) for i, v in enumerate(value))
     discrete = key in _DISCRETE_POLES
+    for z in poles:
+        if not discrete and abs(z) > MAX_POLE:
+            raise ConfigError(
+                f"{key}: the pole {format_poles([z], 6)} is faster than {MAX_POLE:g} rad/s, "
+                "more than the time grid can follow"
+            )
     for z in poles:
         if discrete and not abs(z) < 1:
             raise ConfigError(
@@ -259,8 +365,16 @@ class FigureConfig(Mapping[str, Any]):
         self.source = source
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], source: str = "<dict>") -> FigureConfig:
+    def from_dict(
+        cls,
+        data: Mapping[str, Any],
+        source: str = "<dict>",
+        base: str | os.PathLike[str] | None = None,
+    ) -> FigureConfig:
         """Validate a nested dict (the parsed TOML) and fill in the defaults.
+
+        Every key and value is checked, and every problem is reported at
+        once, one line each.
 
         Parameters
         ----------
@@ -269,6 +383,10 @@ class FigureConfig(Mapping[str, Any]):
             ``{"pa9": {"poles": [-2, -3, -4]}}``.
         source : str
             Name of the origin, put in front of error messages.
+        base : str or path-like, optional
+            The folder that relative file names (``style = "x.mplstyle"``)
+            are read from: the configuration file's folder. Default: the
+            current folder.
 
         Returns
         -------
@@ -277,9 +395,10 @@ class FigureConfig(Mapping[str, Any]):
         Raises
         ------
         ConfigError
-            An unknown key, a value of the wrong type, a bad length, an
-            unstable pole, or poles an observer cannot have (wrong count,
-            missing conjugate, ...). The message is one line.
+            An unknown key, a value of the wrong type or out of its range, a
+            bad length, an unstable or repeated pole, or poles an observer
+            cannot have (wrong count, missing conjugate, ...). One line per
+            problem, all of them (``err.problems``).
 
         Examples
         --------
@@ -290,53 +409,90 @@ class FigureConfig(Mapping[str, Any]):
         ...     print(str(err).split(": a ")[0])
         term.toml: pa9.poles: the pole 1 is unstable
         """
-        try:
-            values = {}
-            for key, value in _flatten(data):
+        problems: list[str] = []
+        values: dict[str, Any] = {}
+        for key, value in _flatten(data):
+            try:
                 if key in _SECTION_HELP:
                     raise ConfigError(f"{key}: expected a table [{key}], got {_describe(value)}")
                 if key not in _SCHEMA:
                     raise ConfigError(_unknown_key(key, isinstance(value, dict)))
                 values[key] = _check_value(key, _SCHEMA[key], value)
-            cfg = cls(values, source)
-            cfg._check_relations()
-            cfg._check_designs()
-        except ConfigError as err:
-            raise ConfigError(f"{source}: {err}") from None
+            except ConfigError as err:
+                problems += err.problems
+        if "style" in values:
+            values["style"] = _resolve_style(values["style"], base)
+        bad = {p.split(":", 1)[0].split("[", 1)[0] for p in problems}
+        cfg = cls({k: v for k, v in values.items() if k not in bad}, source)
+        problems += cfg._check_relations(skip=bad)
+        problems += cfg._check_designs(skip=bad)
+        if problems:
+            raise ConfigError(*(f"{source}: {p}" for p in problems))
         return cfg
 
-    def _check_relations(self) -> None:
+    def _check_relations(self, skip: set[str] = frozenset()) -> list[str]:
+        """Problems between keys (lengths, order, Nyquist, files); keys in ``skip`` are bad."""
+        problems = []
         times, values = self["pa9.piecewise.times"], self["pa9.piecewise.values"]
-        if len(times) != len(values):
-            raise ConfigError(
-                f"pa9.piecewise: times and values must have the same length, got {len(times)} "
-                f"and {len(values)}"
-            )
-        if any(b <= a for a, b in zip(times, times[1:], strict=False)):
-            raise ConfigError(f"pa9.piecewise.times: must be strictly increasing, got {times}")
+        if not {"pa9.piecewise.times", "pa9.piecewise.values"} & skip:
+            if len(times) != len(values):
+                problems.append(
+                    f"pa9.piecewise: times and values must have the same length, got "
+                    f"{len(times)} and {len(values)}"
+                )
+        if "pa9.piecewise.times" not in skip:
+            if any(b <= a for a, b in zip(times, times[1:], strict=False)):
+                problems.append(f"pa9.piecewise.times: must be strictly increasing, got {times}")
+            elif "pa9.duration" not in skip and times and times[-1] >= self["pa9.duration"]:
+                problems.append(
+                    f"pa9.piecewise.times: {times[-1]:g} s is not before the end of the run "
+                    f"(pa9.duration = {self['pa9.duration']:g} s)"
+                )
+        if not {"pa9.samples", "pa9.duration", "pa9.sine.frequency"} & skip:
+            nyquist = math.pi * (self["pa9.samples"] - 1) / self["pa9.duration"]
+            if self["pa9.sine.frequency"] >= nyquist / 4:
+                problems.append(
+                    f"pa9.sine.frequency: {self['pa9.sine.frequency']:g} rad/s is too fast for "
+                    f"the time grid (pa9.samples over pa9.duration): keep it below "
+                    f"{nyquist / 4:.4g} rad/s, a quarter of the grid's Nyquist frequency"
+                )
+        if not {"case_study.v.hold", "case_study.steps"} & skip:
+            if self["case_study.v.hold"] > self["case_study.steps"]:
+                problems.append(
+                    f"case_study.v.hold: {self['case_study.v.hold']} steps is longer than the run "
+                    f"(case_study.steps = {self['case_study.steps']})"
+                )
         style = self["style"]
         import matplotlib.style
 
-        if style not in matplotlib.style.available and style != "default":
+        if "style" not in skip and style not in matplotlib.style.available and style != "default":
             path = Path(style)
-            if not (path.suffix == ".mplstyle" and path.is_file()):
+            if path.suffix == ".mplstyle" or os.sep in style or "/" in style:
+                if not path.is_file():
+                    problems.append(f"style: no such file {style}")
+            else:
                 close = difflib.get_close_matches(style, matplotlib.style.available, 1)
                 hint = f" (did you mean {close[0]!r}?)" if close else ""
-                raise ConfigError(
+                problems.append(
                     f"style: {style!r} is neither a matplotlib style nor a .mplstyle file{hint}"
                 )
+        return problems
 
-    def _check_designs(self) -> None:
+    def _check_designs(self, skip: set[str] = frozenset()) -> list[str]:
         """Design every observer once, so that bad poles are reported before any work."""
+        problems = []
         for key in ("pa9.poles", "case_study.poles", "missile.pmo_poles"):
+            if key in skip:
+                continue
             try:
                 _design(self, key)
             except ConfigError as err:
-                raise ConfigError(f"{key}: {err}") from None
+                problems += [f"{key}: {p}" for p in err.problems]
             except ValueError as err:
                 text = " ".join(str(err).split())
                 text = text.removeprefix("poles: ")
-                raise ConfigError(f"{key}: {text}") from None
+                problems.append(f"{key}: {text}")
+        return problems
 
     def __getitem__(self, key: str) -> Any:
         return self._values[key]
@@ -357,6 +513,52 @@ class FigureConfig(Mapping[str, Any]):
             k: (None if o.default is None else _check_value(k, o, o.default))
             for k, o in _SCHEMA.items()
         }
+
+
+def _resolve_style(style: str, base: str | os.PathLike[str] | None) -> str:
+    """A style file named relative to the configuration file, as an absolute path."""
+    if style.endswith(".mplstyle") or "/" in style or os.sep in style:
+        path = Path(style).expanduser()
+        if not path.is_absolute() and base is not None:
+            path = Path(base) / path
+        return os.fspath(path.resolve())
+    return style
+
+
+def check_dpi(dpi: object) -> int:
+    """The resolution ``dpi`` as an int, if it is within :data:`DPI_RANGE`.
+
+    Parameters
+    ----------
+    dpi : int
+        Dots per inch.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ConfigError
+        Not an integer, or outside :data:`DPI_RANGE`.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import check_dpi, ConfigError
+    >>> check_dpi(150)
+    150
+    >>> try:
+    ...     check_dpi(100000)
+    ... except ConfigError as err:
+    ...     print(err)
+    dpi: must be between 20 and 1200, got 100000
+    """
+    low, high = DPI_RANGE
+    if isinstance(dpi, bool) or not isinstance(dpi, int):
+        raise ConfigError(f"dpi: expected an integer between {low} and {high}, got {dpi!r}")
+    if not low <= dpi <= high:
+        raise ConfigError(f"dpi: must be between {low} and {high}, got {dpi}")
+    return dpi
 
 
 def _unknown_key(key: str, table: bool = False) -> str:
@@ -385,8 +587,9 @@ def load_config(path: str | os.PathLike[str] | None = None) -> FigureConfig:
     Raises
     ------
     ConfigError
-        The file cannot be read, is not valid TOML, or has a bad value (the
-        message is one line, starting with the file name).
+        The file cannot be read, is not valid TOML, or has bad values (one
+        line per problem, each starting with the file name). A style file is
+        looked up relative to the configuration file's folder.
 
     Examples
     --------
@@ -410,7 +613,7 @@ def load_config(path: str | os.PathLike[str] | None = None) -> FigureConfig:
         raise ConfigError(f"{name}: cannot read it ({err.strerror or err})") from None
     except tomllib.TOMLDecodeError as err:
         raise ConfigError(f"{name}: not valid TOML: {' '.join(str(err).split())}") from None
-    return FigureConfig.from_dict(data, source=name)
+    return FigureConfig.from_dict(data, source=name, base=Path(path).resolve().parent)
 
 
 def _toml_value(value: Any) -> str:

@@ -46,21 +46,40 @@ import numpy as np
 from .._display import format_poles
 from ..experiments import CASE_STUDY, MISSILE, PA9
 from ..plotting import (
+    _zero_to_rounding,
     finish_panel,
     new_figure,
     plot_error,
     plot_residual,
+    residual_colors,
     symbol,
     time_label,
+    with_unit,
 )
-from .config import ConfigError, FigureConfig, _design, default_config_toml, load_config
-from .output import FORMATS, OutputError, prepare_output_dir, save_figure
+from .config import (
+    ConfigError,
+    FigureConfig,
+    _design,
+    check_dpi,
+    default_config_toml,
+    load_config,
+)
+from .output import (
+    FORMATS,
+    MANIFEST,
+    OutputError,
+    StagedFolder,
+    prepare_output_dir,
+    save_figure,
+    write_manifest,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
 __all__ = [
     "FORMATS",
+    "MANIFEST",
     "FIGURES",
     "FigureSpec",
     "FigureResult",
@@ -71,6 +90,7 @@ __all__ = [
     "default_config_toml",
     "prepare_output_dir",
     "save_figure",
+    "check_dpi",
     "generate",
 ]
 
@@ -193,7 +213,7 @@ def _pa9_disturbance(runs: _Runs, which: str) -> Figure:
     ax_d.plot(t, resp.inputs.d[0], color="k")
     formula = repr(d)
     ax_d.set_title(f"d(t) = {formula if len(formula) <= 80 else formula[:77] + '...'}")
-    finish_panel(ax_d, "disturbance $d$", legend=False)
+    finish_panel(ax_d, with_unit("disturbance $d$"), legend=False)
     plot_error(ax_e, resp)
     plot_residual(ax_r, resp)
     ax_r.set_xlabel(time_label(resp.plant.dt))
@@ -231,9 +251,14 @@ def _pa9_luenberger(runs: _Runs) -> Figure:
         ):
             ax = axes[row, col]
             values = getattr(sine, what)
+            colors = (
+                residual_colors(sine.plant.C)
+                if what == "residual"
+                else [f"C{i}" for i in range(values.shape[0])]
+            )
             for i in range(values.shape[0]):
-                ax.plot(sine.time, values[i], color=f"C{i}", label=symbol(sym, i))
-                ax.plot(steps.time, getattr(steps, what)[i], color=f"C{i}", linestyle="--")
+                ax.plot(sine.time, values[i], color=colors[i], label=symbol(sym, i))
+                ax.plot(steps.time, getattr(steps, what)[i], color=colors[i], linestyle="--")
             finish_panel(ax, label)
         axes[0, col].set_title(name)
         axes[1, col].set_xlabel(time_label(r["plant"].dt))
@@ -265,7 +290,7 @@ def _case_error(runs: _Runs) -> Figure:
     if rho > 0:
         ax.semilogy(k, norm[0] * rho**k, "--", label=rf"$\|e[0]\|\,{rho:.3g}^k$")
     ax.set_xlabel(time_label(True))  # the case study counts steps k
-    finish_panel(ax, r"$\|e[k]\|_2$")
+    finish_panel(ax, with_unit(r"$\|e[k]\|_2$"))
     ax.set_title("Case study: the estimation error ignores both unknown signals")
     return fig
 
@@ -281,7 +306,7 @@ def _missile_states(runs: _Runs, name: str, label: str, figs: str) -> Figure:
         ax.plot(t, free.states[i], color="tab:green", label=f"{symbol('x', i)} without $v$")
         hat = symbol("x", i, hat=True)
         ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=hat)
-        finish_panel(ax, symbol("x", i))
+        finish_panel(ax, with_unit(symbol("x", i)))
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle(
@@ -303,10 +328,15 @@ def _missile_error(runs: _Runs) -> Figure:
     fig = new_figure(9.0, 6.0)
     axes = fig.subplots(2, 2, sharex=True)
     for i, ax in enumerate(axes.flat):
+        errors = []
         for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", "--")):
             resp = m[name]["response"]
             ax.plot(resp.time, resp.error[i], linestyle=style, label=label)
-        finish_panel(ax, rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$")
+            errors.append(resp.error[i])
+        finish_panel(ax, with_unit(rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$"))
+        # a measured state is estimated exactly: its error is rounding noise, shown on zero
+        scale = float(np.max(np.abs(m["pmo"]["response"].states[i])))
+        _zero_to_rounding(ax, np.array(errors), scale)
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle("Missile autopilot: estimation error of both observers")
@@ -325,7 +355,7 @@ def _missile_inputs(runs: _Runs) -> Figure:
             est = m[name]["inputs"].estimates[i]
             hat = symbol("v", i, hat=True)
             ax.plot(t, est, color="k", linestyle=style, lw=1.2, label=f"{hat} {label}")
-        finish_panel(ax, symbol("v", i))
+        finish_panel(ax, with_unit(symbol("v", i)))
         lim = 1.3 * float(np.max(np.abs(actual[i])))
         ax.set_ylim(-lim, lim)
     axes[-1].set_xlabel(time_label(m["plant"].dt))
@@ -521,19 +551,26 @@ def generate(
 ) -> list[FigureResult]:
     """Make the figures ``names`` (all by default) into the folder ``out``.
 
-    A figure that fails is reported in its :class:`FigureResult` and the
-    others are still made.
+    All or nothing: the files are written into a temporary folder beside
+    ``out`` and swapped in only when every figure was made, together with a
+    manifest, ``manifest.json`` (the configuration as used
+    and its hash, the versions, each file's SHA-256). The new folder replaces
+    the old one whole, so no file of an earlier run is left. A figure that
+    fails is reported in its :class:`FigureResult` and the others are still
+    tried, but then nothing is written and an existing ``out`` is left exactly
+    as it was (as after an exception or Ctrl-C).
 
     Parameters
     ----------
     out : str or path-like
-        Output folder (created if needed).
+        Output folder: created, or replaced if it holds an earlier output
+        (a manifest of uio-teach) or nothing.
     names : sequence of str, optional
         Names from :data:`FIGURES`; all of them by default.
     fmt : {"png", "pdf", "svg"}
         Image format (tables are always ``.csv`` and ``.md``).
     dpi : int
-        Resolution.
+        Resolution, within ``DPI_RANGE`` (20 to 1200).
     config : FigureConfig, optional
         The parameters; the defaults when omitted.
     progress : callable, optional
@@ -543,14 +580,16 @@ def generate(
     Returns
     -------
     list of FigureResult
-        One per requested name, in the order of :data:`FIGURES`.
+        One per requested name, in the order of :data:`FIGURES`; the paths
+        are those in ``out``.
 
     Raises
     ------
     ValueError
-        An unknown name, format or a non-positive ``dpi``.
+        An unknown name or format, or a ``dpi`` out of range.
     uio_teach.instructor.output.OutputError
-        ``out`` cannot be created or written to.
+        ``out`` cannot be created or written to, or is a folder that does not
+        look like an earlier output (not empty, no manifest).
 
     Examples
     --------
@@ -565,36 +604,42 @@ def generate(
 
     if fmt not in FORMATS:
         raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    if isinstance(dpi, bool) or not isinstance(dpi, int) or dpi <= 0:
-        raise ValueError(f"dpi must be a positive integer, got {dpi!r}")
+    dpi = check_dpi(dpi)
     wanted = list(FIGURES) if names is None else list(dict.fromkeys(names))
     unknown = [n for n in wanted if n not in FIGURES]
     if unknown:
         raise ValueError(unknown_figure_message(unknown[0]))
     wanted = [n for n in FIGURES if n in wanted]
-    folder = prepare_output_dir(out)
+    target = Path(out)
     cfg = config if config is not None else FigureConfig()
     runs = _Runs(cfg)
     results: list[FigureResult] = []
-    for index, name in enumerate(wanted, start=1):
-        spec = FIGURES[name]
-        start = time.perf_counter()
-        try:
-            with matplotlib.style.context(cfg["style"]):
-                if spec.table:
-                    paths = tuple(spec.draw(runs, folder))
-                else:
-                    fig = spec.draw(runs)
-                    paths = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
-            result = FigureResult(name, paths, time.perf_counter() - start)
-        except Exception as exc:  # one figure failing must not stop the others
-            message = " ".join(str(exc).split()) or "no message"
-            result = FigureResult(
-                name, (), time.perf_counter() - start, f"{type(exc).__name__}: {message}"
-            )
-        results.append(result)
-        if progress is not None:
-            progress(index, len(wanted), result)
+    with StagedFolder(target, "figures") as stage:
+        folder = stage.path
+        for index, name in enumerate(wanted, start=1):
+            spec = FIGURES[name]
+            start = time.perf_counter()
+            try:
+                with matplotlib.style.context(cfg["style"]):
+                    if spec.table:
+                        made = tuple(spec.draw(runs, folder))
+                    else:
+                        fig = spec.draw(runs)
+                        made = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
+                paths = tuple(target / path.name for path in made)
+                result = FigureResult(name, paths, time.perf_counter() - start)
+            except Exception as exc:  # one figure failing must not stop the others
+                message = " ".join(str(exc).split()) or "no message"
+                result = FigureResult(
+                    name, (), time.perf_counter() - start, f"{type(exc).__name__}: {message}"
+                )
+            results.append(result)
+            if progress is not None:
+                progress(index, len(wanted), result)
+        if all(r.ok for r in results):
+            options = {"figures": wanted, "format": fmt, "dpi": dpi, "config_file": cfg.source}
+            write_manifest(folder, command="uio-teach figures", config=cfg, options=options)
+            stage.commit()
     return results
 
 

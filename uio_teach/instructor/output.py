@@ -1,9 +1,19 @@
-"""Writing the instructor's outputs: reproducible figure files and a checked output folder.
+"""Writing the instructor's outputs: reproducible files, a manifest, and an all-or-nothing folder.
 
 :func:`save_figure` leaves out the time stamps and software names that
 matplotlib would write into PNG, PDF and SVG files, so the same figure always
 gives the same bytes; :func:`prepare_output_dir` creates the folder or says, in
 one line, why it cannot.
+
+:class:`StagedFolder` makes a run all or nothing: the files are written into a
+temporary folder beside the target, and only a run that finished swaps it in
+(the previous folder is then removed whole, so no file of an earlier run
+stays). A run that fails, raises or is interrupted leaves an existing folder
+exactly as it was. A folder that is not empty and has no :data:`MANIFEST`
+written by ``uio-teach`` is never replaced: it does not look like an earlier
+output, and it may hold someone's work. :func:`write_manifest` records what a
+run used and made (the configuration and its hash, the versions, every file
+with its SHA-256).
 
 Examples
 --------
@@ -14,15 +24,37 @@ Examples
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
+import shutil
+import sys
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["FORMATS", "OutputError", "save_figure", "prepare_output_dir"]
+__all__ = [
+    "FORMATS",
+    "MANIFEST",
+    "OutputError",
+    "StagedFolder",
+    "save_figure",
+    "prepare_output_dir",
+    "write_manifest",
+    "read_manifest",
+    "check_output_folder",
+    "sha256_file",
+    "library_versions",
+]
+
+MANIFEST = "manifest.json"
+"""The name of the manifest every run of ``uio-teach figures`` writes into its folder."""
+
+_LIBRARIES = ("numpy", "scipy", "control", "matplotlib", "cvxpy")
 
 FORMATS = ("png", "pdf", "svg")
 """The image formats :func:`save_figure` writes."""
@@ -133,3 +165,286 @@ def prepare_output_dir(out: str | os.PathLike[str]) -> Path:
             f"cannot write to the output folder {os.fspath(path)}: {reason}"
         ) from None
     return path
+
+
+def sha256_file(path: str | os.PathLike[str]) -> str:
+    """The SHA-256 of a file's bytes, as 64 hexadecimal digits.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.output import sha256_file
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = pathlib.Path(tmp) / "a.txt"
+    ...     _ = path.write_bytes(b"abc")
+    ...     sha256_file(path)[:16]
+    'ba7816bf8f01cfea'
+    """
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def library_versions() -> dict[str, str]:
+    """The versions of Python, uio-teach and the libraries the figures depend on.
+
+    Returns
+    -------
+    dict
+        Name -> version (``"not installed"`` for a missing library).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.output import library_versions
+    >>> sorted(library_versions())[:3]
+    ['control', 'cvxpy', 'matplotlib']
+    """
+    from importlib import metadata
+
+    from .. import __version__
+
+    versions = {"python": sys.version.split()[0], "uio-teach": __version__}
+    for name in _LIBRARIES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return dict(sorted(versions.items()))
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, complex):
+        return value.real if value.imag == 0 else str(value).strip("()")
+    if isinstance(value, (tuple, list)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    return value
+
+
+def write_manifest(
+    folder: str | os.PathLike[str],
+    *,
+    command: str,
+    config: Mapping[str, Any],
+    options: Mapping[str, Any] | None = None,
+) -> Path:
+    """Write :data:`MANIFEST` into ``folder``: what was used and what was made.
+
+    The manifest holds the command, the configuration as used (every key,
+    defaults included) and the SHA-256 of its canonical JSON, the options
+    (format, resolution, figures asked for), the versions of Python, uio-teach
+    and the libraries, and every file of the folder with its size and
+    SHA-256. It has no time stamp, so the same run gives the same manifest.
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The folder the files were written into.
+    command : str
+        The command that made them, e.g. ``"uio-teach figures"``.
+    config : mapping
+        The configuration as used.
+    options : mapping, optional
+        Further settings of the run.
+
+    Returns
+    -------
+    pathlib.Path
+        The manifest's path.
+
+    Examples
+    --------
+    >>> import json, tempfile, pathlib
+    >>> from uio_teach.instructor.output import write_manifest
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (pathlib.Path(tmp) / "a.csv").write_text("x\\n")
+    ...     path = write_manifest(tmp, command="demo", config={"seed": 4})
+    ...     data = json.loads(path.read_text())
+    >>> [f["name"] for f in data["files"]], data["config"]
+    (['a.csv'], {'seed': 4})
+    """
+    folder = Path(folder)
+    cfg = _jsonable(dict(config))
+    canonical = json.dumps(cfg, sort_keys=True, separators=(",", ":"))
+    files = [
+        {"name": p.name, "bytes": p.stat().st_size, "sha256": sha256_file(p)}
+        for p in sorted(folder.iterdir())
+        if p.is_file() and p.name != MANIFEST
+    ]
+    data = {
+        "generator": "uio-teach",
+        "command": command,
+        "config": cfg,
+        "config_sha256": hashlib.sha256(canonical.encode()).hexdigest(),
+        "options": _jsonable(dict(options or {})),
+        "versions": library_versions(),
+        "files": files,
+    }
+    path = folder / MANIFEST
+    path.write_text(json.dumps(data, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+    return path
+
+
+def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The manifest of an earlier run in ``folder``, or ``None`` if it has none (or not ours).
+
+    Parameters
+    ----------
+    folder : str or path-like
+        The folder.
+
+    Returns
+    -------
+    dict or None
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from uio_teach.instructor.output import read_manifest
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     print(read_manifest(tmp))
+    None
+    """
+    path = Path(folder) / MANIFEST
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("generator") != "uio-teach":
+        return None
+    return data
+
+
+class StagedFolder:
+    """Write a folder all at once: into a temporary folder beside it, swapped in by :meth:`commit`.
+
+    Use it as a context manager. Inside, write into :attr:`path`; call
+    :meth:`commit` when everything is written. Leaving the block without a
+    commit (a failure, an exception, Ctrl-C) deletes the temporary folder and
+    leaves ``target`` exactly as it was. A commit replaces ``target`` whole,
+    so no file of an earlier run is left next to the new ones.
+
+    Parameters
+    ----------
+    target : str or path-like
+        The folder to make or replace.
+    what : str
+        What goes in it, for messages (``"figures"``).
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file; or it is a folder that is not empty and has no
+        :data:`MANIFEST` of uio-teach (it does not look like an earlier output:
+        empty it, or choose another folder); or the temporary folder cannot
+        be made beside it.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.output import StagedFolder
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     target = pathlib.Path(tmp) / "figures"
+    ...     with StagedFolder(target) as stage:
+    ...         _ = (stage.path / "a.txt").write_text("new")
+    ...         print(target.exists())
+    ...         _ = stage.commit()
+    ...     print(sorted(p.name for p in target.iterdir()))
+    False
+    ['a.txt']
+    """
+
+    def __init__(self, target: str | os.PathLike[str], what: str = "output") -> None:
+        self.target = Path(target)
+        self.what = what
+        self.committed = False
+        self.path: Path | None = None
+        check_output_folder(self.target)
+
+    def __enter__(self) -> StagedFolder:
+        parent = self.target.absolute().parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self.path = Path(tempfile.mkdtemp(dir=parent, prefix=f".{self.target.name}.new-"))
+        except OSError as err:
+            reason = err.strerror or str(err)
+            raise OutputError(
+                f"cannot create the output folder {os.fspath(self.target)}: {reason}"
+            ) from None
+        return self
+
+    def commit(self) -> Path:
+        """Swap the written folder in place of ``target``; returns ``target``."""
+        assert self.path is not None, "use StagedFolder in a with block"
+        check_output_folder(self.target)  # it may have changed while we were writing
+        old = None
+        if self.target.exists():
+            old = Path(tempfile.mkdtemp(dir=self.path.parent, prefix=f".{self.target.name}.old-"))
+            os.rmdir(old)
+            os.replace(self.target, old)
+        try:
+            os.replace(self.path, self.target)
+        except OSError:
+            if old is not None:
+                os.replace(old, self.target)
+            raise
+        self.committed = True
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+        return self.target
+
+    def __exit__(self, *exc: object) -> None:
+        if not self.committed and self.path is not None:
+            shutil.rmtree(self.path, ignore_errors=True)
+
+
+def check_output_folder(target: str | os.PathLike[str]) -> None:
+    """Raise :class:`OutputError` unless ``target`` may be made or replaced by a run.
+
+    It may if it does not exist, is an empty folder, or holds an earlier
+    output (a :data:`MANIFEST` of uio-teach).
+
+    Parameters
+    ----------
+    target : str or path-like
+        The output folder.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, or a folder that is not empty and has no
+        manifest of uio-teach.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.output import check_output_folder, OutputError
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (pathlib.Path(tmp) / "notes.txt").write_text("mine")
+    ...     try:
+    ...         check_output_folder(tmp)
+    ...     except OutputError as err:
+    ...         print("left alone" in str(err))
+    True
+    """
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise OutputError(f"the output folder {os.fspath(target)} is a file, not a folder")
+    if target.is_dir() and any(target.iterdir()) and read_manifest(target) is None:
+        raise OutputError(
+            f"the output folder {os.fspath(target)} is not empty and has no {MANIFEST} of "
+            "uio-teach, so it does not look like an earlier output; it is left alone: empty "
+            "it or choose another folder"
+        )
