@@ -141,16 +141,19 @@ class CheckResult:
 _F = TypeVar("_F", bound=Callable[..., CheckResult])
 
 
-def _never_raises(title: str) -> Callable[[_F], _F]:
-    """Turn any unexpected exception of a check into a ✗ message instead of a traceback."""
+def _never_raises(title: str, check_id: str = "") -> Callable[[_F], _F]:
+    """Turn any unexpected exception of a check into a ✗ message instead of a traceback.
+
+    The result, made by the check or here, carries ``check_id`` (e.g. ``"pa9.design"``).
+    """
 
     def decorate(func: _F) -> _F:
         @functools.wraps(func)
         def wrapper(*args: Any, **kwargs: Any) -> CheckResult:
             try:
-                return func(*args, **kwargs)
+                result = func(*args, **kwargs)
             except Exception as exc:  # a student must never see a traceback here
-                return CheckResult(
+                result = CheckResult(
                     title,
                     [
                         (
@@ -161,7 +164,14 @@ def _never_raises(title: str) -> Callable[[_F], _F]:
                         )
                     ],
                 )
+            if check_id:
+                try:
+                    result.check_id = check_id
+                except AttributeError:  # pragma: no cover - a read-only attribute
+                    pass
+            return result
 
+        wrapper.check_id = check_id  # type: ignore[attr-defined]
         return wrapper  # type: ignore[return-value]
 
     return decorate
