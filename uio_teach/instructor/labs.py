@@ -125,6 +125,20 @@ class LabUsageError(LabError):
     """A source that is not a lab chapter, or a folder that does not exist (a usage error)."""
 
 
+def _params_literal(source: str) -> Any:
+    """The value of ``PARAMS = <literal>`` in a cell, or ``None`` if the cell is not that."""
+    tree = _python(source)
+    if tree is None or len(tree.body) != 1 or not isinstance(tree.body[0], ast.Assign):
+        return None
+    node = tree.body[0]
+    if [getattr(t, "id", None) for t in node.targets] != ["PARAMS"]:
+        return None
+    try:
+        return ast.literal_eval(node.value)
+    except (ValueError, SyntaxError):
+        return None
+
+
 def params_source(params: dict[str, Any]) -> str:
     """The source of the ``parameters`` cell: ``PARAMS = {...}`` as a JSON-compatible literal.
 
@@ -498,7 +512,7 @@ class _Builder:
             if self.parameters_seen:
                 raise LabError("more than one cell is tagged 'parameters'")
             self.parameters_seen = True
-            if self.params is not None:
+            if self.params is not None and _params_literal(source) != self.params:
                 source = params_source(self.params)
             self.cells.append(_Cell("code", source, [PARAMETERS_TAG], meta))
             return
