@@ -417,3 +417,48 @@ def test_labs_command_fails_clearly_on_a_missing_source(tmp_path, capsys):
     assert code == 2 and "no lab chapter" in capsys.readouterr().err
     code = cli.main(["labs", "--out", str(tmp_path), "--book", str(tmp_path / "nonexist")])
     assert code == 2 and "nonexist: no such folder" in capsys.readouterr().err
+
+
+# nothing of the solution in the student notebook ------------------------------------------------
+
+
+def solution_only_lines(solution) -> list[str]:
+    """Lines of the solution cells that no other cell of the solution notebook has."""
+    shared = set()
+    for cell in solution.cells:
+        if "solution" not in tags(cell):
+            shared.update(line.strip() for line in cell.source.splitlines())
+    out = []
+    for cell in solution.cells:
+        if cell.cell_type == "code" and "solution" in tags(cell):
+            for line in cell.source.splitlines():
+                line = line.strip()
+                if len(line) >= 12 and line not in shared and line not in out:
+                    out.append(line)
+    return out
+
+
+def test_no_line_of_solution_code_is_in_the_student_notebook(lab):
+    """Not in its code, and not in its markdown either (a summary that repeats the solution)."""
+    text = "\n".join(c.source for c in lab["student"].cells)
+    lines = solution_only_lines(lab["solution"])
+    assert len(lines) >= 10
+    leaked = [line for line in lines if line in text]
+    assert not leaked, leaked
+
+
+def test_no_model_answer_is_in_the_student_notebook(lab):
+    """The prose of the solutions (the model answers) is only in the solution notebook."""
+    text = "\n".join(c.source for c in lab["student"].cells)
+    prose = [
+        c.source
+        for c in lab["solution"].cells
+        if c.cell_type == "markdown"
+        and "solution" in tags(c)
+        and not c.source.startswith("**Solution of")
+    ]
+    assert prose
+    for answer in prose:
+        for sentence in re.split(r"(?<=[.:])\s+", answer):
+            if len(sentence) > 40:
+                assert sentence not in text, sentence
