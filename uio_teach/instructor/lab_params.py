@@ -357,7 +357,9 @@ class CaseStudyParams(LabParams):
 
         plant = examples.dt_case_study()
         C, B2, D = plant.C, plant.E, plant.D
-        M = np.hstack([B2, np.zeros_like(D)]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
+        M = np.hstack([B2, np.zeros((plant.n, D.shape[1]))]) @ np.linalg.pinv(
+            np.hstack([C @ B2, D])
+        )
         Pi = np.eye(plant.n) - M @ C
         while True:
             x0 = rng.choice([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0], 3)
@@ -394,7 +396,9 @@ class CaseStudyParams(LabParams):
 
         plant = examples.dt_case_study()
         C, B2, D, A = plant.C, plant.E, plant.D, plant.A
-        M = np.hstack([B2, np.zeros_like(D)]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
+        M = np.hstack([B2, np.zeros((plant.n, D.shape[1]))]) @ np.linalg.pinv(
+            np.hstack([C @ B2, D])
+        )
         A1 = (np.eye(plant.n) - M @ C) @ A
         placed = design_pmo(plant, poles=[self.pole])
         return {
