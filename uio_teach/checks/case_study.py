@@ -466,8 +466,11 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
     True
     """
     result = CheckResult("Case study: the residual and D v")
+    missing = [name for name, value in (("Dv", Dv), ("Nr", Nr)) if value is None]
+    for name in missing:
+        result.add(False, f"{name} is missing: compute it from the run (see the exercise).")
     resp = _read_resp(result, response)
-    if resp is None:
+    if resp is None or missing:
         return result
     plant = resp.plant
     N = resp.time.size
