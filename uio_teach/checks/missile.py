@@ -372,15 +372,17 @@ def missile_catch_times(catch: Any, response: Any, vhat: Any, *, tol: float = 0.
     from ..reconstruction import catch_time
 
     result = CheckResult("Missile: the catch times of Table II")
+    missing: list[str] = []
     if not isinstance(catch, Mapping):
         got = "None" if catch is None else type(catch).__name__
         result.add(
             False, f"catch must be a dict {{'x1': ..., 'v2': ...}} of times in s, got {got}."
         )
-        return result
-    missing = [k for k in NAMES if k not in catch]
-    if missing:
-        result.add(False, f"catch has no time for {', '.join(missing)}.")
+        missing = list(NAMES)
+    else:
+        missing = [k for k in NAMES if k not in catch]
+        if missing:
+            result.add(False, f"catch has no time for {', '.join(missing)}.")
     resp = _resp(result, response)
     vh = _vhat(result, vhat)
     if resp is None or vh is None or missing:
@@ -455,9 +457,9 @@ def missile_noise(rms: Any, response: Any, *, sigma: float, after: float = 0.1) 
     from ..reconstruction import reconstruct_input
 
     result = CheckResult("Missile: what noise does to the reconstruction")
-    resp = _resp(result, response)
     q = 2
     vals = _read_matrix(result, "rms", rms, 1, q, f"{q} numbers: v1, v2")
+    resp = _resp(result, response)
     if resp is None or vals is None:
         return result
     noise = np.asarray(resp.inputs.noise, float)
