@@ -410,7 +410,8 @@ def case_study_simulation(
         observer_state=resp.observer_states[:, 0],
     )
     diff = float(np.max(np.abs(resp.error - quiet.error)))
-    if diff <= 1e-8 * max(1.0, float(np.max(np.abs(resp.states)))):
+    decoupled = diff <= 1e-8 * max(1.0, float(np.max(np.abs(resp.states))))
+    if decoupled:
         result.add(
             True,
             f"the error ignores u2 and v: run again without them, it is the same"
@@ -428,6 +429,12 @@ def case_study_simulation(
         result.add(False, "the error is zero from the start: start the plant from x[0] != 0.")
     elif e1 <= decay * e0:
         result.add(True, f"the error decays: {e0:.3g} at k = 0, {e1:.2g} at k = {t[-1]:g}.")
+    elif not decoupled:
+        result.add(
+            False,
+            f"the error does not decay: {e1:.3g} at the end against {e0:.3g} at k = 0, because "
+            "the unknown signals keep driving it (see above).",
+        )
     else:
         result.add(
             False,
