@@ -17,9 +17,9 @@ V = (P["v"]["amplitude"], P["v"]["hold"], P["v"]["seed"])
 PLANT = ut.examples.dt_case_study()
 A, C, B2, D = PLANT.A, PLANT.C, PLANT.E, PLANT.D
 n, p = PLANT.n, PLANT.p
-I = np.eye(n)
+EYE = np.eye(n)
 M = np.hstack([B2, np.zeros((n, 1))]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
-A1 = (I - M @ C) @ A
+A1 = (EYE - M @ C) @ A
 LMI = ut.design_pmo(PLANT, method="lmi")
 L, P_LMI = LMI.L, LMI.lmi_certificate
 N = ut.linalg.left_null(D)
@@ -71,7 +71,7 @@ CATALOGUE = {
         "which ignores D",
     ),
     "M with a minus sign": (lambda: checks.case_study_projection(-M), "drop the minus sign"),
-    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(I - MC)B2 is not 0"),
+    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(EYE - MC)B2 is not 0"),
     "M with a NaN": (
         lambda: checks.case_study_projection(np.where(M > 0.4, np.nan, M)),
         "every entry must be a finite number",

@@ -325,6 +325,18 @@ def missile_reconstruction(
             False, "vhat is not the reconstruction of this run: ut.reconstruct_input(plant, run)."
         )
         return result
+    from ..reconstruction import reconstruct_input
+
+    ref = reconstruct_input(resp.plant, resp, method=vh.method, tau=vh.tau)
+    gap = float(np.max(np.abs(ref.estimates - vh.estimates)))
+    if gap > 1e-6 * max(1.0, float(np.max(np.abs(ref.estimates)))):
+        result.add(
+            False,
+            f"vhat is not the reconstruction of this run (it differs from "
+            f"ut.reconstruct_input(plant, run) by up to {gap:.3g}): reconstruct from the run "
+            "you pass.",
+        )
+        return result
     late = resp.time >= after
     err = np.max(np.abs(vh.error[:, late]), axis=1)
     peak = np.max(np.abs(vh.actual), axis=1)
