@@ -71,7 +71,7 @@ CATALOGUE = {
         "which ignores D",
     ),
     "M with a minus sign": (lambda: checks.case_study_projection(-M), "drop the minus sign"),
-    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(EYE - MC)B2 is not 0"),
+    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(I - MC)B2 is not 0"),
     "M with a NaN": (
         lambda: checks.case_study_projection(np.where(M > 0.4, np.nan, M)),
         "every entry must be a finite number",
