@@ -387,6 +387,8 @@ class CaseStudyParams(LabParams):
             out.append("the unknown inputs must be visible")
         if self.steps < 20:
             out.append("the simulation is too short to see the error decay")
+        if self.seed < 0 or self.v_hold < 1:
+            out.append("the seed of v must be >= 0 and its hold at least one step")
         return out
 
     def answers(self) -> dict[str, Any]:
@@ -508,6 +510,8 @@ class MissileParams(LabParams):
             out.append("the PMO poles must be stable and fast enough for the 0.5 s window")
         if self.noise <= 0:
             out.append("the noise exercise needs a positive noise level")
+        if self.seed < 0:
+            out.append("the seed of the noise must be >= 0")
         return out
 
     def answers(self) -> dict[str, Any]:

@@ -994,6 +994,11 @@ def write_labs(
     for path in paths:
         lab = lab_of(path)
         base = lab.params.from_config(config) if lab is not None else None
+        if base is not None and base.problems():
+            raise LabUsageError(
+                f"the {lab.id} lab cannot be made with these numbers: "  # type: ignore[union-attr]
+                + "; ".join(base.problems())
+            )
         if groups is None:
             jobs.append((path, lab, "", base))
         elif lab is not None:
