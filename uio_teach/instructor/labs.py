@@ -64,12 +64,13 @@ from typing import Any, Literal
 
 from .book import (
     _HEADING,
-    _LABELLED_MATH,
     _TARGET,
     BookIndex,
     _fence_states,
     default_book_dir,
 )
+from .myst import Converter, Directive, tokens
+from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
 __all__ = [
     "VERSIONS",
@@ -101,20 +102,7 @@ PARAMETERS_TAG = "parameters"
 
 Version = Literal["student", "solution"]
 
-_ROLE = re.compile(r"\{(?P<name>[\w:.-]+)\}`(?P<content>[^`]+)`")
 _CHECK_CALL = re.compile(r"\bchecks\.\w+\s*\(")
-_ADMONITIONS = {
-    "note",
-    "tip",
-    "hint",
-    "important",
-    "warning",
-    "caution",
-    "attention",
-    "danger",
-    "error",
-    "seealso",
-}
 
 
 class LabError(ValueError):
@@ -169,129 +157,6 @@ def params_source(params: dict[str, Any]) -> str:
         text,
     )
     return f"PARAMS = {text}"
-
-
-# MyST Markdown -> Jupyter Markdown ---------------------------------------------------------------
-
-
-@dataclass
-class _Directive:
-    name: str
-    arg: str
-    options: dict[str, str]
-    body: str
-
-
-def _tokens(text: str) -> list[str | _Directive]:
-    """Split Markdown into plain text and top-level directives, as jupytext's MyST parser does.
-
-    The block parser of :mod:`jupytext.myst` (markdown-it-py with the MyST plugins, and the
-    colon fence of mdit-py-plugins) finds the directives; jupytext reads their options.
-    """
-    from jupytext.myst import get_parser, parse_directive_options
-    from mdit_py_plugins.colon_fence import colon_fence_plugin
-
-    lines = text.split("\n")
-    out: list[str | _Directive] = []
-    done = 0
-    for token in get_parser().use(colon_fence_plugin).parse(text):
-        info = token.info.strip()
-        if token.level or token.type not in ("fence", "colon_fence") or not info.startswith("{"):
-            continue
-        head = re.match(r"^\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*)$", info)
-        if head is None:
-            continue
-        start, end = token.map
-        if start > done:
-            out.append("\n".join(lines[done:start]))
-        body, options = parse_directive_options(token.content, f"line {start + 1}: ")
-        options = {str(k): "" if v is None else str(v) for k, v in options.items()}
-        out.append(_Directive(head["name"], head["arg"], options, "\n".join(body).strip("\n")))
-        done = end
-    if done < len(lines):
-        out.append("\n".join(lines[done:]))
-    return [t for t in out if not isinstance(t, str) or t.strip("\n")] or [text]
-
-
-def _quote(text: str) -> str:
-    return "\n".join(f"> {line}" if line.strip() else ">" for line in text.split("\n"))
-
-
-class _Converter:
-    """MyST roles, labels and labelled equations of one page, written as plain Markdown."""
-
-    def __init__(self, index: BookIndex, stem: str) -> None:
-        self.index = index
-        self.stem = stem
-
-    def role(self, m: re.Match[str]) -> str:
-        name, content = m.group("name"), m.group("content")
-        explicit = re.match(r"^(?P<text>.+?)\s*<(?P<target>[^>]+)>$", content, re.DOTALL)
-        target = explicit.group("target") if explicit else content
-        if name.startswith("cite"):
-            return self.index.cite("t" if name.endswith(":t") else "p", content)
-        if name == "math":
-            return f"${content}$"
-        if name in ("sub", "sup"):
-            return f"<{name}>{content}</{name}>"
-        if explicit:
-            return explicit.group("text")
-        if name == "doc":
-            return self.index.short_page(Path(target).stem, self.stem)
-        if name == "eq":
-            if target in self.index.equations:
-                stem, k = self.index.equations[target]
-                return f"eq. ({self.index.number(stem, k)})"
-            return f"eq. ({target})"
-        if name in ("ref", "numref"):
-            if target in self.index.exercises:
-                stem, k = self.index.exercises[target]
-                return f"exercise {self.index.number(stem, k)}"
-            if target in self.index.sections:
-                stem, title = self.index.sections[target]
-                if stem == self.stem:
-                    return f'section "{title}"'
-                return self.index.short_page(stem, self.stem)
-            return target
-        return content
-
-    def inline(self, text: str) -> str:
-        def tag(m: re.Match[str]) -> str:
-            label = m.group("label")
-            if label in self.index.equations:
-                stem, k = self.index.equations[label]
-                number = self.index.number(stem, k)
-            else:
-                number = label
-            return f"$${m.group('body').rstrip()} \\tag{{{number}}}$$"
-
-        text = _LABELLED_MATH.sub(tag, text)
-        lines = [ln for ln in text.split("\n") if not _TARGET.match(ln.strip())]
-        lines = [ln for ln in lines if not re.match(r"^%( |$)", ln)]  # MyST comments
-        text = _ROLE.sub(self.role, "\n".join(lines))
-        return re.sub(r"\n{3,}", "\n\n", text).strip("\n")
-
-    def directive(self, d: _Directive, exercise_number: str | None = None) -> str:
-        body = self.markdown(d.body)
-        if d.name == "exercise":
-            title = f"**Exercise {exercise_number}**" + (f" ({d.arg})" if d.arg else "")
-            return _quote(f"{title}\n\n{body}")
-        if d.name in _ADMONITIONS or d.name == "admonition":
-            title = d.arg if d.name == "admonition" and d.arg else d.name.capitalize()
-            return _quote(f"**{title}.** {body}")
-        if d.name == "math":
-            return f"$$\n{d.body}\n$$"
-        if d.name in ("code", "code-block", "sourcecode"):
-            return f"```{d.arg}\n{d.body}\n```"
-        if d.name in ("figure", "image"):
-            return f"*Figure: {body or d.arg}*"
-        return body
-
-    def markdown(self, text: str) -> str:
-        parts = []
-        for token in _tokens(text):
-            parts.append(self.inline(token) if isinstance(token, str) else self.directive(token))
-        return "\n\n".join(p for p in parts if p.strip())
 
 
 # Python names a solution defines and later cells use ---------------------------------------------
@@ -379,7 +244,7 @@ class _Builder:
     def __init__(
         self,
         version: Version,
-        converter: _Converter,
+        converter: Converter,
         index: BookIndex,
         params: dict[str, Any] | None = None,
     ) -> None:
@@ -439,7 +304,7 @@ class _Builder:
 
     # markdown -----------------------------------------------------------------------------------
     def markdown(self, text: str) -> None:
-        for token in _tokens(text):
+        for token in tokens(text):
             if isinstance(token, str):
                 self._text(token)
             else:
@@ -471,7 +336,7 @@ class _Builder:
             chunk.append(line)
         self._emit_md(self.conv.inline("\n".join(chunk)))
 
-    def _directive(self, d: _Directive) -> None:
+    def _directive(self, d: Directive) -> None:
         if d.name == "solution-start":
             self.flush()
             self.solution = d.arg.strip() or self.exercise[0]
@@ -655,7 +520,7 @@ def make_notebook(
             f"{' '.join(str(exc).split())})"
         ) from None
     index = index if index is not None else BookIndex.from_book(path.parent)
-    builder = _Builder(version, _Converter(index, path.stem), index, params)
+    builder = _Builder(version, Converter(index, path.stem), index, params)
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             builder.markdown(cell.source)
@@ -855,55 +720,6 @@ class LabResult:
     group: str = ""
 
 
-def draw_variants(lab: Lab, groups: int, seed: int, base: Any = None) -> list[Any]:
-    """``groups`` distinct parameter sets of ``lab``, each a fair exercise, from ``seed``.
-
-    Parameters
-    ----------
-    lab : Lab
-        The lab (an entry of :data:`LABS`).
-    groups : int
-        How many variants.
-    seed : int
-        Seed of the draw; the same seed gives the same variants.
-    base : LabParams, optional
-        What the variants keep (time grid, ...): the term's parameters.
-
-    Returns
-    -------
-    list
-        Parameter objects of ``lab.params``.
-
-    Examples
-    --------
-    >>> from uio_teach.instructor.labs import LABS, draw_variants
-    >>> a, b = draw_variants(LABS["pa9"], 2, seed=5)
-    >>> a != b and not a.problems() and not b.problems()
-    True
-    """
-    import numpy as np
-
-    index = list(LABS).index(lab.id) if lab.id in LABS else 0
-    rng = np.random.default_rng([int(seed), index])
-    out: list[Any] = []
-    seen: set[str] = set()
-    for _ in range(1000 * max(1, groups)):
-        if len(out) == groups:
-            break
-        variant = lab.params.draw(rng, base)
-        key = repr(variant.to_params())
-        if key in seen or variant.problems():
-            continue
-        seen.add(key)
-        out.append(variant)
-    if len(out) < groups:
-        raise LabUsageError(f"cannot draw {groups} distinct variants of the {lab.id} lab")
-    return out
-
-
-ANSWER_KEY = "answer_key.csv"
-
-
 def write_labs(
     out: str | os.PathLike[str],
     sources: Sequence[str | os.PathLike[str]] | None = None,
@@ -1060,49 +876,3 @@ def write_labs(
     if groups is not None:
         write_answer_key(Path(out) / ANSWER_KEY, [(lab, g, p) for _, lab, g, p, _, _ in built])
     return results
-
-
-def write_answer_key(path: Path, rows: Sequence[tuple[Any, str, Any]]) -> Path:
-    """Write the answer key CSV: ``lab``, ``group``, ``params``, then one column per key number.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The CSV file.
-    rows : sequence of (Lab, str, LabParams)
-        The lab, the group id and its parameters, in order.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Examples
-    --------
-    >>> import tempfile, pathlib, csv
-    >>> from uio_teach.instructor.labs import LABS, write_answer_key
-    >>> from uio_teach.instructor.lab_params import PA9Params
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     key = write_answer_key(pathlib.Path(tmp) / "k.csv", [(LABS["pa9"], "g01", PA9Params())])
-    ...     row = next(csv.DictReader(key.open()))
-    >>> row["lab"], row["group"], row["pa9.K2"] != ""
-    ('pa9', 'g01', True)
-    """
-    import csv
-    import json
-
-    table = []
-    columns: list[str] = []
-    for lab, group, params in rows:
-        answers = {f"{lab.id}.{k}": v for k, v in params.answers().items()}
-        for k in answers:
-            if k not in columns:
-                columns.append(k)
-        record = {"lab": lab.id, "group": group, "params": json.dumps(params.to_params())}
-        record.update({k: json.dumps(v) for k, v in answers.items()})
-        table.append(record)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, ["lab", "group", "params", *columns], lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(table)
-    return path
