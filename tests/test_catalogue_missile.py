@@ -146,6 +146,10 @@ CATALOGUE = {
     ),
     # the noise ---------------------------------------------------------------------------------
     "rms left out": (lambda: checks.missile_noise(None, NOISY, sigma=SIGMA), "rms is missing"),
+    "noise of another seed": (
+        lambda: checks.missile_noise(RMS, sim(noise=SIGMA, seed=SEED + 1), sigma=SIGMA, seed=SEED),
+        "the noise of the run is not the one of seed",
+    ),
     "the noise-free run": (
         lambda: checks.missile_noise(RMS, RUN, sigma=SIGMA),
         "the run has no measurement noise",
@@ -189,7 +193,7 @@ def test_the_right_answer_passes_every_check():
         checks.missile_ginverse(Cg, Pc, K),
         checks.missile_reconstruction(VHAT, RUN),
         checks.missile_catch_times(CATCH, RUN0, VHAT0, tol=TOL),
-        checks.missile_noise(RMS, NOISY, sigma=SIGMA),
+        checks.missile_noise(RMS, NOISY, sigma=SIGMA, seed=SEED),
     ]
     for result in results:
         assert result.passed, str(result)

@@ -494,3 +494,21 @@ def test_a_variant_solves_with_every_check_passing_and_its_student_form_runs(
     for cell in student.cells:
         if "check" in tags(cell):
             assert "✗" in text_output(cell) and "Traceback" not in text_output(cell)
+
+
+def test_a_source_that_is_not_a_lab_is_a_usage_error(tmp_path, capsys):
+    garbled = tmp_path / "lab_notes.md"
+    garbled.write_text("# Notes\n\n```{exercise\nno closing\n")
+    code = cli.main(["labs", "--out", str(tmp_path / "out"), "--source", str(garbled)])
+    err = capsys.readouterr().err
+    assert code == 2 and "lab_notes.md: not a lab chapter" in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("version", labs.VERSIONS)
+def test_cross_references_are_short_plain_text(lab, version):
+    text = "\n".join(c.source for c in lab[version].cells if c.cell_type == "markdown")
+    assert re.search(r"\beq\. \(\d+\.\d+\)", text)
+    assert re.search(r"\bchapter \d+\b", text)
+    assert not re.search(r"\) of chapter \d", text)
+    assert not re.search(r"chapter \d+, \*", text)

@@ -442,7 +442,9 @@ def missile_catch_times(catch: Any, response: Any, vhat: Any, *, tol: float = 0.
 
 
 @_never_raises("Missile: what noise does to the reconstruction", "missile.noise")
-def missile_noise(rms: Any, response: Any, *, sigma: float, after: float = 0.1) -> CheckResult:
+def missile_noise(
+    rms: Any, response: Any, *, sigma: float, seed: int | None = None, after: float = 0.1
+) -> CheckResult:
     """Check the RMS error of ``v̂`` with noise, and compare it with ``sigma rho_i / (sqrt(2) h)``.
 
     Parameters
@@ -453,6 +455,8 @@ def missile_noise(rms: Any, response: Any, *, sigma: float, after: float = 0.1) 
         The noisy run.
     sigma : float
         The asked noise level.
+    seed : int, optional
+        The asked seed of the noise.
     after : float, optional
         Start of the window (s).
 
@@ -487,6 +491,25 @@ def missile_noise(rms: Any, response: Any, *, sigma: float, after: float = 0.1) 
         )
     else:
         result.add(True, f"the run has measurement noise with sigma = {float(sigma):g}.")
+    if seed is not None:
+        from ..simulation import simulate
+
+        again = simulate(
+            resp.plant,
+            resp.observer,
+            resp.time,
+            d=resp.inputs.d,
+            initial_state=resp.states[:, 0],
+            observer_state=resp.observer_states[:, 0],
+            noise=float(sigma),
+            seed=int(seed),
+        )
+        if not np.allclose(np.asarray(again.inputs.noise), noise, rtol=0, atol=1e-12):
+            result.add(
+                False,
+                f"the noise of the run is not the one of seed {int(seed)}: pass "
+                'seed=PARAMS["noise"]["seed"] to ut.simulate.',
+            )
     vh = reconstruct_input(resp.plant, resp)
     late = resp.time >= after
     ref = np.sqrt(np.mean(vh.error[:, late] ** 2, axis=1))
