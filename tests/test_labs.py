@@ -370,7 +370,7 @@ def test_small_lab_student_version(small_lab, tmp_path):
     assert "Notes for the marker" not in text
     assert "After the notes" in text and "> **Note.** Kept for everyone." in text
     assert "(Smith and Jones, 2001)" in text
-    assert 'See (Smith and Jones, 2001) and section "Part two"; equation eq. (1):' in text
+    assert 'See (Smith and Jones, 2001) and section "Part two"; equation (1):' in text
     assert "$$\ny = 2x \\tag{1}$$" in text
     assert "# not a heading" in text  # fenced code is left alone
     assert "> **Exercise 1**" in text and "> **Exercise 2**" in text

@@ -136,6 +136,8 @@ class Converter:
         lines = [ln for ln in text.split("\n") if not _TARGET.match(ln.strip())]
         lines = [ln for ln in lines if not re.match(r"^%( |$)", ln)]  # MyST comments
         text = _ROLE.sub(self.role, "\n".join(lines))
+        # "eq. {eq}`x`" in the source: the role already says "eq."
+        text = re.sub(r"\b([Ee]q\.|[Ee]quations?)(\s+)eq\. \(", r"\1\2(", text)
         return re.sub(r"\n{3,}", "\n\n", text).strip("\n")
 
     def directive(self, d: Directive, exercise_number: str | None = None) -> str:
