@@ -12,8 +12,8 @@ a list of ✓ / ✗ messages that say what is right, what is not, and how to fix
   ``e`` and the residual ``r``.
 * :func:`pa9_piecewise` -- a response with a piecewise-constant disturbance:
   the same error as with the sinusoid.
-* ``case_study_*`` -- the case-study lab (:mod:`uio_teach.checks.case_study`).
-* ``missile_*`` -- the missile lab (:mod:`uio_teach.checks.missile`).
+* ``case_study_*`` -- the case-study lab (module ``uio_teach.checks.case_study``).
+* ``missile_*`` -- the missile lab (module ``uio_teach.checks.missile``).
 
 Every result carries a ``check_id`` such as ``"pa9.design"``.
 

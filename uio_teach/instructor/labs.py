@@ -489,10 +489,10 @@ def make_notebook(
 
     Raises
     ------
-    LabUsageError
-        The source is not a lab chapter (it has no solution to hide).
     LabError
-        The source cannot be read, or a solution block is not closed.
+        The source cannot be read, or a solution block is not closed; a
+        ``LabUsageError`` (a subclass) when the source is not a lab chapter (it
+        has no solution to hide) or does not exist.
 
     Examples
     --------
@@ -766,10 +766,10 @@ def write_labs(
 
     Raises
     ------
-    LabUsageError
-        A missing folder or file, a source that is not a lab, a bad ``groups``.
     LabError
-        A lab cannot be converted.
+        A lab cannot be converted; a ``LabUsageError`` (a subclass) for a
+        missing folder or file, a source that is not a lab, a bad ``groups``
+        or numbers that make no fair exercise.
     OSError
         The output folder cannot be written (see
         :func:`uio_teach.instructor.output.prepare_output_dir`).
