@@ -11,15 +11,24 @@ tagged ``solution``. From the one source, :func:`make_notebook` builds:
   cell sets them to ``None``, so the notebook runs from top to bottom and each
   check cell says, in plain words, what is still missing. Check cells are kept
   (tagged ``check``); a section headed "Instructor notes" is left out. A
-  solution made of prose only becomes a markdown "Your answer" cell.
+  solution that explains in words (a model answer) gets a markdown "Your
+  answer" cell instead; nothing of the solution is left in the notebook.
 * the **solution** version: complete, solution cells tagged ``solution``,
-  check cells ``check``, the instructor notes kept (tagged ``instructor``).
+  the check cells that students run tagged ``check``, the instructor notes
+  kept (tagged ``instructor``, never ``check``).
+
+The one code cell tagged ``parameters`` defines ``PARAMS``, the numbers of the
+exercise; with ``params=`` it is rewritten for a term (``--config``) or a group
+(``--groups``). :data:`LABS` names the course's labs, their parameter classes
+(:mod:`uio_teach.instructor.lab_params`) and the check ids of their check
+cells. A source without a solution is not a lab (:class:`LabUsageError`).
 
 Both have empty outputs and pass :func:`nbformat.validate`. The MyST syntax
-that Jupyter does not render is rewritten as plain Markdown: exercises become
-quotes titled "Exercise <number>" (numbered as in the book), ``{eq}`` references
-become equation numbers, ``{ref}`` and ``{doc}`` become titles, ``{cite:p}``
-becomes (Author, year), labelled display equations get a ``\\tag``.
+that Jupyter does not render is rewritten as plain Markdown by
+:mod:`uio_teach.instructor.myst`: exercises become quotes titled "Exercise
+<number>" (numbered as in the book), ``{eq}`` references become "eq. (3.2)",
+``{doc}`` and ``{ref}`` become "chapter 3", ``{cite:p}`` becomes (Author,
+year), labelled display equations get a ``\\tag``.
 
 Examples
 --------
