@@ -257,7 +257,7 @@ def test_piecewise_needs_jumps(uio, sine_response):
 def test_piecewise_comparison_needs_the_same_start_and_grid(uio, sine_response):
     other = ut.simulate(PLANT, uio, TIME, d=STEPS, initial_state=[0.0, 1.0, 0.0])
     result = checks.pa9_piecewise(other, sinusoidal=sine_response)
-    assert "start from different states" in failures_text(result)
+    assert "start the plant from different states" in failures_text(result)
     other = ut.simulate(PLANT, uio, np.linspace(0, 10, 501), d=STEPS, initial_state=X0)
     result = checks.pa9_piecewise(other, sinusoidal=sine_response)
     assert "different time points" in failures_text(result)
@@ -305,10 +305,8 @@ def test_plot_without_labels_fails(sine_response):
     ax.plot(sine_response.time, sine_response.error.T)
     result = checks.pa9_plot(fig)
     text = failures_text(result)
-    assert "axes 1 has no y-label" in text
+    assert "one axes with curves; e and r belong in two panels" in text
     assert "axes 1 has no x-label" in text
-    assert "no label, title or legend names the error" in text
-    assert "no label, title or legend names the residual" in text
 
 
 def test_plot_with_a_non_time_x_label_fails(sine_response):
@@ -328,20 +326,24 @@ def test_plot_of_the_states_instead_of_the_error(sine_response):
     result = checks.pa9_plot(fig, response=sine_response)
     assert checks.pa9_plot(fig).passed  # the labels alone look right ...
     text = failures_text(result)  # ... but the curves are x and y
-    assert "plot resp.error, not resp.states" in text
-    assert "plot resp.residual, not resp.outputs" in text
+    assert "the error panel shows the states x (resp.states)" in text
+    assert "the residual panel shows the outputs y (resp.outputs)" in text
 
 
 def test_plot_with_missing_components(sine_response):
     fig = good_figure(sine_response)
     fig.axes[0].lines[1].remove()
     result = checks.pa9_plot(fig, response=sine_response)
-    assert "some error components are missing from the figure: e2" in failures_text(result)
+    assert "the error panel lacks some error components: e2." in failures_text(result)
 
 
-@pytest.mark.parametrize("thing", [None, 3, "figure"])
+@pytest.mark.parametrize("thing", [3, "figure"])
 def test_plot_needs_a_figure(thing):
     assert "fig must be a matplotlib figure" in failures_text(checks.pa9_plot(thing))
+
+
+def test_plot_of_none_says_the_figure_is_missing():
+    assert "fig is missing (None)" in failures_text(checks.pa9_plot(None))
 
 
 def test_empty_figure_fails():
@@ -369,4 +371,4 @@ def test_stacked_axes_need_only_the_bottom_x_label(sine_response):
     ax_r.set_xlabel("time (s)")
     assert checks.pa9_plot(fig).passed
     ax_e.set_xlim(0, 5)  # a different time range needs its own label
-    assert "axes 1 has no x-label" in failures_text(checks.pa9_plot(fig))
+    assert "axes 1 (error) has no x-label" in failures_text(checks.pa9_plot(fig))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 import textwrap
+import time
 from pathlib import Path
 
 import jupytext
@@ -92,7 +93,9 @@ def test_notebooks_are_valid_nbformat_4_with_empty_outputs(lab, version):
     nbformat.validate(nb)
     assert nb.nbformat == 4
     assert nb.metadata.kernelspec.name == "python3"
-    assert nb.metadata.uio_teach == {"source": lab["source"].name, "version": version}
+    meta = nb.metadata.uio_teach
+    assert meta["source"] == lab["source"].name and meta["version"] == version
+    assert meta["lab"] == labs.lab_of(lab["source"]).id
     for cell in nb.cells:
         if cell.cell_type == "code":
             assert cell.outputs == [] and cell.execution_count is None
@@ -126,14 +129,40 @@ def test_the_student_version_has_no_solution(lab):
     assert "Solution of Exercise" not in text and "Instructor notes" not in text
 
 
-def test_each_solution_becomes_one_todo_cell_with_its_exercise_label(lab):
+def test_each_solution_becomes_todo_cells_with_its_exercise_label(lab):
     myst_text = lab["source"].read_text(encoding="utf-8")
     blocks = re.findall(r"\{solution-start\}\s*(\S+)", myst_text)
     todo = [c for c in lab["student"].cells if "todo" in tags(c)]
-    assert len(todo) == len(blocks) == lab["result"].todo_cells
-    for cell, label in zip(todo, blocks, strict=True):
+    assert len(todo) == lab["result"].todo_cells
+    labels = []
+    for cell in todo:
         first = cell.source.splitlines()[0]
-        assert first.startswith("# TODO: Exercise ") and f"({label})" in first
+        assert first.startswith(("# TODO: Exercise ", "**Your answer to Exercise ")), first
+        label = re.search(r"\((ex-[\w-]+)\)", first).group(1)
+        if label not in labels:
+            labels.append(label)
+    assert labels == blocks
+
+
+def test_a_solution_explained_in_words_gets_a_your_answer_cell(lab):
+    """The solution's prose is a model answer: the student gets an empty answer cell instead."""
+    cells = lab["solution"].cells
+    explained = set()
+    for i, cell in enumerate(cells):
+        if cell.cell_type == "markdown" and "solution" in tags(cell):
+            if not cell.source.startswith("**Solution of Exercise"):
+                head = next(
+                    c.source
+                    for c in reversed(cells[:i])
+                    if c.source.startswith("**Solution of Exercise")
+                )
+                explained.add(re.search(r"Exercise ([\d.]+)", head).group(1))
+    answers = {
+        re.search(r"Exercise ([\d.]+)", c.source).group(1)
+        for c in lab["student"].cells
+        if c.cell_type == "markdown" and c.source.startswith("**Your answer to Exercise")
+    }
+    assert explained and explained <= answers
 
 
 def test_the_check_cells_are_kept_in_both_versions(lab):
@@ -147,10 +176,17 @@ def test_the_check_cells_are_kept_in_both_versions(lab):
     ]
     assert source_checks, "the lab has no check cells"
     solution = [c for c in lab["solution"].cells if "check" in tags(c)]
-    assert [c.source for c in solution] == source_checks
-    for_students = [c.source for c in solution if "instructor" not in tags(c)]
-    assert for_students  # the checks that follow the exercises, not the instructor's demos
-    assert [c.source for c in lab["student"].cells if "check" in tags(c)] == for_students
+    # only the cells a student runs carry the tag: not the instructor's demonstrations
+    assert not any("instructor" in tags(c) for c in solution)
+    demos = [
+        c.source
+        for c in lab["solution"].cells
+        if "instructor" in tags(c) and re.search(r"\bchecks\.\w+\(", c.source)
+    ]
+    assert [c.source for c in solution] == [s for s in source_checks if s not in demos]
+    assert [c.source for c in lab["student"].cells if "check" in tags(c)] == [
+        c.source for c in solution
+    ]
 
 
 def test_the_solution_version_is_complete(lab):
@@ -189,10 +225,16 @@ def test_the_student_version_runs_and_its_checks_say_what_is_missing(lab, tmp_pa
         assert "missing" in out or "got None" in out or "got NoneType" in out, out
 
 
+LAB_SECONDS = 60
+
+
 @pytest.mark.book
 def test_the_solution_version_runs_and_every_check_passes(lab, tmp_path):
+    start = time.perf_counter()
     nb = execute(lab["solution"], tmp_path)
-    checks = [c for c in nb.cells if "check" in tags(c) and "instructor" not in tags(c)]
+    seconds = time.perf_counter() - start
+    assert seconds < LAB_SECONDS, f"{lab['source'].name}: {seconds:.1f} s"
+    checks = [c for c in nb.cells if "check" in tags(c)]
     assert checks
     for cell in checks:
         out = text_output(cell)
@@ -319,14 +361,16 @@ def test_small_lab_student_version(small_lab, tmp_path):
         "# The cells below use these names; replace None by your answer:",
         "y = None",
     ]  # x and helper are not used later: no placeholder for them
-    assert todo[1].startswith("**Your answer to Exercise 2 (ex-small-2):**")  # prose only
-    assert todo[2].splitlines()[0] == "# TODO: Exercise 2 (ex-small-2). Write your code here."
-    assert "z = None" in todo[2]
+    # the solution of exercise 1 explains in words too: an answer cell after the code cell
+    assert todo[1].startswith("**Your answer to Exercise 1 (ex-small-1)**")
+    assert todo[2].startswith("**Your answer to Exercise 2 (ex-small-2)**")  # prose only
+    assert todo[3].splitlines()[0] == "# TODO: Exercise 2 (ex-small-2). Write your code here."
+    assert "z = None" in todo[3]
     assert "Because" not in text and "only for instructors" not in text
     assert "Notes for the marker" not in text
     assert "After the notes" in text and "> **Note.** Kept for everyone." in text
     assert "(Smith and Jones, 2001)" in text
-    assert "See (Smith and Jones, 2001) and *Part two*; equation (1):" in text
+    assert 'See (Smith and Jones, 2001) and section "Part two"; equation (1):' in text
     assert "$$\ny = 2x \\tag{1}$$" in text
     assert "# not a heading" in text  # fenced code is left alone
     assert "> **Exercise 1**" in text and "> **Exercise 2**" in text
@@ -374,7 +418,97 @@ def test_labs_command_writes_both_versions_with_a_summary(tmp_path, capsys):
 def test_labs_command_fails_clearly_on_a_missing_source(tmp_path, capsys):
     code = cli.main(["labs", "--out", str(tmp_path), "--source", "no_such_lab.md"])
     err = capsys.readouterr().err
-    assert code == 1
+    assert code == 2
     assert err == "uio-teach labs: error: no_such_lab.md: no such file\n"
     code = cli.main(["labs", "--out", str(tmp_path), "--book", str(tmp_path)])
-    assert code == 1 and "no lab chapter" in capsys.readouterr().err
+    assert code == 2 and "no lab chapter" in capsys.readouterr().err
+    code = cli.main(["labs", "--out", str(tmp_path), "--book", str(tmp_path / "nonexist")])
+    assert code == 2 and "nonexist: no such folder" in capsys.readouterr().err
+
+
+# nothing of the solution in the student notebook ------------------------------------------------
+
+
+def solution_only_lines(solution) -> list[str]:
+    """Lines of the solution cells that no other cell of the solution notebook has."""
+    shared = set()
+    for cell in solution.cells:
+        if "solution" not in tags(cell):
+            shared.update(line.strip() for line in cell.source.splitlines())
+    out = []
+    for cell in solution.cells:
+        if cell.cell_type == "code" and "solution" in tags(cell):
+            for line in cell.source.splitlines():
+                line = line.strip()
+                if len(line) >= 12 and line not in shared and line not in out:
+                    out.append(line)
+    return out
+
+
+def test_no_line_of_solution_code_is_in_the_student_notebook(lab):
+    """Not in its code, and not in its markdown either (a summary that repeats the solution)."""
+    text = "\n".join(c.source for c in lab["student"].cells)
+    lines = solution_only_lines(lab["solution"])
+    assert len(lines) >= 10
+    leaked = [line for line in lines if line in text]
+    assert not leaked, leaked
+
+
+def test_no_model_answer_is_in_the_student_notebook(lab):
+    """The prose of the solutions (the model answers) is only in the solution notebook."""
+    text = "\n".join(c.source for c in lab["student"].cells)
+    prose = [
+        c.source
+        for c in lab["solution"].cells
+        if c.cell_type == "markdown"
+        and "solution" in tags(c)
+        and not c.source.startswith("**Solution of")
+    ]
+    assert prose
+    for answer in prose:
+        for sentence in re.split(r"(?<=[.:])\s+", answer):
+            if len(sentence) > 40:
+                assert sentence not in text, sentence
+
+
+# a variant of every lab runs too ------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def variant_dir(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("variants")
+    labs.write_labs(out, groups=2, seed=11)
+    return out
+
+
+@pytest.mark.book
+@pytest.mark.parametrize("lab_id", list(labs.LABS))
+def test_a_variant_solves_with_every_check_passing_and_its_student_form_runs(
+    lab_id, variant_dir, tmp_path
+):
+    solution = execute(read(variant_dir / lab_id / "solution" / f"{lab_id}_g02.ipynb"), tmp_path)
+    for cell in solution.cells:
+        if "check" in tags(cell):
+            assert re.search(r"All \d+ checks passed\.", text_output(cell)), text_output(cell)
+    student = execute(read(variant_dir / lab_id / "student" / f"{lab_id}_g02.ipynb"), tmp_path)
+    for cell in student.cells:
+        if "check" in tags(cell):
+            assert "✗" in text_output(cell) and "Traceback" not in text_output(cell)
+
+
+def test_a_source_that_is_not_a_lab_is_a_usage_error(tmp_path, capsys):
+    garbled = tmp_path / "lab_notes.md"
+    garbled.write_text("# Notes\n\n```{exercise\nno closing\n")
+    code = cli.main(["labs", "--out", str(tmp_path / "out"), "--source", str(garbled)])
+    err = capsys.readouterr().err
+    assert code == 2 and "lab_notes.md: not a lab chapter" in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("version", labs.VERSIONS)
+def test_cross_references_are_short_plain_text(lab, version):
+    text = "\n".join(c.source for c in lab[version].cells if c.cell_type == "markdown")
+    assert re.search(r"\beq\. \(\d+\.\d+\)", text)
+    assert re.search(r"\bchapter \d+\b", text)
+    assert not re.search(r"\) of chapter \d", text)
+    assert not re.search(r"chapter \d+, \*", text)

@@ -155,8 +155,12 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
     _run([sys.executable, target / "bin" / "uio-teach", "labs", "--out", "labs", "-q"], installed)
     for version in ("student", "solution"):
         notebooks = sorted((work / "labs" / version).glob("*.ipynb"))
-        assert [p.name for p in notebooks] == ["lab_pa9.ipynb"]
-        assert f"Exercise {chapter}.1" in notebooks[0].read_text(encoding="utf-8")
+        assert [p.name for p in notebooks] == [
+            "lab_case_study.ipynb",
+            "lab_missile.ipynb",
+            "lab_pa9.ipynb",
+        ]
+        assert f"Exercise {chapter}.1" in notebooks[-1].read_text(encoding="utf-8")
 
 
 @pytest.mark.slow

@@ -1,4 +1,4 @@
-"""Checks for the lab of Practical Assignment 9: plain-words feedback on a student's work.
+"""Checks for the labs (Practical Assignment 9, the case study, the missile): plain-words feedback.
 
 Each function takes what a lab group produced (matrices, a simulation, a
 figure), never raises on a student mistake, and returns a :class:`CheckResult`:
@@ -12,6 +12,10 @@ a list of ✓ / ✗ messages that say what is right, what is not, and how to fix
   ``e`` and the residual ``r``.
 * :func:`pa9_piecewise` -- a response with a piecewise-constant disturbance:
   the same error as with the sinusoid.
+* ``case_study_*`` -- the case-study lab (module ``uio_teach.checks.case_study``).
+* ``missile_*`` -- the missile lab (module ``uio_teach.checks.missile``).
+
+Every result carries a ``check_id`` such as ``"pa9.design"``.
 
 Examples
 --------
@@ -27,7 +31,21 @@ True
 """
 
 from ._common import CheckResult, clear_collected, collected
+from .case_study import (
+    case_study_lmi,
+    case_study_pole,
+    case_study_projection,
+    case_study_residual,
+    case_study_simulation,
+)
 from .design import pa9_design
+from .missile import (
+    missile_catch_times,
+    missile_ginverse,
+    missile_noise,
+    missile_pmo,
+    missile_reconstruction,
+)
 from .plots import pa9_plot
 from .responses import pa9_piecewise, pa9_simulation
 
@@ -39,4 +57,14 @@ __all__ = [
     "pa9_simulation",
     "pa9_plot",
     "pa9_piecewise",
+    "case_study_projection",
+    "case_study_lmi",
+    "case_study_pole",
+    "case_study_simulation",
+    "case_study_residual",
+    "missile_pmo",
+    "missile_ginverse",
+    "missile_reconstruction",
+    "missile_catch_times",
+    "missile_noise",
 ]

@@ -244,11 +244,12 @@ def _never_raises(title: str, check_id: str | None = None) -> Callable[[_F], _F]
                     ],
                 )
             if isinstance(result, CheckResult):
-                if result.check_id is None:
+                if check_id or result.check_id is None:
                     result.check_id = ident
                 _COLLECTED.append(result)
             return result
 
+        wrapper.check_id = ident  # type: ignore[attr-defined]
         return wrapper  # type: ignore[return-value]
 
     return decorate

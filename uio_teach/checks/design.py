@@ -36,15 +36,19 @@ from ._common import (
 __all__ = ["pa9_design"]
 
 
-@_never_raises("Practical Assignment 9: the observer design")
+_OMITTED: Any = type("_Omitted", (), {"__repr__": lambda self: "<omitted>"})()
+
+
+@_never_raises("Practical Assignment 9: the observer design", "pa9.design")
 def pa9_design(
     H: Any,
     T: Any,
     K1: Any,
-    F: Any = None,
-    K2: Any = None,
+    F: Any = _OMITTED,
+    K2: Any = _OMITTED,
     plant: Any = None,
     *,
+    poles: Any = None,
     tol: float = 1e-6,
 ) -> CheckResult:
     """Check a decoupling-observer design against the equations (8) of the assignment.
@@ -52,7 +56,8 @@ def pa9_design(
     The checks, in order: the shapes; ``(I - HC)E = 0`` (the disturbance is
     cancelled); ``T = I - HC``; ``F = TA - K1C``; ``K2 = FH``; ``F`` stable
     (its eigenvalues in the open left half-plane, or in the unit disk for a
-    discrete plant). Each relation is checked against your own ``H`` and
+    discrete plant); with ``poles``, the eigenvalues of ``F`` are the poles
+    the exercise asks for. Each relation is checked against your own ``H`` and
     ``K1``, the two matrices you are free to choose: any ``H`` with
     ``HCE = E`` is accepted, not only ``E (CE)^+``.
 
@@ -66,12 +71,16 @@ def pa9_design(
         Your output-injection gain ``K1``.
     F : array_like, shape (n, n), optional
         Your ``F``; when omitted, ``TA - K1C`` is computed from your ``H`` and
-        ``K1`` and only its stability is checked.
+        ``K1`` and only its stability is checked. Passing ``None`` (an answer
+        not written yet) is a ✗.
     K2 : array_like, shape (n, p), optional
-        Your ``K2``; when omitted, it is not checked.
+        Your ``K2``; when omitted, it is not checked. Passing ``None`` is a ✗.
     plant : Plant, optional
         The plant; the assignment's example :func:`uio_teach.examples.pa9` by
         default.
+    poles : sequence of complex, optional
+        The poles the exercise asks for (e.g. ``[-1, -2, -3]``): the eigenvalues
+        of ``F`` must be these, each to ``1e-6`` relative.
     tol : float, optional
         Relative tolerance of the equalities (entries are compared with
         ``tol * max(1, largest entry)``). Full-precision NumPy results agree to
@@ -118,10 +127,13 @@ def pa9_design(
     H = _read_matrix(result, "H", H, n, p, what_np)
     T = _read_matrix(result, "T", T, n, n, what_nn)
     K1 = _read_matrix(result, "K1", K1, n, p, what_np)
-    F_given = F is not None
-    K2_given = K2 is not None
+    F_given = F is not _OMITTED
+    K2_given = K2 is not _OMITTED
     F = _read_matrix(result, "F", F, n, n, what_nn) if F_given else None
     K2 = _read_matrix(result, "K2", K2, n, p, what_np) if K2_given else None
+    wanted = _read_poles(result, poles, n, plant.is_discrete) if poles is not None else None
+    if poles is not None and wanted is None:
+        return result
     if H is None or T is None or K1 is None or (F_given and F is None) or (K2_given and K2 is None):
         result.add(None, "Fix the shapes first; the design equations are checked afterwards.")
         return result
@@ -233,6 +245,7 @@ def pa9_design(
     F_used = F if F_given else F_ref
     which = "F" if F_given else "F = TA - K1C"
     stable, eig, bad = _stability(F_used, plant.is_discrete)
+    asked = wanted if wanted is not None else experiments.PA9.poles
     region = "inside the unit circle" if plant.is_discrete else "in the open left half-plane"
     law = "e[k+1] = F e[k]" if plant.is_discrete else "e' = F e"
     if stable:
@@ -248,6 +261,77 @@ def pa9_design(
             f"{format_poles(bad)} "
             f"{'are' if len(bad) > 1 else 'is'} not {region}, so the error {law} does not "
             "decay. Choose K1 so that TA - K1C has the poles you want, e.g. "
-            f"K1 = ct.place((T @ A).T, C.T, {_numbers(experiments.PA9.poles)}).T.",
+            f"K1 = ct.place((T @ A).T, C.T, {_numbers(asked)}).T.",
         )
+    if wanted is not None:
+        _poles_asked(result, eig, wanted, which, A - K1 @ C, T_ref @ A - K1 @ C, F_given)
     return result
+
+
+def _read_poles(result: CheckResult, poles: Any, n: int, discrete: bool) -> np.ndarray | None:
+    """The poles an exercise asks for, as a sorted complex array (a ✗ if they are unusable)."""
+    from ..linalg import sort_poles
+
+    try:
+        arr = np.array([complex(p) for p in np.ravel(np.asarray(poles, dtype=object))])
+    except (TypeError, ValueError):
+        result.add(False, f"poles must be a list of {n} numbers, got {poles!r}.")
+        return None
+    if arr.size != n or not np.all(np.isfinite(arr)):
+        result.add(False, f"poles must be a list of {n} finite numbers, got {poles!r}.")
+        return None
+    return sort_poles(arr)
+
+
+def _same_poles(got: np.ndarray, wanted: np.ndarray) -> bool:
+    from ..linalg import sort_poles
+
+    got = sort_poles(np.asarray(got, complex))
+    if got.size != wanted.size:
+        return False
+    used = [False] * got.size
+    for w in wanted:
+        k = next(
+            (i for i, g in enumerate(got) if not used[i] and abs(g - w) <= 1e-6 * max(1.0, abs(w))),
+            None,
+        )
+        if k is None:
+            return False
+        used[k] = True
+    return True
+
+
+def _poles_asked(
+    result: CheckResult,
+    eig: np.ndarray,
+    wanted: np.ndarray,
+    which: str,
+    F_without_T: np.ndarray,
+    F_ref: np.ndarray,
+    F_given: bool,
+) -> None:
+    """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for, else a ✗ with the cause."""
+    if _same_poles(eig, wanted):
+        result.add(True, f"{which} has the poles asked for, {format_poles(wanted)}.")
+        return
+    if _same_poles(np.linalg.eigvals(F_without_T), wanted):
+        hint = (
+            " Your K1 places the poles of A - K1C, not of TA - K1C: place them for the pair "
+            "(TA, C), K1 = ct.place((T @ A).T, C.T, poles).T."
+        )
+    elif (
+        F_given
+        and not _same_poles(np.linalg.eigvals(F_ref), eig)
+        and _same_poles(np.linalg.eigvals(F_ref), wanted)
+    ):
+        hint = " TA - K1C has them, so your F is not TA - K1C (see above)."
+    else:
+        hint = (
+            " Place them with K1 = ct.place((T @ A).T, C.T, poles).T, with the poles of the "
+            "exercise."
+        )
+    result.add(
+        False,
+        f"{which} has the poles {format_poles(eig)}, but the exercise asks for "
+        f"{format_poles(wanted)}.{hint}",
+    )

@@ -177,8 +177,16 @@ def _jumps(d: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.any(np.abs(np.diff(d, axis=1)) > 1e-9 * scale, axis=0))
 
 
-@_never_raises("Practical Assignment 9: the test with a sinusoidal disturbance")
-def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
+@_never_raises("Practical Assignment 9: the test with a sinusoidal disturbance", "pa9.simulation")
+def pa9_simulation(
+    response: Any,
+    *,
+    decay: float = 0.01,
+    poles: Any = None,
+    amplitude: float | None = None,
+    frequency: float | None = None,
+    initial_state: Any = None,
+) -> CheckResult:
     """Check a simulation with a sinusoidal disturbance: does the error ignore ``d`` and decay?
 
     The checks: the disturbance ``d`` is nonzero and oscillates; the
@@ -193,6 +201,12 @@ def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
         The result of :func:`uio_teach.simulate`.
     decay : float, optional
         The largest final error, relative to the initial one (1 %).
+    poles : sequence of complex, optional
+        The observer poles the exercise asks for.
+    amplitude, frequency : float, optional
+        The sinusoid ``d(t) = amplitude sin(frequency t)`` the exercise asks for.
+    initial_state : array_like, optional
+        The plant's initial state the exercise asks for.
 
     Returns
     -------
@@ -237,6 +251,12 @@ def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
             result.add(
                 True, f"d oscillates like a sinusoid (it crosses its mean {crossings} times)."
             )
+        if amplitude is not None and frequency is not None and resp.plant.q == 1:
+            want = float(amplitude) * np.sin(float(frequency) * resp.time)
+            _asked_signal(
+                result, d[0], want, f"d(t) = {float(amplitude):g} sin({float(frequency):g} t)"
+            )
+    _asked_setup(result, resp, poles, initial_state)
     if not _noise_free(result, resp):
         return result
     e0 = _initial_error(result, resp)
@@ -245,9 +265,19 @@ def pa9_simulation(response: Any, *, decay: float = 0.01) -> CheckResult:
     return result
 
 
-@_never_raises("Practical Assignment 9: the test with a piecewise-constant disturbance")
+@_never_raises(
+    "Practical Assignment 9: the test with a piecewise-constant disturbance", "pa9.piecewise"
+)
 def pa9_piecewise(
-    response: Any, sinusoidal: Any = None, *, decay: float = 0.01, max_jumps: float = 0.1
+    response: Any,
+    sinusoidal: Any = None,
+    *,
+    decay: float = 0.01,
+    max_jumps: float = 0.1,
+    times: Any = None,
+    values: Any = None,
+    poles: Any = None,
+    initial_state: Any = None,
 ) -> CheckResult:
     """Check a simulation with a piecewise-constant disturbance, and compare with the sinusoid.
 
@@ -267,6 +297,13 @@ def pa9_piecewise(
         The largest final error, relative to the initial one (1 %).
     max_jumps : float, optional
         The largest fraction of samples at which ``d`` may change.
+    times, values : sequence of float, optional
+        The disturbance the exercise asks for,
+        ``ut.signals.piecewise_constant(times, values)``.
+    poles : sequence of complex, optional
+        The observer poles the exercise asks for.
+    initial_state : array_like, optional
+        The plant's initial state the exercise asks for.
 
     Returns
     -------
@@ -306,14 +343,26 @@ def pa9_piecewise(
                 "(is it still the sinusoid?): use d=ut.signals.piecewise_constant(times, values).",
             )
         else:
-            times = ", ".join(f"{resp.time[k + 1]:.3g}" for k in jumps[:6])
+            at = ", ".join(f"{resp.time[k + 1]:.3g}" for k in jumps[:6])
             more = ", ..." if jumps.size > 6 else ""
             unit = "" if resp.plant.dt is True else " s"
             result.add(
                 True,
                 f"d is piecewise constant: {_plural(jumps.size, 'jump')} (at t = "
-                f"{times}{more}{unit}).",
+                f"{at}{more}{unit}).",
             )
+        if times is not None and values is not None and resp.plant.q == 1:
+            from ..signals import piecewise_constant
+
+            want = np.asarray(piecewise_constant(times, values)(resp.time), float).ravel()
+            _asked_signal(
+                result,
+                d[0],
+                want,
+                f"the piecewise-constant d with times {_numbers(times)} and values "
+                f"{_numbers(values)}",
+            )
+    _asked_setup(result, resp, poles, initial_state)
     if not _noise_free(result, resp):
         return result
     e0 = _initial_error(result, resp)
@@ -340,13 +389,28 @@ def _compare(result: CheckResult, resp, other) -> None:
             "compared sample by sample: use the same timepts in both.",
         )
         return
-    if not np.allclose(resp.states[:, 0], other.states[:, 0]) or not np.allclose(
-        resp.estimates[:, 0], other.estimates[:, 0]
-    ):
+    if not np.allclose(resp.states[:, 0], other.states[:, 0]):
         result.add(
             False,
-            "the two simulations start from different states, so their errors differ for that "
-            "reason alone: use the same initial_state (and observer_state) in both.",
+            f"the two simulations start the plant from different states, "
+            f"{_numbers(resp.states[:, 0])} here and {_numbers(other.states[:, 0])} in the "
+            "sinusoidal test, so their errors differ for that reason alone: use the same "
+            "initial_state in both.",
+        )
+        return
+    if not _same_observer(resp.observer, other.observer):
+        result.add(
+            False,
+            f"the two simulations use different observers (a {resp.observer.family} here, "
+            f"a {other.observer.family} in the sinusoidal test): simulate the same decoupling "
+            "observer in both.",
+        )
+        return
+    if not np.allclose(resp.estimates[:, 0], other.estimates[:, 0]):
+        result.add(
+            False,
+            "the two simulations start the observer from different states, so their errors "
+            "differ for that reason alone: use the same observer_state (or none) in both.",
         )
         return
     diff = float(np.max(np.abs(resp.error - other.error)))
@@ -364,3 +428,57 @@ def _compare(result: CheckResult, resp, other) -> None:
             f"the error differs from the sinusoidal test by up to {diff:.3g}: are both "
             "simulations made with the same decoupling observer?",
         )
+
+
+def _same_observer(a: Any, b: Any) -> bool:
+    if a is b:
+        return True
+    if type(a) is not type(b) or getattr(a, "family", None) != getattr(b, "family", None):
+        return False
+    for name in ("F", "H", "T", "K1", "K2", "L", "M", "error_matrix"):
+        x, y = getattr(a, name, None), getattr(b, name, None)
+        if x is None and y is None:
+            continue
+        if x is None or y is None or np.shape(x) != np.shape(y) or not np.allclose(x, y):
+            return False
+    return True
+
+
+def _asked_signal(result: CheckResult, got: np.ndarray, want: np.ndarray, what: str) -> None:
+    diff = float(np.max(np.abs(np.asarray(got, float) - want)))
+    if diff <= 1e-9 * max(1.0, float(np.max(np.abs(want)))):
+        result.add(True, f"d is the disturbance the exercise asks for, {what}.")
+    else:
+        result.add(
+            False,
+            f"d is not the disturbance the exercise asks for, {what} (they differ by up to "
+            f"{diff:.3g}): take its numbers from PARAMS.",
+        )
+
+
+def _asked_setup(result: CheckResult, resp: Any, poles: Any, initial_state: Any) -> None:
+    """✓/✗ on the initial state and the observer poles that the exercise asks for."""
+    if initial_state is not None:
+        want = np.asarray(initial_state, float).ravel()
+        got = resp.states[:, 0]
+        if want.shape == got.shape and np.allclose(got, want, rtol=0, atol=1e-9):
+            result.add(True, f"the plant starts from x(0) = {_numbers(want)}, as asked.")
+        else:
+            result.add(
+                False,
+                f"the plant starts from x(0) = {_numbers(got)}, but the exercise asks for "
+                f'{_numbers(want)}: pass initial_state=PARAMS["initial_state"].',
+            )
+    if poles is not None:
+        from .design import _same_poles
+
+        got_poles = resp.observer.poles()
+        want_poles = np.array([complex(p) for p in np.ravel(np.asarray(poles, dtype=object))])
+        if _same_poles(got_poles, want_poles):
+            result.add(True, f"the observer has the poles asked for, {format_poles(want_poles)}.")
+        else:
+            result.add(
+                False,
+                f"the observer has the poles {format_poles(got_poles)}, but the exercise asks "
+                f"for {format_poles(want_poles)}: simulate the observer of requirement 1.",
+            )

@@ -249,6 +249,32 @@ class BookIndex:
         chapter = self.chapters.get(stem)
         return f"chapter {chapter}, *{title}*" if chapter else f"*{title}*"
 
+    def short_page(self, stem: str, here: str) -> str:
+        """A page as short plain text: ``chapter 3`` (the title if unnumbered).
+
+        Parameters
+        ----------
+        stem : str
+            The page referred to.
+        here : str
+            The page the reference is on (``"this chapter"`` if it is ``stem``).
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> from uio_teach.instructor.book import BookIndex
+        >>> index = BookIndex(chapters={"pa9": 4}, titles={"api": "API"})
+        >>> index.short_page("pa9", "lab"), index.short_page("api", "lab")
+        ('chapter 4', '*API*')
+        """
+        if stem == here:
+            return "this chapter"
+        chapter = self.chapters.get(stem)
+        return f"chapter {chapter}" if chapter else f"*{self.titles.get(stem, stem)}*"
+
     def cite(self, kind: str, keys: str) -> str:
         """A citation as text: ``kind`` ``"p"`` gives (Author, year), ``"t"`` Author (year).
 

@@ -124,13 +124,29 @@ notebooks, with empty outputs:
 
 In the student version a TODO cell sets the names that the later check cells
 use to None, so the notebook runs from top to bottom and each check says what
-is still missing.
+is still missing; a question answered in words gets a "Your answer" cell.
+
+The numbers of each lab (poles, disturbances, switching times, noise, seeds)
+are in its cell tagged `parameters` (`PARAMS = {...}`); the code and the checks
+read them from there. --config takes them from the term config (the keys of
+`uio-teach figures --print-config`: pa9.*, case_study.*, seed,
+missile.pmo_poles). --groups N --seed S draws numbers of its own for every
+group, each a fair exercise (the observer exists, poles distinct and stable,
+disturbances visible), and writes
+
+  DIR/<lab>/student/<lab>_g01.ipynb, DIR/<lab>/solution/<lab>_g01.ipynb, ...
+  DIR/answer_key.csv        one row per lab and group: lab, group, params,
+                            then the expected matrices and numbers (JSON)
+
+The same seed gives byte-identical files.
 """
 
 _LABS_EPILOG = """\
 examples:
   uio-teach labs --out handout/labs
   uio-teach labs --out handout/labs --source book/lab_pa9.md
+  uio-teach labs --out handout/labs --config term.toml
+  uio-teach labs --out handout/labs --groups 12 --seed 2026
 
 exit status:
   0 all notebooks written, 1 a lab could not be read or written, 2 a usage
@@ -298,6 +314,22 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE",
         help="convert these lab chapters only (default: every *lab*.md of the book)",
     )
+    labs.add_argument(
+        "--config", metavar="FILE", help="TOML file with this term's parameters (as for figures)"
+    )
+    labs.add_argument(
+        "--groups",
+        metavar="N",
+        type=_positive_int,
+        help="one variant per group: N student and N solution notebooks per lab, and the key",
+    )
+    labs.add_argument(
+        "--seed",
+        metavar="S",
+        type=_seed,
+        default=None,
+        help="seed of the variants (with --groups; default 0)",
+    )
     labs.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
 
     grade = commands.add_parser(
@@ -330,6 +362,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     grade.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     return parser
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a non-negative integer, got {value}")
+    return value
 
 
 def _error(command: str, message: str, stream: TextIO | None = None) -> None:
@@ -413,18 +455,36 @@ def _figures(args: argparse.Namespace) -> int:
 
 def _labs(args: argparse.Namespace) -> int:
     from . import labs
+    from .config import ConfigError, load_config
 
     start = time.perf_counter()
+    if args.seed is not None and args.groups is None:
+        _error("labs", "--seed needs --groups N (the seed of the groups' variants)")
+        return 2
+    try:
+        config = load_config(args.config) if args.config else None
+    except ConfigError as err:
+        _error("labs", str(err))
+        return 2
 
     def progress(index: int, total: int, result: labs.LabResult) -> None:
         if not args.quiet:
+            group = f" {result.group}" if result.group else ""
             print(
-                f"[{index}/{total}] {result.source.name}: {os.fspath(result.student)} "
+                f"[{index}/{total}] {result.source.name}{group}: {os.fspath(result.student)} "
                 f"({result.todo_cells} TODO cells), {os.fspath(result.solution)}"
             )
 
     try:
-        results = labs.write_labs(args.out, args.source, book_dir=args.book, progress=progress)
+        results = labs.write_labs(
+            args.out,
+            args.source,
+            book_dir=args.book,
+            progress=progress,
+            config=config,
+            groups=args.groups,
+            seed=args.seed or 0,
+        )
     except ImportError as err:
         missing = err.name or str(err)
         _error(
@@ -433,6 +493,9 @@ def _labs(args: argparse.Namespace) -> int:
             "pip install 'uio-teach[instructor]' (in a checkout, `make venv` installs it)",
         )
         return 1
+    except labs.LabUsageError as err:
+        _error("labs", str(err))
+        return 2
     except (labs.LabError, OSError) as err:
         _error("labs", str(err))
         return 1
@@ -440,9 +503,11 @@ def _labs(args: argparse.Namespace) -> int:
         elapsed = time.perf_counter() - start
         n = len(results)
         plural = "s" if n != 1 else ""
+        what = f"{n} lab{plural}" if args.groups is None else f"{n} lab variant{plural}"
+        key = f", and {labs.ANSWER_KEY}" if args.groups is not None else ""
         print(
-            f"{n} lab{plural} written to {os.fspath(args.out)}: {n} student and {n} solution "
-            f"notebook{plural} in {elapsed:.1f} s"
+            f"{what} written to {os.fspath(args.out)}: {n} student and {n} solution "
+            f"notebook{plural}{key} in {elapsed:.1f} s"
         )
     return 0
 

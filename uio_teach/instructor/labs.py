@@ -11,15 +11,24 @@ tagged ``solution``. From the one source, :func:`make_notebook` builds:
   cell sets them to ``None``, so the notebook runs from top to bottom and each
   check cell says, in plain words, what is still missing. Check cells are kept
   (tagged ``check``); a section headed "Instructor notes" is left out. A
-  solution made of prose only becomes a markdown "Your answer" cell.
+  solution that explains in words (a model answer) gets a markdown "Your
+  answer" cell instead; nothing of the solution is left in the notebook.
 * the **solution** version: complete, solution cells tagged ``solution``,
-  check cells ``check``, the instructor notes kept (tagged ``instructor``).
+  the check cells that students run tagged ``check``, the instructor notes
+  kept (tagged ``instructor``, never ``check``).
+
+The one code cell tagged ``parameters`` defines ``PARAMS``, the numbers of the
+exercise; with ``params=`` it is rewritten for a term (``--config``) or a group
+(``--groups``). :data:`LABS` names the course's labs, their parameter classes
+(:mod:`uio_teach.instructor.lab_params`) and the check ids of their check
+cells. A source without a solution is not a lab (:class:`LabUsageError`).
 
 Both have empty outputs and pass :func:`nbformat.validate`. The MyST syntax
-that Jupyter does not render is rewritten as plain Markdown: exercises become
-quotes titled "Exercise <number>" (numbered as in the book), ``{eq}`` references
-become equation numbers, ``{ref}`` and ``{doc}`` become titles, ``{cite:p}``
-becomes (Author, year), labelled display equations get a ``\\tag``.
+that Jupyter does not render is rewritten as plain Markdown by
+:mod:`uio_teach.instructor.myst`: exercises become quotes titled "Exercise
+<number>" (numbered as in the book), ``{eq}`` references become "eq. (3.2)",
+``{doc}`` and ``{ref}`` become "chapter 3", ``{cite:p}`` becomes (Author,
+year), labelled display equations get a ``\\tag``.
 
 Examples
 --------
@@ -64,17 +73,26 @@ from typing import Any, Literal
 
 from .book import (
     _HEADING,
-    _LABELLED_MATH,
     _TARGET,
     BookIndex,
     _fence_states,
     default_book_dir,
 )
+from .myst import Converter, Directive, tokens
+from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
 __all__ = [
     "VERSIONS",
+    "LABS",
+    "Lab",
+    "LabError",
+    "LabUsageError",
     "BookIndex",
     "LabResult",
+    "draw_variants",
+    "lab_of",
+    "params_source",
+    "write_answer_key",
     "default_book_dir",
     "find_labs",
     "make_notebook",
@@ -89,150 +107,65 @@ SOLUTION_TAG = "solution"
 CHECK_TAG = "check"
 TODO_TAG = "todo"
 INSTRUCTOR_TAG = "instructor"
+PARAMETERS_TAG = "parameters"
 
 Version = Literal["student", "solution"]
 
-_ROLE = re.compile(r"\{(?P<name>[\w:.-]+)\}`(?P<content>[^`]+)`")
 _CHECK_CALL = re.compile(r"\bchecks\.\w+\s*\(")
-_ADMONITIONS = {
-    "note",
-    "tip",
-    "hint",
-    "important",
-    "warning",
-    "caution",
-    "attention",
-    "danger",
-    "error",
-    "seealso",
-}
 
 
 class LabError(ValueError):
     """A lab chapter that cannot be converted (one-line message naming the file)."""
 
 
-# MyST Markdown -> Jupyter Markdown ---------------------------------------------------------------
+class LabUsageError(LabError):
+    """A source that is not a lab chapter, or a folder that does not exist (a usage error)."""
 
 
-@dataclass
-class _Directive:
-    name: str
-    arg: str
-    options: dict[str, str]
-    body: str
+def _params_literal(source: str) -> Any:
+    """The value of ``PARAMS = <literal>`` in a cell, or ``None`` if the cell is not that."""
+    tree = _python(source)
+    if tree is None or len(tree.body) != 1 or not isinstance(tree.body[0], ast.Assign):
+        return None
+    node = tree.body[0]
+    if [getattr(t, "id", None) for t in node.targets] != ["PARAMS"]:
+        return None
+    try:
+        return ast.literal_eval(node.value)
+    except (ValueError, SyntaxError):
+        return None
 
 
-def _tokens(text: str) -> list[str | _Directive]:
-    """Split Markdown into plain text and top-level directives, as jupytext's MyST parser does.
+def params_source(params: dict[str, Any]) -> str:
+    """The source of the ``parameters`` cell: ``PARAMS = {...}`` as a JSON-compatible literal.
 
-    The block parser of :mod:`jupytext.myst` (markdown-it-py with the MyST plugins, and the
-    colon fence of mdit-py-plugins) finds the directives; jupytext reads their options.
+    Parameters
+    ----------
+    params : dict
+        JSON-compatible values (numbers, strings, lists, dicts).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.labs import params_source
+    >>> print(params_source({"poles": [-1.0, -2.0]}))
+    PARAMS = {
+        "poles": [-1.0, -2.0]
+    }
     """
-    from jupytext.myst import get_parser, parse_directive_options
-    from mdit_py_plugins.colon_fence import colon_fence_plugin
+    import json
 
-    lines = text.split("\n")
-    out: list[str | _Directive] = []
-    done = 0
-    for token in get_parser().use(colon_fence_plugin).parse(text):
-        info = token.info.strip()
-        if token.level or token.type not in ("fence", "colon_fence") or not info.startswith("{"):
-            continue
-        head = re.match(r"^\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*)$", info)
-        if head is None:
-            continue
-        start, end = token.map
-        if start > done:
-            out.append("\n".join(lines[done:start]))
-        body, options = parse_directive_options(token.content, f"line {start + 1}: ")
-        options = {str(k): "" if v is None else str(v) for k, v in options.items()}
-        out.append(_Directive(head["name"], head["arg"], options, "\n".join(body).strip("\n")))
-        done = end
-    if done < len(lines):
-        out.append("\n".join(lines[done:]))
-    return [t for t in out if not isinstance(t, str) or t.strip("\n")] or [text]
-
-
-def _quote(text: str) -> str:
-    return "\n".join(f"> {line}" if line.strip() else ">" for line in text.split("\n"))
-
-
-class _Converter:
-    """MyST roles, labels and labelled equations of one page, written as plain Markdown."""
-
-    def __init__(self, index: BookIndex, stem: str) -> None:
-        self.index = index
-        self.stem = stem
-
-    def role(self, m: re.Match[str]) -> str:
-        name, content = m.group("name"), m.group("content")
-        explicit = re.match(r"^(?P<text>.+?)\s*<(?P<target>[^>]+)>$", content, re.DOTALL)
-        target = explicit.group("target") if explicit else content
-        if name.startswith("cite"):
-            return self.index.cite("t" if name.endswith(":t") else "p", content)
-        if name == "math":
-            return f"${content}$"
-        if name in ("sub", "sup"):
-            return f"<{name}>{content}</{name}>"
-        if explicit:
-            return explicit.group("text")
-        if name == "doc":
-            return self.index.page(Path(target).stem, self.stem)
-        if name == "eq":
-            if target in self.index.equations:
-                stem, k = self.index.equations[target]
-                where = "" if stem == self.stem else f" of {self.index.page(stem, self.stem)}"
-                return f"({self.index.number(stem, k)}){where}"
-            return f"({target})"
-        if name in ("ref", "numref"):
-            if target in self.index.exercises:
-                stem, k = self.index.exercises[target]
-                return f"Exercise {self.index.number(stem, k)}"
-            if target in self.index.sections:
-                stem, title = self.index.sections[target]
-                where = "" if stem == self.stem else f" in {self.index.page(stem, self.stem)}"
-                return f"*{title}*{where}"
-            return target
-        return content
-
-    def inline(self, text: str) -> str:
-        def tag(m: re.Match[str]) -> str:
-            label = m.group("label")
-            if label in self.index.equations:
-                stem, k = self.index.equations[label]
-                number = self.index.number(stem, k)
-            else:
-                number = label
-            return f"$${m.group('body').rstrip()} \\tag{{{number}}}$$"
-
-        text = _LABELLED_MATH.sub(tag, text)
-        lines = [ln for ln in text.split("\n") if not _TARGET.match(ln.strip())]
-        lines = [ln for ln in lines if not re.match(r"^%( |$)", ln)]  # MyST comments
-        text = _ROLE.sub(self.role, "\n".join(lines))
-        return re.sub(r"\n{3,}", "\n\n", text).strip("\n")
-
-    def directive(self, d: _Directive, exercise_number: str | None = None) -> str:
-        body = self.markdown(d.body)
-        if d.name == "exercise":
-            title = f"**Exercise {exercise_number}**" + (f" ({d.arg})" if d.arg else "")
-            return _quote(f"{title}\n\n{body}")
-        if d.name in _ADMONITIONS or d.name == "admonition":
-            title = d.arg if d.name == "admonition" and d.arg else d.name.capitalize()
-            return _quote(f"**{title}.** {body}")
-        if d.name == "math":
-            return f"$$\n{d.body}\n$$"
-        if d.name in ("code", "code-block", "sourcecode"):
-            return f"```{d.arg}\n{d.body}\n```"
-        if d.name in ("figure", "image"):
-            return f"*Figure: {body or d.arg}*"
-        return body
-
-    def markdown(self, text: str) -> str:
-        parts = []
-        for token in _tokens(text):
-            parts.append(self.inline(token) if isinstance(token, str) else self.directive(token))
-        return "\n\n".join(p for p in parts if p.strip())
+    text = json.dumps(params, indent=4, ensure_ascii=False, allow_nan=False)
+    # short lists of numbers on one line
+    text = re.sub(
+        r"\[\s*([^\[\]{}]*?)\s*\]",
+        lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]",
+        text,
+    )
+    return f"PARAMS = {text}"
 
 
 # Python names a solution defines and later cells use ---------------------------------------------
@@ -317,8 +250,18 @@ class _Cell:
 
 
 class _Builder:
-    def __init__(self, version: Version, converter: _Converter, index: BookIndex) -> None:
+    def __init__(
+        self,
+        version: Version,
+        converter: Converter,
+        index: BookIndex,
+        params: dict[str, Any] | None = None,
+    ) -> None:
         self.version = version
+        self.params = params
+        self.parameters_seen = False
+        self.solution_prose = False
+        self.solutions = 0
         self.student = version == "student"
         self.conv = converter
         self.index = index
@@ -345,6 +288,8 @@ class _Builder:
         return self.student and (self.solution is not None or self.instructor_level is not None)
 
     def _emit_md(self, text: str) -> None:
+        if self.solution is not None and text.strip() and not text.startswith("**Solution of"):
+            self.solution_prose = True
         if self._dropped() or not text.strip():
             return
         tags = self._context_tags()
@@ -368,7 +313,7 @@ class _Builder:
 
     # markdown -----------------------------------------------------------------------------------
     def markdown(self, text: str) -> None:
-        for token in _tokens(text):
+        for token in tokens(text):
             if isinstance(token, str):
                 self._text(token)
             else:
@@ -400,18 +345,20 @@ class _Builder:
             chunk.append(line)
         self._emit_md(self.conv.inline("\n".join(chunk)))
 
-    def _directive(self, d: _Directive) -> None:
+    def _directive(self, d: Directive) -> None:
         if d.name == "solution-start":
             self.flush()
             self.solution = d.arg.strip() or self.exercise[0]
             self.solution_code = []
+            self.solution_prose = False
+            self.solutions += 1
             label, number = self._exercise_label(self.solution)
             self._emit_md(f"**Solution of Exercise {number}**")
             return
         if d.name == "solution-end":
             self.flush()
             if self.student and self.solution is not None:
-                self._todo(self.solution, self.solution_code)
+                self._todo(self.solution, self.solution_code, prose=self.solution_prose)
             self.solution = None
             return
         if d.name == "exercise":
@@ -435,22 +382,33 @@ class _Builder:
         if self.student and self.instructor_level is not None:
             return
         self.flush()
+        if PARAMETERS_TAG in tags:
+            if self.parameters_seen:
+                raise LabError("more than one cell is tagged 'parameters'")
+            self.parameters_seen = True
+            if self.params is not None and _params_literal(source) != self.params:
+                source = params_source(self.params)
+            self.cells.append(_Cell("code", source, [PARAMETERS_TAG], meta))
+            return
         if is_solution:
             if self.student:
                 if self.solution is not None:
                     self.solution_code.append(source)
                 else:
+                    self.solutions += 1
                     self._todo(self.exercise[0], [source])
                 return
             if SOLUTION_TAG not in tags:
                 tags.append(SOLUTION_TAG)
-        elif _CHECK_CALL.search(source) and CHECK_TAG not in tags:
+        elif _CHECK_CALL.search(source) and CHECK_TAG not in tags and self.instructor_level is None:
             tags.append(CHECK_TAG)
-        if self.instructor_level is not None and INSTRUCTOR_TAG not in tags:
-            tags.append(INSTRUCTOR_TAG)
+        if self.instructor_level is not None:
+            tags = [t for t in tags if t != CHECK_TAG]
+            if INSTRUCTOR_TAG not in tags:
+                tags.append(INSTRUCTOR_TAG)
         self.cells.append(_Cell("code", source, tags, meta))
 
-    def _todo(self, label: str | None, code: list[str]) -> None:
+    def _todo(self, label: str | None, code: list[str], prose: bool = False) -> None:
         label, number = self._exercise_label(label)
         name = (f"Exercise {number}" if number else "") + (f" ({label})" if label else "")
         name = name.strip() or "your code"
@@ -458,8 +416,14 @@ class _Builder:
             self.cells.append(
                 _Cell("code", "", [TODO_TAG], solution_code=code, todo_header=f"# TODO: {name}.")
             )
-        else:
-            self.cells.append(_Cell("markdown", f"**Your answer to {name}:**\n\n*...*", [TODO_TAG]))
+        if prose or not code:
+            self.cells.append(
+                _Cell(
+                    "markdown",
+                    f"**Your answer to {name}** (in words; double-click to edit):\n\n*...*",
+                    [TODO_TAG],
+                )
+            )
 
     # finishing ----------------------------------------------------------------------------------
     def finish(self) -> list[_Cell]:
@@ -502,7 +466,12 @@ _BANNER = {
 
 
 def make_notebook(
-    source: str | os.PathLike[str], version: Version, *, index: BookIndex | None = None
+    source: str | os.PathLike[str],
+    version: Version,
+    *,
+    index: BookIndex | None = None,
+    params: dict[str, Any] | None = None,
+    metadata: dict[str, Any] | None = None,
 ) -> Any:
     """Build the student or solution notebook of one lab chapter (outputs empty).
 
@@ -515,6 +484,12 @@ def make_notebook(
     index : BookIndex, optional
         Titles and numbers for the cross-references; by default read from the
         folder of ``source``.
+    params : dict, optional
+        The lab's numbers: the cell tagged ``parameters`` becomes
+        ``PARAMS = <params>`` (default: the chapter's own cell).
+    metadata : dict, optional
+        Added to the notebook's ``uio_teach`` metadata (e.g. ``{"lab": "pa9",
+        "group": "g01"}``).
 
     Returns
     -------
@@ -524,7 +499,9 @@ def make_notebook(
     Raises
     ------
     LabError
-        The source cannot be read, or a solution block is not closed.
+        The source cannot be read, or a solution block is not closed; a
+        ``LabUsageError`` (a subclass) when the source is not a lab chapter (it
+        has no solution to hide) or does not exist.
 
     Examples
     --------
@@ -542,12 +519,17 @@ def make_notebook(
     if version not in VERSIONS:
         raise ValueError(f"version must be one of {VERSIONS}, got {version!r}")
     path = Path(source)
+    if not path.is_file():
+        raise LabUsageError(f"{os.fspath(path)}: no such file")
     try:
         nb = jupytext.read(path)
     except Exception as exc:
-        raise LabError(f"{os.fspath(path)}: cannot read it as a notebook: {exc}") from None
+        raise LabUsageError(
+            f"{os.fspath(path)}: not a lab chapter (cannot read it as a MyST notebook: "
+            f"{' '.join(str(exc).split())})"
+        ) from None
     index = index if index is not None else BookIndex.from_book(path.parent)
-    builder = _Builder(version, _Converter(index, path.stem), index)
+    builder = _Builder(version, Converter(index, path.stem), index, params)
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             builder.markdown(cell.source)
@@ -557,6 +539,13 @@ def make_notebook(
         cells = builder.finish()
     except LabError as err:
         raise LabError(f"{os.fspath(path)}: {err}") from None
+    if builder.solutions == 0:
+        raise LabUsageError(
+            f"{os.fspath(path)}: not a lab chapter: it has no solution to hide (no "
+            "solution-start/solution-end block and no code cell tagged 'solution')"
+        )
+    if params is not None and not builder.parameters_seen:
+        raise LabError(f"{os.fspath(path)}: no code cell tagged 'parameters' to hold PARAMS")
 
     out = [nbformat.v4.new_markdown_cell(_BANNER[version])]
     for cell in cells:
@@ -578,7 +567,7 @@ def make_notebook(
         metadata={
             "kernelspec": kernelspec,
             "language_info": {"name": "python"},
-            "uio_teach": {"source": path.name, "version": version},
+            "uio_teach": {"source": path.name, "version": version, **(metadata or {})},
         },
     )
     nbformat.validate(notebook)
@@ -597,18 +586,117 @@ def find_labs(book_dir: str | os.PathLike[str]) -> list[Path]:
     -------
     list of pathlib.Path
 
+    Raises
+    ------
+    LabUsageError
+        ``book_dir`` is not a folder.
+
     Examples
     --------
     >>> from uio_teach.instructor.labs import default_book_dir, find_labs
-    >>> [p.name for p in find_labs(default_book_dir())][:1]
-    ['lab_pa9.md']
+    >>> [p.name for p in find_labs(default_book_dir())]
+    ['lab_case_study.md', 'lab_missile.md', 'lab_pa9.md']
     """
-    return sorted(p for p in Path(book_dir).glob(LAB_PATTERN) if p.is_file())
+    folder = Path(book_dir)
+    if not folder.is_dir():
+        what = "not a folder" if folder.exists() else "no such folder"
+        raise LabUsageError(f"{os.fspath(folder)}: {what}")
+    return sorted(p for p in folder.glob(LAB_PATTERN) if p.is_file())
+
+
+@dataclass(frozen=True)
+class Lab:
+    """One lab of the course: its chapter, its parameter class and its checks.
+
+    Attributes
+    ----------
+    id : str
+        ``"pa9"``, ``"case_study"`` or ``"missile"``.
+    source : str
+        The file name of its chapter in ``book/``.
+    params : type
+        Its parameter class (:mod:`uio_teach.instructor.lab_params`).
+    check_ids : tuple of str
+        The ``check_id`` of every result its check cells produce, in order.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.labs import LABS
+    >>> LABS["pa9"].check_ids
+    ('pa9.design', 'pa9.simulation', 'pa9.plot', 'pa9.piecewise')
+    """
+
+    id: str
+    source: str
+    params: type
+    check_ids: tuple[str, ...]
+
+
+def _registry() -> dict[str, Lab]:
+    from .lab_params import CaseStudyParams, MissileParams, PA9Params
+
+    return {
+        "pa9": Lab(
+            "pa9",
+            "lab_pa9.md",
+            PA9Params,
+            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise"),
+        ),
+        "case_study": Lab(
+            "case_study",
+            "lab_case_study.md",
+            CaseStudyParams,
+            (
+                "case_study.projection",
+                "case_study.lmi",
+                "case_study.pole",
+                "case_study.simulation",
+                "case_study.residual",
+            ),
+        ),
+        "missile": Lab(
+            "missile",
+            "lab_missile.md",
+            MissileParams,
+            (
+                "missile.pmo",
+                "missile.ginverse",
+                "missile.reconstruction",
+                "missile.catch_times",
+                "missile.noise",
+            ),
+        ),
+    }
+
+
+LABS: dict[str, Lab] = _registry()
+"""The labs of the course by id: chapter file, parameter class, check ids."""
+
+
+def lab_of(source: str | os.PathLike[str]) -> Lab | None:
+    """The registered lab whose chapter is ``source`` (by file name), or ``None``.
+
+    Parameters
+    ----------
+    source : str or path-like
+
+    Returns
+    -------
+    Lab or None
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.labs import lab_of
+    >>> lab_of("book/lab_missile.md").id
+    'missile'
+    """
+    name = Path(source).name
+    return next((lab for lab in LABS.values() if lab.source == name), None)
 
 
 @dataclass(frozen=True)
 class LabResult:
-    """The two notebooks written for one lab chapter.
+    """The two notebooks written for one lab chapter (and one group).
 
     Attributes
     ----------
@@ -622,6 +710,8 @@ class LabResult:
         How many solutions the student version leaves to do.
     seconds : float
         Time spent.
+    group : str
+        The group id (``"g01"``), or ``""`` without groups.
 
     Examples
     --------
@@ -636,6 +726,7 @@ class LabResult:
     solution: Path
     todo_cells: int
     seconds: float
+    group: str = ""
 
 
 def write_labs(
@@ -644,8 +735,20 @@ def write_labs(
     *,
     book_dir: str | os.PathLike[str] | None = None,
     progress: Callable[[int, int, LabResult], None] | None = None,
+    config: Any = None,
+    groups: int | None = None,
+    seed: int = 0,
 ) -> list[LabResult]:
-    """Write ``out/student/<lab>.ipynb`` and ``out/solution/<lab>.ipynb`` for every lab.
+    """Write the student and the solution notebook of every lab (per group with ``groups``).
+
+    Without ``groups``: ``out/student/<lab>.ipynb`` and
+    ``out/solution/<lab>.ipynb``, with the numbers of ``config`` (the term
+    config) or of the chapter. With ``groups``: for every lab with a
+    parameter class, ``out/<lab>/student/<lab>_g01.ipynb`` and
+    ``out/<lab>/solution/<lab>_g01.ipynb`` for each group, each with its own
+    numbers, and ``out/answer_key.csv`` (one row per lab and group: ``lab``,
+    ``group``, ``params`` as JSON, then the expected matrices and numbers as
+    JSON). The same arguments give byte-identical files.
 
     Parameters
     ----------
@@ -657,7 +760,14 @@ def write_labs(
         The book's chapters (for the cross-references and the default
         sources); :func:`~uio_teach.instructor.book.default_book_dir` by default.
     progress : callable, optional
-        Called as ``progress(index, total, result)`` after each lab.
+        Called as ``progress(index, total, result)`` after each notebook pair.
+    config : mapping, optional
+        A term config (:func:`uio_teach.instructor.config.load_config`): the
+        labs' numbers follow it.
+    groups : int, optional
+        Number of lab groups: one variant per group.
+    seed : int, optional
+        Seed of the variants.
 
     Returns
     -------
@@ -666,7 +776,9 @@ def write_labs(
     Raises
     ------
     LabError
-        No lab chapter found, or one cannot be converted.
+        A lab cannot be converted; a ``LabUsageError`` (a subclass) for a
+        missing folder or file, a source that is not a lab, a bad ``groups``
+        or numbers that make no fair exercise.
     OSError
         The output folder cannot be written (see
         :func:`uio_teach.instructor.output.prepare_output_dir`).
@@ -687,29 +799,89 @@ def write_labs(
 
     book = Path(book_dir) if book_dir is not None else default_book_dir()
     paths = [Path(s) for s in sources] if sources else find_labs(book)
-    if not paths:
-        raise LabError(f"no lab chapter ({LAB_PATTERN}) in {os.fspath(book)}")
+    if sources is None or not sources:
+        if not paths:
+            raise LabUsageError(f"no lab chapter ({LAB_PATTERN}) in {os.fspath(book)}")
+    elif not book.is_dir():
+        raise LabUsageError(f"{os.fspath(book)}: no such folder")
     for path in paths:
         if not path.is_file():
-            raise LabError(f"{os.fspath(path)}: no such file")
-    folders = {v: prepare_output_dir(Path(out) / v) for v in VERSIONS}
+            what = "a folder, not a lab chapter" if path.is_dir() else "no such file"
+            raise LabUsageError(f"{os.fspath(path)}: {what}")
+    if groups is not None and not 1 <= int(groups) <= 999:
+        raise LabUsageError(f"groups must be between 1 and 999, got {groups}")
+    if seed is None or int(seed) < 0:
+        raise LabUsageError(f"seed must be a non-negative integer, got {seed}")
     index = BookIndex.from_book(book)
+
+    # every job before anything is written: (path, lab, group, params)
+    jobs: list[tuple[Path, Lab | None, str, Any]] = []
+    for path in paths:
+        lab = lab_of(path)
+        base = lab.params.from_config(config) if lab is not None else None
+        if base is not None and base.problems():
+            raise LabUsageError(
+                f"the {lab.id} lab cannot be made with these numbers: "  # type: ignore[union-attr]
+                + "; ".join(base.problems())
+            )
+        if groups is None:
+            jobs.append((path, lab, "", base))
+        elif lab is not None:
+            variants = draw_variants(lab, int(groups), int(seed), base)
+            jobs += [(path, lab, f"g{g:02d}", v) for g, v in enumerate(variants, start=1)]
+        else:
+            raise LabUsageError(
+                f"{os.fspath(path)}: --groups needs a lab of the course "
+                f"({', '.join(lab.source for lab in LABS.values())})"
+            )
+    # convert first (a bad source fails before any file is written)
+    built = []
+    for path, lab, group, params in jobs:
+        start = time.perf_counter()
+        meta = {"lab": lab.id, "group": group} if lab is not None and group else {}
+        if lab is not None and not group:
+            meta = {"lab": lab.id}
+        nbs = {
+            v: make_notebook(
+                path,
+                v,
+                index=index,
+                params=params.to_params() if params is not None else None,
+                metadata=meta,
+            )
+            for v in VERSIONS
+        }
+        built.append((path, lab, group, params, nbs, time.perf_counter() - start))
+
     results = []
-    for i, path in enumerate(paths, start=1):
+    folders: dict[Any, Path] = {}
+    for i, (path, lab, group, _params, nbs, seconds) in enumerate(built, start=1):
         start = time.perf_counter()
         written = {}
-        todo = 0
-        for version in VERSIONS:
-            nb = make_notebook(path, version, index=index)
-            if version == "student":
-                todo = sum(TODO_TAG in c.metadata.get("tags", []) for c in nb.cells)
-            target = folders[version] / f"{path.stem}.ipynb"
+        for version, nb in nbs.items():
+            if group:
+                where = (lab.id, version)  # type: ignore[union-attr]
+                if where not in folders:
+                    folders[where] = prepare_output_dir(Path(out) / lab.id / version)  # type: ignore[union-attr]
+                target = folders[where] / f"{lab.id}_{group}.ipynb"  # type: ignore[union-attr]
+            else:
+                if version not in folders:
+                    folders[version] = prepare_output_dir(Path(out) / version)
+                target = folders[version] / f"{path.stem}.ipynb"
             nbformat.write(nb, target)
             written[version] = target
+        todo = sum(TODO_TAG in c.metadata.get("tags", []) for c in nbs["student"].cells)
         result = LabResult(
-            path, written["student"], written["solution"], todo, time.perf_counter() - start
+            path,
+            written["student"],
+            written["solution"],
+            todo,
+            seconds + time.perf_counter() - start,
+            group,
         )
         results.append(result)
         if progress is not None:
-            progress(i, len(paths), result)
+            progress(i, len(built), result)
+    if groups is not None:
+        write_answer_key(Path(out) / ANSWER_KEY, [(lab, g, p) for _, lab, g, p, _, _ in built])
     return results

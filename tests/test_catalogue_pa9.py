@@ -1,0 +1,250 @@
+"""A catalogue of wrong answers to the PA9 lab: each gets a ✗ whose message names the mistake.
+
+Every entry is what a lab group could hand in (a matrix left out, a sign flipped, poles other
+than the asked ones, a figure with the wrong curves in a panel, ...) with the gist of the message
+the check must give. The right answer passes every check.
+"""
+
+from __future__ import annotations
+
+import control as ct
+import matplotlib
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import uio_teach as ut
+from uio_teach import checks
+from uio_teach.instructor.lab_params import PA9Params
+
+matplotlib.use("Agg")
+
+P = PA9Params().to_params()
+POLES = P["poles"]
+X0 = P["initial_state"]
+AMP, FREQ = P["sine"]["amplitude"], P["sine"]["frequency"]
+TIMES, VALUES = P["piecewise"]["times"], P["piecewise"]["values"]
+PLANT = ut.examples.pa9()
+A, C, E = PLANT.A, PLANT.C, PLANT.E
+H = E @ np.linalg.pinv(C @ E)
+T = np.eye(3) - H @ C
+K1 = ct.place((T @ A).T, C.T, POLES).T
+F = T @ A - K1 @ C
+K2 = F @ H
+TIME = np.linspace(0, P["duration"], P["samples"])
+SINE = ut.signals.sinusoid(AMP, FREQ)
+STEPS = ut.signals.piecewise_constant(TIMES, VALUES)
+OBS = ut.design_uio(PLANT, K1=K1)
+
+
+def sim(observer=OBS, d=SINE, x0=X0, timepts=TIME, **kw):
+    return ut.simulate(PLANT, observer, timepts, d=d, initial_state=x0, **kw)
+
+
+SINE_RESP = sim()
+STEPS_RESP = sim(d=STEPS)
+
+
+def design(h=H, t=T, k1=K1, f=F, k2=K2):
+    return checks.pa9_design(h, t, k1, f, k2, poles=POLES)
+
+
+def simulation(resp):
+    return checks.pa9_simulation(resp, poles=POLES, amplitude=AMP, frequency=FREQ, initial_state=X0)
+
+
+def piecewise(resp, sinusoidal=SINE_RESP):
+    return checks.pa9_piecewise(
+        resp, sinusoidal=sinusoidal, times=TIMES, values=VALUES, poles=POLES, initial_state=X0
+    )
+
+
+def figure(
+    e_curves,
+    r_curves,
+    e_label="error e = x - x̂",
+    r_label="residual r = y - C x̂",
+    xlabel="time (s)",
+    x=None,
+    one_axes=False,
+):
+    fig = Figure()
+    if one_axes:
+        ax = fig.subplots()
+        ax.plot(TIME if x is None else x, e_curves.T)
+        ax.plot(TIME if x is None else x, r_curves.T)
+        ax.set_ylabel(f"{e_label}, {r_label}")
+        ax.set_xlabel(xlabel)
+        return fig
+    ax_e, ax_r = fig.subplots(2, 1, sharex=True)
+    ax_e.plot(TIME if x is None else x, e_curves.T)
+    ax_e.set_ylabel(e_label)
+    ax_r.plot(TIME if x is None else x, r_curves.T)
+    ax_r.set_ylabel(r_label)
+    ax_r.set_xlabel(xlabel)
+    return fig
+
+
+def plot(fig):
+    return checks.pa9_plot(fig, response=SINE_RESP)
+
+
+R = SINE_RESP
+K1_A = ct.place(A.T, C.T, POLES).T  # placed for A, not TA
+K1_FAST = ct.place((T @ A).T, C.T, [-4, -5, -6]).T
+K1_UNSTABLE = ct.place((T @ A).T, C.T, [1, -2, -3]).T
+LUEN = ut.design_luenberger(PLANT, poles=POLES)
+H_NAN = H.copy()
+H_NAN[1, 0] = np.nan
+
+CATALOGUE = {
+    # requirement 1: the design ------------------------------------------------------------------
+    "H left out": (lambda: design(h=None), "H is missing"),
+    "T left out": (lambda: design(t=None), "T is missing"),
+    "K1 left out": (lambda: design(k1=None), "K1 is missing"),
+    "F left out": (lambda: design(f=None), "F is missing"),
+    "K2 left out": (lambda: design(k2=None), "K2 is missing"),
+    "H transposed": (lambda: design(h=H.T), "It looks transposed"),
+    "H copied with 2 decimals": (lambda: design(h=np.round(H, 2)), "2 decimals"),
+    "H with a minus sign": (lambda: design(h=-H), "drop the minus sign"),
+    "H with a NaN": (lambda: design(h=H_NAN), "every entry must be a finite number"),
+    "H as ragged lists": (lambda: design(h=[[1, 2], [3]]), "could not be read as a matrix"),
+    "H as text": (lambda: design(h="E @ pinv(C @ E)"), "must hold numbers"),
+    "K1 complex": (lambda: design(k1=K1 + 1j), "complex entries"),
+    "T = HC - I": (lambda: design(t=-T), "Your T is HC - I"),
+    "T = HC": (lambda: design(t=H @ C), "Your T is HC"),
+    "F = A - K1C": (lambda: design(f=A - K1 @ C), "the T is missing, F = TA - K1C"),
+    "F = TA + K1C": (lambda: design(f=T @ A + K1 @ C), "the sign of K1C is flipped"),
+    "K2 = -FH": (lambda: design(k2=-F @ H), "K2 is -FH: the sign is flipped"),
+    "K2 = K1 - FH": (lambda: design(k2=K1 - F @ H), "Your K2 is K1 - FH"),
+    "K1 placing -4, -5, -6": (
+        lambda: design(k1=K1_FAST, f=T @ A - K1_FAST @ C, k2=(T @ A - K1_FAST @ C) @ H),
+        "but the exercise asks for -3, -2, -1",
+    ),
+    "K1 placed for A instead of TA": (
+        lambda: design(k1=K1_A, f=T @ A - K1_A @ C, k2=(T @ A - K1_A @ C) @ H),
+        "places the poles of A - K1C, not of TA - K1C",
+    ),
+    "K1 with an unstable pole": (
+        lambda: design(k1=K1_UNSTABLE, f=T @ A - K1_UNSTABLE @ C, k2=(T @ A - K1_UNSTABLE @ C) @ H),
+        "F is not stable: the eigenvalue 1 is not in the open left half-plane",
+    ),
+    # requirement 2: the sinusoidal test ---------------------------------------------------------
+    "simulation left out": (lambda: simulation(None), "got None"),
+    "a Luenberger observer": (lambda: simulation(sim(LUEN)), "Your observer is a Luenberger"),
+    "no disturbance": (lambda: simulation(sim(d=None)), "d is zero during the whole simulation"),
+    "the piecewise d in the sinusoidal test": (
+        lambda: simulation(STEPS_RESP),
+        "d is piecewise constant, not a sinusoid",
+    ),
+    "another amplitude": (
+        lambda: simulation(sim(d=ut.signals.sinusoid(2 * AMP, FREQ))),
+        "is not the disturbance the exercise asks for",
+    ),
+    "another initial state": (
+        lambda: simulation(sim(x0=[0.0, 1.0, 0.0])),
+        "the plant starts from x(0) = [0, 1, 0], but the exercise asks for [1, -1, 0.5]",
+    ),
+    "a zero initial state": (
+        lambda: simulation(sim(x0=[0.0, 0.0, 0.0])),
+        "the error is zero at t = 0",
+    ),
+    "measurement noise": (lambda: simulation(sim(noise=0.01, seed=1)), "measurement noise"),
+    "too short a simulation": (
+        lambda: simulation(sim(timepts=np.linspace(0, 1, 201))),
+        "has not decayed yet",
+    ),
+    "an observer with other poles": (
+        lambda: simulation(sim(ut.design_uio(PLANT, poles=[-4, -5, -6]))),
+        "the observer has the poles -6, -5, -4, but the exercise asks for -1, -2, -3",
+    ),
+    # requirement 3: the figure -----------------------------------------------------------------
+    "figure left out": (lambda: plot(None), "fig is missing (None)"),
+    "outputs y in the residual panel": (
+        lambda: plot(figure(R.error, R.outputs)),
+        "the residual panel shows the outputs y (resp.outputs)",
+    ),
+    "panel labels swapped": (
+        lambda: plot(figure(R.residual, R.error)),
+        "the panels are swapped",
+    ),
+    "one axes instead of two": (
+        lambda: plot(figure(R.error, R.residual, one_axes=True)),
+        "one axes with curves; e and r belong in two panels",
+    ),
+    "time without a unit": (
+        lambda: plot(figure(R.error, R.residual, xlabel="time")),
+        "the x-label 'time' has no unit",
+    ),
+    "sample index under 'time (s)'": (
+        lambda: plot(figure(R.error, R.residual, x=np.arange(TIME.size))),
+        "plotted against the sample index",
+    ),
+    "-e in the error panel": (
+        lambda: plot(figure(-R.error, R.residual)),
+        "the error panel shows -e = x̂ - x",
+    ),
+    "x in the error panel": (
+        lambda: plot(figure(R.states, R.residual)),
+        "the error panel shows the states x (resp.states)",
+    ),
+    "x̂ in the error panel": (
+        lambda: plot(figure(R.estimates, R.residual)),
+        "the error panel shows the estimates x̂",
+    ),
+    "e2 left out": (
+        lambda: plot(figure(R.error[[0, 2]], R.residual)),
+        "the error panel lacks some error components: e2",
+    ),
+    "no x-label": (
+        lambda: plot(figure(R.error, R.residual, xlabel="")),
+        "have no x-label",
+    ),
+    # requirement 4: the piecewise-constant test --------------------------------------------------
+    "the sinusoid again": (lambda: piecewise(SINE_RESP), "so it is not piecewise constant"),
+    "a constant d": (
+        lambda: piecewise(sim(d=ut.signals.piecewise_constant([0], [1.0]))),
+        "d is constant",
+    ),
+    "other switching times": (
+        lambda: piecewise(sim(d=ut.signals.piecewise_constant([0, 1], [1.0, -1.0]))),
+        "is not the disturbance the exercise asks for",
+    ),
+    "another initial state than in requirement 2": (
+        lambda: piecewise(sim(d=STEPS, x0=[0.0, 1.0, 0.0])),
+        "start the plant from different states",
+    ),
+    "a Luenberger observer in requirement 4": (
+        lambda: piecewise(sim(LUEN, d=STEPS)),
+        "the two simulations use different observers",
+    ),
+    "another time grid": (
+        lambda: piecewise(sim(d=STEPS, timepts=np.linspace(0, P["duration"], 1001))),
+        "use the same timepts in both",
+    ),
+}
+
+
+def test_the_catalogue_is_large_enough():
+    assert len(CATALOGUE) >= 25
+
+
+@pytest.mark.parametrize("name", list(CATALOGUE))
+def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
+    make, gist = CATALOGUE[name]
+    result = make()
+    assert not result.passed, f"{name}: passed\n{result}"
+    assert any(gist in msg for msg in result.failures), f"{name}: expected {gist!r}\n{result}"
+
+
+def test_the_right_answer_passes_every_check():
+    fig = figure(R.error, R.residual)
+    for result in (design(), simulation(SINE_RESP), plot(fig), piecewise(STEPS_RESP)):
+        assert result.passed, str(result)
+
+
+def test_the_checks_carry_their_ids():
+    fig = figure(R.error, R.residual)
+    ids = [r.check_id for r in (design(), simulation(R), plot(fig), piecewise(STEPS_RESP))]
+    assert ids == ["pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise"]
+    assert checks.pa9_design(None, None, None).check_id == "pa9.design"  # also on a failure

@@ -1,0 +1,260 @@
+"""The labs' numbers: parameter classes, the term config, one variant per group, the answer key."""
+
+from __future__ import annotations
+
+import ast
+import csv
+import json
+import re
+from pathlib import Path
+
+import jupytext
+import nbformat
+import numpy as np
+import pytest
+
+from uio_teach import checks
+from uio_teach.instructor import cli, labs
+from uio_teach.instructor.config import load_config
+from uio_teach.instructor.lab_params import CaseStudyParams, MissileParams, PA9Params
+
+BOOK = labs.default_book_dir()
+
+
+def tags(cell) -> list[str]:
+    return list(cell.metadata.get("tags", []))
+
+
+def params_cell(nb):
+    cells = [c for c in nb.cells if "parameters" in tags(c)]
+    assert len(cells) == 1
+    return cells[0]
+
+
+def params_of(nb) -> dict:
+    tree = ast.parse(params_cell(nb).source)
+    (node,) = tree.body
+    assert [t.id for t in node.targets] == ["PARAMS"]
+    return ast.literal_eval(node.value)
+
+
+@pytest.mark.parametrize("lab", list(labs.LABS.values()), ids=list(labs.LABS))
+def test_the_chapter_numbers_are_the_defaults_of_the_parameter_class(lab):
+    """The book's PARAMS cell and the parameter class (from uio_teach.experiments) agree."""
+    myst = jupytext.read(BOOK / lab.source)
+    assert params_of(myst) == lab.params().to_params()
+
+
+@pytest.mark.parametrize("cls", [PA9Params, CaseStudyParams, MissileParams])
+def test_params_round_trip_through_json(cls):
+    params = cls().to_params()
+    again = json.loads(json.dumps(params))
+    assert cls.from_params(again) == cls()
+    assert not cls().problems()
+
+
+def test_complex_poles_travel_as_strings():
+    p = PA9Params(poles=(complex(-1, 2), complex(-1, -2), -3.0))
+    assert p.to_params()["poles"] == ["-1+2j", "-1-2j", -3.0]
+    assert PA9Params.from_params(p.to_params()) == p
+    answers = p.answers()
+    assert answers["error_poles"] == [-3.0, "-1-2j", "-1+2j"]
+
+
+@pytest.mark.parametrize("lab", list(labs.LABS.values()), ids=list(labs.LABS))
+def test_the_registry_names_the_check_ids_of_the_check_cells(lab):
+    nb = labs.make_notebook(BOOK / lab.source, "student")
+    ids = []
+    for cell in nb.cells:
+        if "check" in tags(cell):
+            (name,) = re.findall(r"\bchecks\.(\w+)\(", cell.source)
+            ids.append(getattr(checks, name).check_id)
+    assert tuple(ids) == lab.check_ids
+
+
+def test_every_lab_notebook_has_one_parameters_cell_and_its_lab_in_the_metadata(tmp_path):
+    results = labs.write_labs(tmp_path)
+    for result in results:
+        for path in (result.student, result.solution):
+            nb = nbformat.read(path, as_version=4)
+            params_cell(nb)
+            lab = labs.lab_of(result.source)
+            assert nb.metadata.uio_teach["lab"] == lab.id
+
+
+# the term config --------------------------------------------------------------------------------
+
+TERM = """\
+seed = 9
+[pa9]
+poles = [-2.0, -3.0, -4.0]
+[pa9.sine]
+amplitude = 0.5
+frequency = 3.0
+[case_study]
+poles = [0.1]
+[missile]
+pmo_poles = [-90.0, -130.0]
+"""
+
+
+def test_the_term_config_sets_the_numbers_of_every_lab(tmp_path):
+    config = tmp_path / "term.toml"
+    config.write_text(TERM)
+    assert cli.main(["labs", "--out", str(tmp_path / "out"), "--config", str(config), "-q"]) == 0
+    for version in labs.VERSIONS:
+        pa9 = params_of(nbformat.read(tmp_path / "out" / version / "lab_pa9.ipynb", 4))
+        assert pa9["poles"] == [-2.0, -3.0, -4.0] and pa9["sine"] == {
+            "amplitude": 0.5,
+            "frequency": 3.0,
+        }
+        case = params_of(nbformat.read(tmp_path / "out" / version / "lab_case_study.ipynb", 4))
+        assert case["pole"] == 0.1 and case["v"]["seed"] == 9
+        missile = params_of(nbformat.read(tmp_path / "out" / version / "lab_missile.ipynb", 4))
+        assert missile["pmo_poles"] == [-90.0, -130.0]
+    assert PA9Params.from_config(load_config(config)).poles == (-2.0, -3.0, -4.0)
+
+
+def test_the_checks_follow_the_config_poles():
+    """A design for the default poles fails the check of a term with other poles."""
+    import control as ct
+
+    import uio_teach as ut
+
+    plant = ut.examples.pa9()
+    A, C, E = plant.A, plant.C, plant.E
+    H = E @ np.linalg.pinv(C @ E)
+    T = np.eye(3) - H @ C
+    K1 = ct.place((T @ A).T, C.T, [-1, -2, -3]).T
+    F = T @ A - K1 @ C
+    term = PA9Params(poles=(-2.0, -3.0, -4.0)).to_params()
+    assert checks.pa9_design(H, T, K1, F, F @ H, poles=PA9Params().to_params()["poles"]).passed
+    result = checks.pa9_design(H, T, K1, F, F @ H, poles=term["poles"])
+    assert "but the exercise asks for -4, -3, -2" in "\n".join(result.failures)
+
+
+def test_numbers_that_make_no_fair_lab_are_a_usage_error(tmp_path, capsys):
+    config = tmp_path / "term.toml"
+    config.write_text("[pa9]\nduration = 1.0\n")
+    code = cli.main(["labs", "--out", str(tmp_path / "out"), "--config", str(config)])
+    err = capsys.readouterr().err
+    assert code == 2 and "the pa9 lab cannot be made with these numbers" in err
+    assert not (tmp_path / "out").exists()
+
+
+# variants per group ---------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def variants(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("variants")
+    assert cli.main(["labs", "--out", str(out), "--groups", "3", "--seed", "5", "-q"]) == 0
+    return out
+
+
+def test_groups_give_distinct_notebooks_per_lab_named_by_group(variants):
+    for lab in labs.LABS:
+        seen = []
+        for g in ("g01", "g02", "g03"):
+            student = nbformat.read(variants / lab / "student" / f"{lab}_{g}.ipynb", 4)
+            solution = nbformat.read(variants / lab / "solution" / f"{lab}_{g}.ipynb", 4)
+            assert student.metadata.uio_teach["lab"] == lab
+            assert student.metadata.uio_teach["group"] == g
+            assert params_of(student) == params_of(solution)
+            seen.append(params_of(student))
+        assert len({json.dumps(p, sort_keys=True) for p in seen}) == 3
+
+
+def test_every_variant_is_a_fair_exercise(variants):
+    for lab in labs.LABS.values():
+        for g in ("g01", "g02", "g03"):
+            nb = nbformat.read(variants / lab.id / "student" / f"{lab.id}_{g}.ipynb", 4)
+            params = lab.params.from_params(params_of(nb))
+            assert not params.problems()
+    for variant in labs.draw_variants(labs.LABS["pa9"], 30, seed=1):
+        poles = np.array(variant.poles, dtype=float)
+        assert len(set(poles)) == 3 and np.all(poles <= -1) and np.all(poles >= -5)
+        assert abs(variant.sine_amplitude) >= 0.5 and max(map(abs, variant.switch_values)) >= 0.5
+    for variant in labs.draw_variants(labs.LABS["case_study"], 30, seed=1):
+        assert abs(variant.pole) < 1 and abs(variant.pole - 0.5) >= 0.2
+
+
+def test_the_same_seed_gives_byte_identical_files(variants, tmp_path):
+    assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "5", "-q"]) == 0
+    files = sorted(p.relative_to(variants) for p in variants.rglob("*") if p.is_file())
+    again = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+    assert files == again and len(files) == 3 * 3 * 2 + 1
+    for name in files:
+        assert (variants / name).read_bytes() == (tmp_path / name).read_bytes(), name
+
+
+def test_another_seed_gives_other_numbers(variants, tmp_path):
+    assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "6", "-q"]) == 0
+    a = nbformat.read(variants / "pa9" / "student" / "pa9_g01.ipynb", 4)
+    b = nbformat.read(tmp_path / "pa9" / "student" / "pa9_g01.ipynb", 4)
+    assert params_of(a) != params_of(b)
+
+
+def test_the_answer_key_has_one_row_per_lab_and_group_with_the_right_answers(variants):
+    import control as ct
+
+    import uio_teach as ut
+
+    with (variants / "answer_key.csv").open(newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [(r["lab"], r["group"]) for r in rows] == [
+        (lab, g) for lab in sorted(labs.LABS) for g in ("g01", "g02", "g03")
+    ]
+    for row in rows:
+        nb = nbformat.read(
+            variants / row["lab"] / "solution" / f"{row['lab']}_{row['group']}.ipynb", 4
+        )
+        assert json.loads(row["params"]) == params_of(nb)
+        params = json.loads(row["params"])
+        if row["lab"] == "pa9":
+            F = np.array(json.loads(row["pa9.F"]))
+            assert np.allclose(
+                np.sort(np.linalg.eigvals(F).real), sorted(params["poles"]), atol=1e-6
+            )
+            plant = ut.examples.pa9()
+            K1 = np.array(json.loads(row["pa9.K1"]))
+            H = np.array(json.loads(row["pa9.H"]))
+            T = np.array(json.loads(row["pa9.T"]))
+            assert checks.pa9_design(
+                H, T, K1, F, np.array(json.loads(row["pa9.K2"])), poles=params["poles"], tol=1e-8
+            ).passed
+            assert np.allclose(
+                K1, ct.place((T @ plant.A).T, plant.C.T, params["poles"]).T, atol=1e-8
+            )
+        elif row["lab"] == "case_study":
+            L = np.array(json.loads(row["case_study.L_pole"]))
+            assert checks.case_study_pole(L, params["pole"]).passed
+        else:
+            M = np.array(json.loads(row["missile.M"]))
+            L = np.array(json.loads(row["missile.L"]))
+            plant = ut.examples.missile_autopilot()
+            F = (np.eye(4) - M @ plant.C) @ plant.A - L @ plant.C
+            assert checks.missile_pmo(M, L, F, poles=params["pmo_poles"]).passed
+
+
+def test_groups_need_a_lab_of_the_course_and_sane_numbers(tmp_path, capsys):
+    other = tmp_path / "lab_other.md"
+    other.write_text((BOOK / "lab_pa9.md").read_text())
+    code = cli.main(
+        [
+            "labs",
+            "--out",
+            str(tmp_path / "o"),
+            "--groups",
+            "2",
+            "--source",
+            str(other),
+            "--book",
+            str(BOOK),
+        ]
+    )
+    assert code == 2 and "--groups needs a lab of the course" in capsys.readouterr().err
+    assert cli.main(["labs", "--out", str(tmp_path / "o"), "--groups", "0"]) == 2
+    assert cli.main(["labs", "--out", str(tmp_path / "o"), "--groups", "2", "--seed", "-1"]) == 2
+    assert cli.main(["labs", "--out", str(tmp_path / "o"), "--seed", "3"]) == 2
+    assert not (tmp_path / "o").exists()

@@ -1,0 +1,119 @@
+"""Variants of the labs, one per group, and their answer key.
+
+:func:`draw_variants` draws distinct parameter sets of a lab, each a fair
+exercise (see the ``problems()`` of each class of
+:mod:`uio_teach.instructor.lab_params`), from a seed; :func:`write_answer_key`
+writes the expected matrices and numbers of every (lab, group) to a CSV file.
+
+Examples
+--------
+>>> from uio_teach.instructor.labs import LABS
+>>> from uio_teach.instructor.variants import draw_variants
+>>> [v.to_params()["poles"] for v in draw_variants(LABS["pa9"], 2, seed=5)] != []
+True
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = ["ANSWER_KEY", "draw_variants", "write_answer_key"]
+
+ANSWER_KEY = "answer_key.csv"
+"""The file name of the answer key in the output folder."""
+
+
+def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[Any]:
+    """``groups`` distinct parameter sets of ``lab``, each a fair exercise, from ``seed``.
+
+    Parameters
+    ----------
+    lab : Lab
+        The lab (an entry of :data:`LABS`).
+    groups : int
+        How many variants.
+    seed : int
+        Seed of the draw; the same seed gives the same variants.
+    base : LabParams, optional
+        What the variants keep (time grid, ...): the term's parameters.
+
+    Returns
+    -------
+    list
+        Parameter objects of ``lab.params``.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.labs import LABS, draw_variants
+    >>> a, b = draw_variants(LABS["pa9"], 2, seed=5)
+    >>> a != b and not a.problems() and not b.problems()
+    True
+    """
+    import numpy as np
+
+    from .labs import LABS, LabUsageError
+
+    index = list(LABS).index(lab.id) if lab.id in LABS else 0
+    rng = np.random.default_rng([int(seed), index])
+    out: list[Any] = []
+    seen: set[str] = set()
+    for _ in range(1000 * max(1, groups)):
+        if len(out) == groups:
+            break
+        variant = lab.params.draw(rng, base)
+        key = repr(variant.to_params())
+        if key in seen or variant.problems():
+            continue
+        seen.add(key)
+        out.append(variant)
+    if len(out) < groups:
+        raise LabUsageError(f"cannot draw {groups} distinct variants of the {lab.id} lab")
+    return out
+
+
+def write_answer_key(path: Path, rows: Sequence[tuple[Any, str, Any]]) -> Path:
+    """Write the answer key CSV: ``lab``, ``group``, ``params``, then one column per key number.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV file.
+    rows : sequence of (Lab, str, LabParams)
+        The lab, the group id and its parameters, in order.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, csv
+    >>> from uio_teach.instructor.labs import LABS, write_answer_key
+    >>> from uio_teach.instructor.lab_params import PA9Params
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     key = write_answer_key(pathlib.Path(tmp) / "k.csv", [(LABS["pa9"], "g01", PA9Params())])
+    ...     row = next(csv.DictReader(key.open()))
+    >>> row["lab"], row["group"], row["pa9.K2"] != ""
+    ('pa9', 'g01', True)
+    """
+    import csv
+    import json
+
+    table = []
+    columns: list[str] = []
+    for lab, group, params in rows:
+        answers = {f"{lab.id}.{k}": v for k, v in params.answers().items()}
+        for k in answers:
+            if k not in columns:
+                columns.append(k)
+        record = {"lab": lab.id, "group": group, "params": json.dumps(params.to_params())}
+        record.update({k: json.dumps(v) for k, v in answers.items()})
+        table.append(record)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, ["lab", "group", "params", *columns], lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(table)
+    return path
