@@ -92,8 +92,10 @@ class Submission:
     ----------
     file : str
         The submission, as given.
-    lab, group : str
-        The lab id and the group id ("" when unknown).
+    lab : str
+        The lab id ("" when unknown).
+    group : str
+        The group id ("" when unknown).
     status : str
         ``"ok"``, ``"error"`` (some cells raised), ``"timeout"`` (killed at the
         time limit) or ``"unreadable"`` (not a notebook).

@@ -3,9 +3,9 @@
 Every lab notebook has one code cell tagged ``parameters`` that defines
 ``PARAMS``, a JSON-compatible dict; the notebook's code reads its numbers from
 it and passes them to the checks. One frozen dataclass per lab turns these
-numbers into that dict (:meth:`to_params`) and back (:meth:`from_params`),
-reads them from a term config (:meth:`from_config`), draws a variant for a
-lab group (:meth:`draw`) and computes the answer key (:meth:`answers`).
+numbers into that dict (``to_params``) and back (``from_params``),
+reads them from a term config (``from_config``), draws a variant for a
+lab group (``draw``) and computes the answer key (``answers``).
 
 * :class:`PA9Params` -- poles, initial state, the sinusoidal and the
   piecewise-constant disturbance of Practical Assignment 9;
@@ -108,10 +108,14 @@ class PA9Params(LabParams):
         The observer poles (three; complex ones in conjugate pairs).
     initial_state : tuple of float
         ``x(0)``.
-    sine_amplitude, sine_frequency : float
-        ``d(t) = amplitude sin(frequency t)``.
-    switch_times, switch_values : tuple of float
-        The piecewise-constant ``d``.
+    sine_amplitude : float
+        The amplitude of ``d(t) = amplitude sin(frequency t)``.
+    sine_frequency : float
+        Its frequency, in rad/s.
+    switch_times : tuple of float
+        The times at which the piecewise-constant ``d`` switches.
+    switch_values : tuple of float
+        The values it takes.
     duration : float
         Simulated time in s.
     samples : int
@@ -270,8 +274,10 @@ class CaseStudyParams(LabParams):
         Where exercise 3 moves the one movable pole (inside the unit circle).
     initial_state : tuple of float
         ``x[0]``.
-    u2_amplitude, u2_frequency : float
-        ``u2[k] = amplitude sin(frequency k)``.
+    u2_amplitude : float
+        The amplitude of ``u2[k] = amplitude sin(frequency k)``.
+    u2_frequency : float
+        Its frequency, in rad per step.
     v_amplitude : float
         The staircase ``v`` holds levels uniform in ``[-amplitude, amplitude]``.
     v_hold : int

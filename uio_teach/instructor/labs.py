@@ -670,7 +670,7 @@ def _registry() -> dict[str, Lab]:
 
 
 LABS: dict[str, Lab] = _registry()
-"""The labs of the course by id: chapter file, parameter class, check ids."""
+"""The labs of the course, by id (each a :class:`Lab`)."""
 
 
 def lab_of(source: str | os.PathLike[str]) -> Lab | None:

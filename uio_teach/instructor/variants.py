@@ -31,7 +31,7 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
     Parameters
     ----------
     lab : Lab
-        The lab (an entry of :data:`LABS`).
+        The lab (an entry of :data:`~uio_teach.instructor.labs.LABS`).
     groups : int
         How many variants.
     seed : int
