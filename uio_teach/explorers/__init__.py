@@ -35,6 +35,7 @@ from .frames import Frame, compute_frame
 from .model import (
     DISTURBANCES,
     FAMILIES,
+    STARTS,
     Channel,
     Scenario,
     Settings,
@@ -46,6 +47,7 @@ from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9
 __all__ = [
     "DISTURBANCES",
     "FAMILIES",
+    "STARTS",
     "Channel",
     "Settings",
     "Scenario",
