@@ -31,7 +31,7 @@ Examples
 
 from ..luenberger import luenberger_poles
 from ._figure import ExplorerFigure, render
-from .frames import Frame, compute_frame
+from .frames import Frame, compute_frame, error_grows, excited_modes
 from .model import (
     DISTURBANCES,
     FAMILIES,
@@ -61,5 +61,7 @@ __all__ = [
     "disturbance_signals",
     "luenberger_poles",
     "compute_frame",
+    "excited_modes",
+    "error_grows",
     "render",
 ]

@@ -48,10 +48,44 @@ from .._display import format_poles
 from ..plant import Plant
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
-from .model import DISTURBANCES, Scenario, Settings
+from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
 
-__all__ = ["Explorer", "pa9_explorer", "case_study_explorer", "missile_explorer", "explorer"]
+__all__ = [
+    "Explorer",
+    "pa9_explorer",
+    "case_study_explorer",
+    "missile_explorer",
+    "explorer",
+    "drag_available",
+]
+
+_GRAB_PIXELS = 14  # a press this close to a movable pole on the pole map grabs it
+
+# The explorer on display for each scenario name: re-running a cell closes the previous one,
+# so its figure and widgets are freed instead of piling up.
+_LIVE: dict[str, Explorer] = {}
+
+
+def drag_available() -> bool:
+    """True when poles can be dragged on the pole map: ipympl (the widget backend) is installed.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> from uio_teach.explorers.widgets import drag_available
+    >>> isinstance(drag_available(), bool)
+    True
+    """
+    try:
+        import ipympl.backend_nbagg  # noqa: F401
+    except Exception:  # not installed, or an incompatible version: sliders only
+        return False
+    return True
+
 
 _STYLE = {"description_width": "120px"}
 _WIDTH = "330px"
@@ -111,6 +145,11 @@ class Explorer:
     static : bool
         Include the static frames in the display (needed for the static
         book; ``False`` displays faster in a live notebook).
+    drag : bool, optional
+        Show the figure as an ipympl canvas on which the movable poles can be
+        dragged on the pole map (besides the sliders). By default when ipympl
+        is installed; without it the figure is a picture and the sliders work
+        alone.
 
     Attributes
     ----------
@@ -121,7 +160,8 @@ class Explorer:
         pair, ``"pole 2 real part"`` and ``"pole 2 frequency"``, in discrete
         time ``"pole 2 radius"`` and ``"pole 2 angle"``), ``"pattern"`` (how
         many complex pairs), ``"mode"`` and ``"decay"`` (LMI), ``"disturbance"``,
-        ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``.
+        ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``,
+        ``"start"`` (where the observers start, :data:`~uio_teach.explorers.STARTS`).
     figure : ExplorerFigure
         The figure, updated in place.
     frame : Frame
@@ -141,8 +181,9 @@ class Explorer:
     >>> print(ex.frame.observer_message)
     this pole makes the PMO unstable: the error grows (pole 1.05 outside the unit circle)
     >>> ex.set(mode="lmi", decay=0.4)
-    >>> "infeasible" in ex.frame.observer_message
-    True
+    >>> print(ex.frame.observer_message)   # doctest: +NORMALIZE_WHITESPACE
+    no gain meets the bound radius 0.4: the fixed poles (invariant zeros, radius 0.5)
+    cannot move; choose a bound beyond them
     """
 
     def __init__(
@@ -152,7 +193,12 @@ class Explorer:
         *,
         dpi: float = 90,
         static: bool = True,
+        drag: bool | None = None,
     ) -> None:
+        old = _LIVE.pop(scenario.name, None)
+        if old is not None:
+            old.close()
+        _LIVE[scenario.name] = self
         self.scenario = scenario
         self._base = scenario.defaults if settings is None else settings
         self._static = static
@@ -164,6 +210,18 @@ class Explorer:
         self.frame: Frame | None = None
         self.image = W.Image(format="png", layout=W.Layout(width="100%", max_width="900px"))
         self.message = W.HTML()
+        self.canvas: Any = None
+        self._dragging: tuple[int, str] | None = None
+        if drag is None:
+            drag = drag_available() and scenario.movable > 0
+        if drag:
+            self.canvas = self._make_canvas()
+        fig = self.figure.fig
+        self._connections = [
+            fig.canvas.mpl_connect("button_press_event", self.on_press),
+            fig.canvas.mpl_connect("motion_notify_event", self.on_motion),
+            fig.canvas.mpl_connect("button_release_event", self.on_release),
+        ]
         self._build_controls()
         self.update()
 
@@ -225,6 +283,14 @@ class Explorer:
                                  base.frequency)  # fmt: skip
         c["period"] = _slider(f"switching ({unit})", *sc.period_limits, base.period)
         dist += [c["disturbance"], c["amplitude"], c["frequency"], c["period"]]
+        c["start"] = W.Dropdown(
+            options=[(k, k) for k in STARTS],
+            value=base.start if base.start in STARTS else "zero estimate",
+            description="observer start",
+            style=_STYLE,
+            layout=W.Layout(width=_WIDTH),
+        )
+        observer.append(c["start"])
         meas = [W.HTML("<b>Measurement</b>")]
         c["noise"] = _slider("noise (std)", *sc.noise_limits, base.noise, 100)
         meas.append(c["noise"])
@@ -238,7 +304,8 @@ class Explorer:
         self._show_relevant()
         boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in (observer, dist, meas)]
         controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
-        self.widget = W.VBox([controls, self.image, self.message])
+        view = self.canvas if self.canvas is not None else self.image
+        self.widget = W.VBox([controls, view, self.message])
 
     @staticmethod
     def _pattern_label(k: int, pairs: int) -> str:
@@ -346,6 +413,7 @@ class Explorer:
             "frequency": float(c["frequency"].value),
             "period": float(c["period"].value),
             "noise": float(c["noise"].value),
+            "start": c["start"].value,
         }
         if "mode" in c:
             changes["mode"] = c["mode"].value
@@ -417,7 +485,7 @@ class Explorer:
         Examples
         --------
         >>> from uio_teach.explorers import widgets
-        >>> ex = widgets.pa9_explorer(static=False)
+        >>> ex = widgets.pa9_explorer(static=False, drag=False)
         >>> ex.update()
         >>> bytes(ex.image.value[:4])
         b'\\x89PNG'
@@ -426,7 +494,11 @@ class Explorer:
         try:
             frame = compute_frame(self.scenario, self.settings)
             self.figure.update(frame)
-            self.image.value = self.figure.to_png(colors=128)
+            if self.canvas is not None:
+                self.figure.draw()
+                self.canvas.blit()  # sends the changed pixels to the page
+            else:
+                self.image.value = self.figure.to_png(colors=128)
         except Exception as exc:  # pragma: no cover - compute_frame already turns errors into text
             self.message.value = (
                 f'<span style="color:#c0392b">could not update the picture: '
@@ -435,6 +507,131 @@ class Explorer:
             return
         self.frame = frame
         self.message.value = _message_html(frame)
+
+    # dragging poles on the pole map -------------------------------------------------------
+    def _make_canvas(self) -> Any:
+        """An ipympl canvas for the figure, or None when the widget backend does not load."""
+        try:
+            from ipympl.backend_nbagg import Canvas, FigureManager
+
+            canvas = Canvas(self.figure.fig)
+            FigureManager(canvas, 0)
+            canvas.header_visible = False
+            canvas.footer_visible = False
+            canvas.toolbar_visible = False
+            canvas.resizable = False
+            canvas.capture_scroll = False
+            canvas.layout.width = "100%"
+            canvas.layout.max_width = "900px"
+        except Exception:  # a frontend without ipympl: sliders only
+            return None
+        self.figure._background = None  # the canvas is new: the next draw is a full one
+        return canvas
+
+    def _slot_points(self) -> list[tuple[int, complex]]:
+        """The movable poles on the map (upper member of a pair), by slot."""
+        out = []
+        for index, slot in enumerate(self._slots):
+            values = [control.value for control in slot.controls.values()]
+            if slot.kind == "real":
+                out.append((index, complex(values[0], 0.0)))
+            elif self.scenario.discrete:
+                out.append((index, cmath.rect(values[0], math.radians(values[1]))))
+            else:
+                out.append((index, complex(values[0], values[1])))
+        return out
+
+    def on_press(self, event: Any) -> None:
+        """Grab the movable pole nearest to a press on the pole map (within a few pixels).
+
+        Parameters
+        ----------
+        event : matplotlib.backend_bases.MouseEvent
+            The press (``inaxes``, ``x``, ``y`` in pixels, ``button``).
+
+        Examples
+        --------
+        >>> from types import SimpleNamespace
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.case_study_explorer(static=False, drag=False)
+        >>> ax = ex.figure.axes["poles"]
+        >>> x, y = ax.transData.transform((0.0, 0.0))        # where pole 1 is drawn
+        >>> ex.on_press(SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=0.0, ydata=0.0))
+        >>> ex.on_motion(SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=0.3, ydata=0.1))
+        >>> ex.on_release(SimpleNamespace(inaxes=ax, button=1))
+        >>> ex.settings.poles
+        (0.3,)
+        """
+        ax = self.figure.axes["poles"]
+        if getattr(event, "inaxes", None) is not ax or getattr(event, "button", 1) not in (1, None):
+            return
+        if "mode" in self.controls and self.controls["mode"].value == "lmi":
+            return
+        best, where = None, float(_GRAB_PIXELS)
+        for index, p in self._slot_points():
+            for q in (p, p.conjugate()):
+                px, py = ax.transData.transform((q.real, q.imag))
+                gap = math.hypot(px - event.x, py - event.y)
+                if gap <= where:
+                    best, where = index, gap
+        self._dragging = None if best is None else (best, "grab")
+
+    def on_motion(self, event: Any) -> None:
+        """Move the grabbed pole to the pointer: its sliders follow, the figure updates.
+
+        Parameters
+        ----------
+        event : matplotlib.backend_bases.MouseEvent
+            The motion (``inaxes``, ``xdata``, ``ydata``).
+        """
+        if self._dragging is None:
+            return
+        ax = self.figure.axes["poles"]
+        if getattr(event, "inaxes", None) is not ax or event.xdata is None:
+            return
+        slot = self._slots[self._dragging[0]]
+        controls = list(slot.controls.values())
+        z = complex(float(event.xdata), float(event.ydata))
+        with self.hold():
+            if slot.kind == "real":
+                controls[0].value = _clamp(controls[0], z.real)
+            elif self.scenario.discrete:
+                controls[0].value = _clamp(controls[0], abs(z))
+                controls[1].value = _clamp(controls[1], math.degrees(abs(cmath.phase(z))))
+            else:
+                controls[0].value = _clamp(controls[0], z.real)
+                controls[1].value = _clamp(controls[1], abs(z.imag))
+
+    def on_release(self, event: Any) -> None:
+        """Let go of the grabbed pole.
+
+        Parameters
+        ----------
+        event : matplotlib.backend_bases.MouseEvent
+            The release.
+        """
+        self._dragging = None
+
+    def close(self) -> None:
+        """Close the figure's canvas and the widgets (frees their memory at once).
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.pa9_explorer(static=False, drag=False)
+        >>> ex.close()
+        """
+        if _LIVE.get(self.scenario.name) is self:
+            del _LIVE[self.scenario.name]
+        for cid in self._connections:
+            self.figure.fig.canvas.mpl_disconnect(cid)
+        if self.canvas is not None:
+            self.canvas.close()
+        self.widget.close()
+        for control in list(self.controls.values()):
+            control.close()
+        self.image.close()
+        self.message.close()
 
     # display ------------------------------------------------------------------------------
     def static_html(self) -> str:
@@ -471,9 +668,19 @@ class Explorer:
         return f"<Explorer {self.scenario.title!r}: {self.scenario.observer_name}>"
 
 
+def _clamp(control: Any, value: float) -> float:
+    """A value inside the slider's range, on its step."""
+    step = control.step or 0
+    value = min(max(float(value), control.min), control.max)
+    if step:
+        value = control.min + round((value - control.min) / step) * step
+        value = round(value, max(0, 1 - math.floor(math.log10(step))) + 6)
+    return float(min(max(value, control.min), control.max))
+
+
 def _message_html(frame: Frame) -> str:
     name = html.escape(frame.scenario.observer_name)
-    lines = []
+    lines = [frame.explanation] if frame.explanation else []
     if frame.poles.size:
         lines.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     if frame.luenberger_poles.size:
@@ -485,7 +692,7 @@ def _message_html(frame: Frame) -> str:
     return f'<div style="font-size:0.9em">{text}</div>'
 
 
-def pa9_explorer(*, static: bool = True) -> Explorer:
+def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     """Explore the PA9 decoupling UIO against a Luenberger observer.
 
     Three movable poles (real, or one complex pair and a real pole), the
@@ -496,6 +703,9 @@ def pa9_explorer(*, static: bool = True) -> Explorer:
     ----------
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -509,10 +719,10 @@ def pa9_explorer(*, static: bool = True) -> Explorer:
     >>> sorted(n for n in ex.controls if n.startswith("pole"))
     ['pole 1', 'pole 2 frequency', 'pole 2 real part']
     """
-    return Explorer(pa9_scenario(), static=static)
+    return Explorer(pa9_scenario(), static=static, drag=drag)
 
 
-def case_study_explorer(*, static: bool = True) -> Explorer:
+def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     """Explore the discrete case study: one movable pole, or the LMI's radius bound.
 
     The two fixed poles at 0.5 are the invariant zeros; in ``"LMI bound"``
@@ -523,6 +733,9 @@ def case_study_explorer(*, static: bool = True) -> Explorer:
     ----------
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -536,10 +749,12 @@ def case_study_explorer(*, static: bool = True) -> Explorer:
     >>> bool(abs(ex.frame.poles).max() <= 0.8 + 1e-6)
     True
     """
-    return Explorer(case_study_scenario(), static=static)
+    return Explorer(case_study_scenario(), static=static, drag=drag)
 
 
-def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Explorer:
+def missile_explorer(
+    *, observer_family: str = "pmo", static: bool = True, drag: bool | None = None
+) -> Explorer:
     """Explore the missile autopilot: the observer, its residual and the reconstructed inputs.
 
     Two movable poles of the projection-operator observer (the other two
@@ -554,6 +769,9 @@ def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Ex
         poles are fixed: the main control is then the amplitude).
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -584,7 +802,7 @@ def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Ex
             static_values=(0.0, 5.0, 10.0, 20.0, 40.0),
             _cache={},
         )
-    return Explorer(scenario, static=static)
+    return Explorer(scenario, static=static, drag=drag)
 
 
 def explorer(
@@ -597,6 +815,7 @@ def explorer(
     u: Any = None,
     reconstruct: bool = False,
     static: bool = True,
+    drag: bool | None = None,
 ) -> Explorer:
     """Explore your own plant: an unknown input observer against a Luenberger observer.
 
@@ -623,6 +842,9 @@ def explorer(
         Also reconstruct the unknown input (``E`` of full column rank).
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -653,4 +875,4 @@ def explorer(
         reconstruct=reconstruct,
         name=(plant.name or "plant").replace(" ", "-"),
     )
-    return Explorer(scenario, static=static)
+    return Explorer(scenario, static=static, drag=drag)
