@@ -50,7 +50,9 @@ def assert_same(actual, expected):
 
 def test_pa9_frame_equals_direct_simulation():
     sc = pa9_scenario()
-    s = sc.defaults.replace(poles=(-1.5 + 2j, -4.0), amplitude=2.0, frequency=3.0)
+    s = sc.defaults.replace(
+        poles=(-1.5 + 2j, -4.0), amplitude=2.0, frequency=3.0, start="zero observer state"
+    )
     frame = compute_frame(sc, s)
     plant = ut.examples.pa9()
     t = np.linspace(0, 10, 1001)
@@ -76,7 +78,7 @@ def test_pa9_frame_equals_direct_simulation():
 
 def test_case_study_frame_equals_direct_simulation():
     sc = case_study_scenario()
-    s = sc.defaults.replace(poles=(0.3,), amplitude=1.5, frequency=0.8)
+    s = sc.defaults.replace(poles=(0.3,), amplitude=1.5, frequency=0.8, start="zero observer state")
     frame = compute_frame(sc, s)
     plant = ut.examples.dt_case_study()
     steps = np.arange(41)
@@ -96,7 +98,7 @@ def test_case_study_frame_equals_direct_simulation():
 
 def test_missile_frame_reproduces_the_paper_inputs_and_reconstruction():
     sc = missile_scenario()
-    frame = compute_frame(sc)
+    frame = compute_frame(sc, sc.defaults.replace(start="zero observer state"))
     plant = ut.examples.missile_autopilot()
     t = np.linspace(0, 0.5, 1001)
     resp = ut.simulate(
@@ -132,7 +134,7 @@ def test_unstable_pole_gives_a_message_and_clipped_curves():
     raw = frame.response.error
     assert np.abs(raw).max() > frame.limits["error"]  # e^{10} ~ 2e4: it does explode
     assert np.abs(frame.curves["uio.error"]).max() <= frame.limits["error"]
-    assert any("clipped" in m for m in frame.messages)
+    assert any("cut off" in m for m in frame.messages)
 
 
 def test_pole_on_the_boundary_does_not_decay():
@@ -149,7 +151,10 @@ def test_lmi_mode_feasible_and_infeasible():
     assert np.abs(ok.poles).max() <= 0.7 + 1e-6
     bad = compute_frame(sc, sc.defaults.replace(mode="lmi", decay=0.45))
     assert bad.observer is None
-    assert "infeasible" in bad.observer_message and "0.5 cannot move" in bad.observer_message
+    # plain words: the bound, the fixed poles that block it; no solver status
+    assert "no gain meets the bound radius 0.45" in bad.observer_message
+    assert "radius 0.5) cannot move" in bad.observer_message
+    assert "infeasible" not in bad.observer_message and "_" not in bad.observer_message
     assert bad.curves["uio.error"] is None and bad.curves["lb.error"] is not None
 
 
@@ -221,7 +226,7 @@ def test_figure_is_updated_in_place(scenario):
     ef = ExplorerFigure(scenario, dpi=60)
     ef.update(compute_frame(scenario))
     lines = {k: list(v) for k, v in ef.lines.items()}
-    texts = (ef.title, ef.footer, *ef.notes.values())
+    texts = (ef.title, ef.footer)
     before = [line.get_ydata().copy() for line in ef.lines["uio.error"]]
     other = scenario.static_values[1]  # a stable value, not the default
     assert other != scenario.defaults.poles[0]
@@ -230,11 +235,11 @@ def test_figure_is_updated_in_place(scenario):
     )
     ef.update(frame)
     assert {k: list(v) for k, v in ef.lines.items()} == lines  # the same Line2D objects
-    assert texts == (ef.title, ef.footer, *ef.notes.values())
+    assert texts == (ef.title, ef.footer)
     after = [line.get_ydata() for line in ef.lines["uio.error"]]
     assert any(not np.array_equal(a, b) for a, b in zip(after, before, strict=True))
-    for i, line in enumerate(ef.lines["uio.error"]):
-        assert_same(line.get_ydata(), frame.curves["uio.error"][i])
+    for i, line in enumerate(ef.lines["uio.error"]):  # |e| on the log axis
+        assert_same(line.get_ydata(), np.abs(frame.curves["uio.error"][i]))
     assert_same(ef.lines["lb.residual"][-1].get_ydata(), frame.curves["lb.residual"][-1])
 
 
@@ -264,7 +269,7 @@ def test_render_and_missing_curves():
     ef = ExplorerFigure(sc)
     ef.update(compute_frame(sc, sc.defaults.replace(mode="lmi", decay=0.4)))
     assert ef.lines["uio.error"][0].get_xdata().size == 0  # no design, no curve
-    assert ef.notes["uio"].get_visible() and "infeasible" in ef.notes["uio"].get_text()
+    assert "no gain meets the bound" in ef.footer.get_text()
 
 
 # every setting: a picture or a message, never an exception --------------------------------

@@ -92,8 +92,13 @@ def _keep_range(
 ) -> tuple[float, float]:
     """Keep the current limits while the data fit and fill at least a third of them."""
     lo, hi = wanted
-    if fresh or lo < current[0] or hi > current[1]:
+    if fresh:
         return wanted
+    if lo < current[0] or hi > current[1]:
+        # grow with room to spare, so that the next slightly larger curve fits as well
+        a, b = min(lo, current[0]), max(hi, current[1])
+        pad = 0.25 * (b - a)
+        return _nice_range([np.array([a - pad * (lo < current[0]), b + pad * (hi > current[1])])])
     if (hi - lo) < (current[1] - current[0]) / 3:
         return wanted
     return current

@@ -318,7 +318,7 @@ def _stability_message(
     word = "pole" if edge_poles.size == 1 else "poles"
     if not excited[bad].any():
         return f"{word} {format_poles(edge_poles, 3)} {edge}, not excited from this start"
-    return f"{word} {format_poles(edge_poles, 3)} {edge}: that part of the error never decays"
+    return f"{word} {format_poles(edge_poles, 3)} {edge}: that part of the error does not decay"
 
 
 def _lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:

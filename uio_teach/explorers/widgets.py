@@ -147,9 +147,9 @@ class Explorer:
         book; ``False`` displays faster in a live notebook).
     drag : bool, optional
         Show the figure as an ipympl canvas on which the movable poles can be
-        dragged on the pole map (besides the sliders). By default when ipympl
-        is installed; without it the figure is a picture and the sliders work
-        alone.
+        dragged on the pole map (besides the sliders). By default in a Jupyter
+        kernel with ipympl installed; otherwise the figure is a picture and the
+        sliders work alone.
 
     Attributes
     ----------
@@ -213,7 +213,7 @@ class Explorer:
         self.canvas: Any = None
         self._dragging: tuple[int, str] | None = None
         if drag is None:
-            drag = drag_available() and scenario.movable > 0
+            drag = _in_kernel() and drag_available() and scenario.movable > 0
         if drag:
             self.canvas = self._make_canvas()
         fig = self.figure.fig
@@ -666,6 +666,17 @@ class Explorer:
 
     def __repr__(self) -> str:
         return f"<Explorer {self.scenario.title!r}: {self.scenario.observer_name}>"
+
+
+def _in_kernel() -> bool:
+    """True inside a Jupyter kernel (where a canvas widget can be shown)."""
+    try:
+        from IPython import get_ipython
+
+        shell = get_ipython()
+    except Exception:  # pragma: no cover - IPython comes with ipywidgets
+        return False
+    return shell is not None and hasattr(shell, "kernel")
 
 
 def _clamp(control: Any, value: float) -> float:
