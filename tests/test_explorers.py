@@ -329,3 +329,99 @@ def test_every_setting_gives_a_picture_or_a_message(name):
                 assert np.nanmax(np.abs(curve), initial=0.0) <= max(frame.limits.values())
 
     check()
+
+
+# the movable pole moves the decoupled observer's error; words agree with the plot ------------
+
+
+def _own_scenario():
+    plant = ut.Plant([[0, 1], [-0.08, 0.6]], [[-0.5, 1]], E=[[0], [1]], dt=1)
+    return make_scenario(plant, "uio")
+
+
+ALL = {**SCENARIOS, "own": _own_scenario}
+
+
+@pytest.mark.parametrize("name", sorted(ALL))
+def test_sweeping_the_first_movable_pole_changes_the_decoupled_error(name):
+    sc = ALL[name]()
+    lo, hi = sc.pole_limits
+    edge = 1.0 if sc.discrete else 0.0
+    stable = [v for v in np.linspace(lo, min(hi, edge), 9)[1:-1]]
+    errors = []
+    for p in stable:
+        frame = compute_frame(sc, sc.defaults.replace(poles=(p, *sc.defaults.poles[1:])))
+        assert frame.observer is not None and frame.observer_message == ""
+        assert frame.excited.all()  # the default start reaches every mode
+        errors.append(frame.response.error)
+    for a, b in zip(errors, errors[1:], strict=False):
+        assert np.abs(a - b).max() > 1e-4 * np.abs(a).max()  # it was 1e-15 from z(0) = 0
+
+
+@pytest.mark.parametrize("name", sorted(ALL))
+def test_at_the_unstable_end_the_message_and_the_plotted_error_agree(name):
+    from uio_teach.explorers import error_grows
+
+    sc = ALL[name]()
+    p = sc.pole_limits[1]
+    frame = compute_frame(sc, sc.defaults.replace(poles=(p, *sc.defaults.poles[1:])))
+    assert error_grows(frame.response.error)
+    assert "the error grows" in frame.observer_message
+    shown = np.abs(frame.curves["uio.error"])
+    N = shown.shape[1]
+    assert shown[:, -N // 10 :].max() > 1.5 * shown[:, : N // 10].max()
+
+
+def test_an_unexcited_unstable_mode_is_named_and_the_error_does_not_grow():
+    from uio_teach.explorers import error_grows
+
+    sc = case_study_scenario()
+    frame = compute_frame(sc, sc.defaults.replace(poles=(1.05,), start="zero observer state"))
+    assert not error_grows(frame.response.error)
+    assert "does not excite" in frame.observer_message
+    assert "grows" not in frame.observer_message.split(":")[0]
+    assert not frame.excited[np.argmin(abs(frame.poles - 1.05))]
+    # and the words next to the plot name the fixed modes
+    assert "0.5, 0.5 (the invariant zeros" in frame.explanation
+
+
+def test_a_pole_on_an_invariant_zero_gets_a_note():
+    sc = case_study_scenario()
+    frame = compute_frame(sc, sc.defaults.replace(poles=(0.5,)))
+    assert any("sits on the invariant zero 0.5" in m for m in frame.messages)
+    assert not any("invariant zero" in m for m in compute_frame(sc).messages)
+
+
+def test_the_lmi_bound_shapes_the_certified_envelope():
+    sc = case_study_scenario()
+    ends = []
+    for bound in (0.6, 0.8, 1.0):
+        frame = compute_frame(sc, sc.defaults.replace(mode="lmi", decay=bound))
+        (label,) = [k for k in frame.guides if "certified" in k]
+        envelope = frame.guides[label]
+        size = np.linalg.norm(frame.response.error, axis=0)
+        assert np.all(size <= envelope * (1 + 1e-9))  # a true bound on the simulated error
+        ends.append(envelope[-1])
+    assert ends[0] < ends[1] < ends[2]
+
+
+def test_dragging_a_pole_on_the_pole_map_moves_its_slider():
+    from types import SimpleNamespace
+
+    from uio_teach.explorers import widgets
+
+    ex = widgets.pa9_explorer(static=False, drag=False)
+    ax = ex.figure.axes["poles"]
+    x, y = ax.transData.transform((-2.0, 0.0))  # pole 2
+    press = SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=-2.0, ydata=0.0)
+    ex.on_press(press)
+    ex.on_motion(SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=-5.0, ydata=0.3))
+    ex.on_release(press)
+    assert ex.settings.poles == (-1.0, -5.0, -3.0)
+    assert ex.controls["pole 2"].value == -5.0
+    assert np.isclose(np.sort(ex.frame.poles.real), [-5.0, -3.0, -1.0]).all()
+    # a press far from every pole grabs nothing
+    far = ax.transData.transform((-9.0, 9.0))
+    ex.on_press(SimpleNamespace(inaxes=ax, x=far[0], y=far[1], button=1, xdata=-9.0, ydata=9.0))
+    ex.on_motion(SimpleNamespace(inaxes=ax, x=0, y=0, button=1, xdata=-7.0, ydata=0.0))
+    assert ex.settings.poles == (-1.0, -5.0, -3.0)

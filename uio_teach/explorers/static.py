@@ -167,7 +167,7 @@ def frame_settings(
 
 def _caption(frame: Frame) -> str:
     name = frame.scenario.observer_name
-    parts = []
+    parts = [f"disturbance: {frame.disturbance}"] if frame.disturbance else []
     if frame.poles.size:
         parts.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     parts += frame.all_messages
