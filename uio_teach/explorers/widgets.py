@@ -625,13 +625,19 @@ class Explorer:
             del _LIVE[self.scenario.name]
         for cid in self._connections:
             self.figure.fig.canvas.mpl_disconnect(cid)
+        for slot in self._slots:
+            for control in slot.controls.values():
+                control.unobserve_all()
+        for control in self.controls.values():
+            control.unobserve_all()
         if self.canvas is not None:
-            self.canvas.close()
-        self.widget.close()
+            _close_tree(self.canvas)
+        _close_tree(self.widget)
         for control in list(self.controls.values()):
-            control.close()
-        self.image.close()
-        self.message.close()
+            _close_tree(control)
+        _close_tree(self.image)
+        _close_tree(self.message)
+        self.figure._background = None  # the largest buffer: free it even if self is kept
 
     # display ------------------------------------------------------------------------------
     def static_html(self) -> str:
@@ -666,6 +672,17 @@ class Explorer:
 
     def __repr__(self) -> str:
         return f"<Explorer {self.scenario.title!r}: {self.scenario.observer_name}>"
+
+
+def _close_tree(widget: Any) -> None:
+    """Close a widget, its children, its layout and its style (they are widgets too)."""
+    for child in getattr(widget, "children", ()) or ():
+        _close_tree(child)
+    for name in ("layout", "style"):
+        sub = getattr(widget, name, None)
+        if isinstance(sub, W.Widget):
+            sub.close()
+    widget.close()
 
 
 def _in_kernel() -> bool:
