@@ -10,7 +10,7 @@ its explorer pages are measured as well.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
+import threading
 from pathlib import Path
 
 import pytest
@@ -41,8 +41,10 @@ SCENARIOS = {
 }
 
 
-@pytest.fixture(scope="module")
-def browser() -> Iterator[object]:
+def _in_chromium(work) -> None:
+    """Run ``work(browser)`` in headless Chromium, in a thread of its own (an earlier test may
+    leave an asyncio loop running in the main thread, where Playwright's sync API will not
+    start)."""
     if not CHROMIUM.exists():
         message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
         if os.environ.get("CI") == "true":
@@ -50,14 +52,26 @@ def browser() -> Iterator[object]:
         pytest.skip(message)
     from playwright.sync_api import sync_playwright
 
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(
-            executable_path=str(CHROMIUM), args=ARGS, headless=True
-        )
+    failure: list[BaseException] = []
+
+    def drive() -> None:
         try:
-            yield browser
-        finally:
-            browser.close()
+            with sync_playwright() as playwright:
+                browser = playwright.chromium.launch(
+                    executable_path=str(CHROMIUM), args=ARGS, headless=True
+                )
+                try:
+                    work(browser)
+                finally:
+                    browser.close()
+        except BaseException as exc:  # re-raised in the test's thread
+            failure.append(exc)
+
+    thread = threading.Thread(target=drive)
+    thread.start()
+    thread.join()
+    if failure:
+        raise failure[0]
 
 
 _STATE_JS = """() => {
@@ -75,7 +89,7 @@ _SET_JS = """([i, j]) => {
 
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
-def test_every_position_changes_picture_caption_and_alt(name, browser, tmp_path):
+def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
     page_data = static_explorer(SCENARIOS[name]())
     html = f"<!doctype html><html lang='en'><body>{page_data.html}</body></html>"
     path = tmp_path / f"{name}.html"
@@ -83,19 +97,26 @@ def test_every_position_changes_picture_caption_and_alt(name, browser, tmp_path)
     assert path.stat().st_size <= MAX_PAGE
     values = 1 + max(f.index[0] for f in page_data.frames)
     kinds = 1 + max(f.index[1] for f in page_data.frames)
-    page = browser.new_page(viewport={"width": 390, "height": 844})
-    page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file:") else r.abort())
-    page.goto(path.as_uri())
     seen = []
-    for j in range(kinds):
-        for i in range(values):
-            page.evaluate(_SET_JS, [i, j])
-            page.wait_for_function("() => document.querySelector('img.uio-frame').complete")
-            state = page.evaluate(_STATE_JS)
-            assert state["width"] >= 1200, state["width"]
-            assert state["live"] == "polite"
-            seen.append(state)
-    page.close()
+
+    def work(browser) -> None:
+        page = browser.new_page(viewport={"width": 390, "height": 844})  # a phone
+        page.route(
+            "**/*", lambda r: r.continue_() if r.request.url.startswith("file:") else r.abort()
+        )
+        page.goto(path.as_uri())
+        for j in range(kinds):
+            for i in range(values):
+                page.evaluate(_SET_JS, [i, j])
+                page.wait_for_function("() => document.querySelector('img.uio-frame').complete")
+                state = page.evaluate(_STATE_JS)
+                assert state["width"] >= 1200, state["width"]
+                assert state["live"] == "polite"
+                seen.append(state)
+        page.close()
+
+    _in_chromium(work)
+    assert len(seen) == values * kinds
     for key in ("src", "alt", "caption"):
         assert len({s[key] for s in seen}) == len(seen), f"{key} repeats between positions"
 

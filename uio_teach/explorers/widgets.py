@@ -651,8 +651,8 @@ class Explorer:
         --------
         >>> from uio_teach.explorers import widgets
         >>> ex = widgets.case_study_explorer(static=False)
-        >>> ex.static_html().count('data-k="')
-        24
+        >>> ex.static_html().count('data-k="')     # 9 pole positions, 2 disturbance types
+        18
         """
         if self._static_html is None:
             from .static import static_html
