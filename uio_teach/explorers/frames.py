@@ -101,7 +101,7 @@ class Frame:
         no gain moves (the invariant zeros).
     excited : numpy.ndarray of bool
         For each entry of ``poles``: does the observer's start reach that mode
-        of the error (:func:`excited_modes`)?
+        of the error (``excited_modes``)?
     initial_error : numpy.ndarray
         ``e(0) = x(0) - xhat(0)`` of the unknown input observer.
     guides : dict
@@ -498,12 +498,12 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
     settings' poles (or the LMI bound), the Luenberger observer with the poles
     of :func:`uio_teach.luenberger.luenberger_poles`; both are simulated with
     :func:`uio_teach.simulate` on the same plant, inputs, noise (same seed)
-    and initial state, both starting as :attr:`Settings.start` says (by
+    and initial state, both starting as ``Settings.start`` says (by
     default from a zero estimate). Errors, residuals (and reconstructed
     inputs) are clipped for display at ten times the largest plant state,
     output (and unknown input) of the simulation. Anything that goes wrong
     becomes a message. A message that says the error grows is only given when
-    the simulated error does grow (:func:`error_grows`); an unstable mode that
+    the simulated error does grow (``error_grows``); an unstable mode that
     the start does not excite is named as such.
 
     Parameters

@@ -138,7 +138,7 @@ class Settings:
     seed : int
         Seed of the random steps and of the noise.
     start : str
-        Where the observers start, one of :data:`STARTS`.
+        Where the observers start, one of ``STARTS``.
 
     Examples
     --------
@@ -202,7 +202,7 @@ class Scenario:
         The simulation grid.
     initial_state : numpy.ndarray
         The plant's initial state (where the observers start is a control,
-        :attr:`Settings.start`).
+        ``Settings.start``).
     u : callable or None
         The known input.
     defaults : Settings

@@ -161,7 +161,7 @@ class Explorer:
         time ``"pole 2 radius"`` and ``"pole 2 angle"``), ``"pattern"`` (how
         many complex pairs), ``"mode"`` and ``"decay"`` (LMI), ``"disturbance"``,
         ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``,
-        ``"start"`` (where the observers start, :data:`~uio_teach.explorers.STARTS`).
+        ``"start"`` (where the observers start, ``uio_teach.explorers.STARTS``).
     figure : ExplorerFigure
         The figure, updated in place.
     frame : Frame
