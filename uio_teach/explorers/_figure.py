@@ -420,9 +420,11 @@ class ExplorerFigure:
                 ax = self.axes[f"{who}.{row}"]
                 data = [frame.curves.get(f"{who}.{row}")]
                 if row == "error":
-                    if who == "uio":
-                        data += [g for g in frame.guides.values()]
-                    ax.set_ylim(*_log_range(data, None if fresh else ax.get_ylim()))
+                    # the curves are clipped at limits["error"], which the plant's own signals
+                    # set, not the poles: a range from it stays put while the poles move
+                    top = frame.limits.get("error")
+                    ranged = [np.array([top])] if top else data
+                    ax.set_ylim(*_log_range(ranged, None if fresh else ax.get_ylim()))
                     continue
                 if row == "input":
                     data.append(frame.d)
