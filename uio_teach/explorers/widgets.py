@@ -498,7 +498,7 @@ class Explorer:
                 self.figure.draw()
                 self.canvas.blit()  # sends the changed pixels to the page
             else:
-                self.image.value = self.figure.to_png(colors=128)
+                self.image.value = self.figure.to_png(colors=128, compress_level=1)
         except Exception as exc:  # pragma: no cover - compute_frame already turns errors into text
             self.message.value = (
                 f'<span style="color:#c0392b">could not update the picture: '
