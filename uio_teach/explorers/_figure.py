@@ -104,6 +104,18 @@ def _keep_range(
     return current
 
 
+def _finite_max(*arrays: np.ndarray | None) -> float:
+    best = 0.0
+    for a in arrays:
+        if a is None or not np.size(a):
+            continue
+        a = np.abs(np.asarray(a, dtype=float))
+        a = a[np.isfinite(a)]
+        if a.size:
+            best = max(best, float(a.max()))
+    return best
+
+
 def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
     return bool(
         inner.x0 >= outer.x0 - slack
@@ -202,8 +214,8 @@ class ExplorerFigure:
             gridspec_kw={
                 "width_ratios": [1.0, 1.0, 0.85],
                 "left": 0.075,
-                "right": 0.985,
-                "top": 0.86,
+                "right": 0.965,
+                "top": 0.84,
                 "bottom": 0.21 if not scenario.reconstruct else 0.16,
                 "wspace": 0.42,
                 "hspace": 0.5,
@@ -262,15 +274,21 @@ class ExplorerFigure:
                     self.lines["guides"] = [
                         ax.plot([], [], color=c, lw=1.3, ls=ls, label=lab)[0]
                         for c, ls, lab in (
-                            ("k", "-.", "certified bound"),
-                            ("C3", "--", "slowest moved pole"),
-                            ("C2", ":", "slowest fixed pole"),
+                            ("k", "-.", "certified" if scenario.decay_limits else "_certified"),
+                            ("C3", "--", "slowest moved"),
+                            ("C2", ":", "slowest fixed" if scenario.fixed_poles.size else "_f"),
                         )
                     ]
                 if who == "uio":
                     ax.set_ylabel(ylabels[r] if r != "error" else "|error| (log)", fontsize=8 * k)
                 if counts[r] and (who == "uio" or r == "input"):
-                    ax.legend(**{**_LEGEND, "fontsize": 6.5 * k})
+                    # the log error axis reaches a decade above the clipping bound, so its
+                    # top band is free of curves: a wide, flat legend sits there
+                    if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
+                        shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
+                        ax.legend(handles=shown, **{**_LEGEND, "fontsize": 6.5 * k, "ncol": 1})
+                    else:
+                        ax.legend(**{**_LEGEND, "fontsize": 6.5 * k})
             axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8 * k)
         axes["uio.error"].set_title(
             f"{scenario.observer_name} (decouples {sym})", fontsize=9 * k, fontweight="bold"
@@ -301,7 +319,7 @@ class ExplorerFigure:
             mfc="none",
             mec="C2",
             mew=1.5,
-            label="fixed (zeros)",
+            label="fixed" if zeros.size else "_fixed",
         )
         self.lines["poles"] = pz.plot(
             [], [], "x", ms=8, mew=1.8, color="C3", label=scenario.observer_name
@@ -426,8 +444,9 @@ class ExplorerFigure:
                     ranged = [np.array([top])] if top else data
                     ax.set_ylim(*_log_range(ranged, None if fresh else ax.get_ylim()))
                     continue
-                if row == "input":
-                    data.append(frame.d)
+                if row == "input":  # zoomed on the true input: a wild estimate runs off the panel
+                    size = _finite_max(frame.d) or 1.0
+                    data = [np.array([-1.6 * size, 1.6 * size])]
                 ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), fresh))
         sig = self.axes["signals"]
         wanted = _nice_range([frame.d, frame.v])

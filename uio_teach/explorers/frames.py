@@ -575,6 +575,11 @@ def _explain(scenario: Scenario, s: Settings, movable, fixed, poles, excited) ->
             f"Fixed whatever the gain: {format_poles(fixed, 3)} (the invariant zeros, o on "
             "the pole map)."
         )
+    if scenario.reconstruct:
+        parts.append(
+            "The input panels are zoomed on the true input (grey): larger swings of a "
+            "reconstruction run off the panel."
+        )
     if poles.size and excited.size == poles.size:
         start = STARTS.get(s.start, s.start)
         quiet = poles[~excited]
@@ -733,6 +738,9 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
             if hit:
                 clipped.setdefault(key, set()).add(what)
     for key, whats in clipped.items():
+        whats.discard("input")  # the input panels are zoomed on the true input anyway
+        if not whats:
+            continue
         who = scenario.observer_name if key == "uio" else "Luenberger observer"
         which = " and ".join(sorted(whats))
         verb = "leaves" if len(whats) == 1 else "leave"
