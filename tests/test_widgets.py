@@ -374,3 +374,44 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
         pool.submit(drive).result()
     assert not errors, errors
     assert all(u.startswith(("file:", "data:")) for u in requests), requests
+
+
+# dragging poles: ipympl canvas when available, sliders alone otherwise ----------------------
+
+
+def test_drag_uses_an_ipympl_canvas_and_redraws_after_a_resize():
+    pytest.importorskip("ipympl")
+    ex = widgets.pa9_explorer(static=False, drag=True)
+    assert ex.canvas is not None and ex.canvas in ex.widget.children
+    ex.set(**{"pole 1": -3.0})
+    ex.figure.fig.set_dpi(180)  # what a HiDPI page does to the canvas
+    ex.set(**{"pole 1": -2.5})
+    fast = np.asarray(ex.figure.fig.canvas.buffer_rgba()).copy()
+    ex.figure.fig.canvas.draw()
+    full = np.asarray(ex.figure.fig.canvas.buffer_rgba())
+    assert fast.shape == full.shape and np.any(fast != full, axis=-1).mean() < 0.003
+    ex.close()
+
+
+def test_without_the_widget_backend_the_sliders_work_alone(monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "ipympl.backend_nbagg", None)  # import fails
+    assert widgets.drag_available() is False
+    ex = widgets.pa9_explorer(static=False, drag=True)
+    assert ex.canvas is None and ex.image in ex.widget.children
+    ex.set(**{"pole 1": -4.0})
+    assert bytes(ex.image.value[:4]) == b"\x89PNG"
+    assert ex.settings.poles[0] == -4.0
+
+
+def test_rerunning_a_cell_frees_the_previous_explorer():
+    import gc
+    import weakref
+
+    first = widgets.case_study_explorer(static=False)
+    ref = weakref.ref(first.figure)
+    del first
+    widgets.case_study_explorer(static=False)
+    gc.collect()
+    assert ref() is None

@@ -508,6 +508,11 @@ class ExplorerFigure:
         1
         """
         canvas = self.fig.canvas
+        size = (canvas, self.fig.dpi, *self.fig.get_size_inches())
+        if size != getattr(self, "_size", None):  # a new canvas, or resized (HiDPI screen)
+            self._size = size
+            self._background = None
+            self._cells = None
         keys = {name: (*ax.get_xlim(), *ax.get_ylim()) for name, ax in self.axes.items()}
         keys["title"] = (self.title.get_text(),)
         keys["footer"] = (self.footer.get_text(),)
