@@ -46,6 +46,7 @@ import numpy as np
 
 from .._display import format_poles
 from ..plant import Plant
+from ._drag import DragPoles, _in_kernel, drag_available
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
@@ -60,31 +61,9 @@ __all__ = [
     "drag_available",
 ]
 
-_GRAB_PIXELS = 14  # a press this close to a movable pole on the pole map grabs it
-
 # The explorer on display for each scenario name: re-running a cell closes the previous one,
 # so its figure and widgets are freed instead of piling up.
 _LIVE: dict[str, Explorer] = {}
-
-
-def drag_available() -> bool:
-    """True when poles can be dragged on the pole map: ipympl (the widget backend) is installed.
-
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
-    >>> from uio_teach.explorers.widgets import drag_available
-    >>> isinstance(drag_available(), bool)
-    True
-    """
-    try:
-        import ipympl.backend_nbagg  # noqa: F401
-    except Exception:  # not installed, or an incompatible version: sliders only
-        return False
-    return True
 
 
 _STYLE = {"description_width": "120px"}
@@ -125,7 +104,7 @@ class _Slot:
         self.controls = controls
 
 
-class Explorer:
+class Explorer(DragPoles):
     """A live explorer: controls, the figure and messages, wired to :func:`compute_frame`.
 
     Build one with :func:`pa9_explorer`, :func:`case_study_explorer`,
@@ -508,110 +487,6 @@ class Explorer:
         self.frame = frame
         self.message.value = _message_html(frame)
 
-    # dragging poles on the pole map -------------------------------------------------------
-    def _make_canvas(self) -> Any:
-        """An ipympl canvas for the figure, or None when the widget backend does not load."""
-        try:
-            from ipympl.backend_nbagg import Canvas, FigureManager
-
-            canvas = Canvas(self.figure.fig)
-            FigureManager(canvas, 0)
-            canvas.header_visible = False
-            canvas.footer_visible = False
-            canvas.toolbar_visible = False
-            canvas.resizable = False
-            canvas.capture_scroll = False
-            canvas.layout.width = "100%"
-            canvas.layout.max_width = "900px"
-        except Exception:  # a frontend without ipympl: sliders only
-            return None
-        self.figure._background = None  # the canvas is new: the next draw is a full one
-        return canvas
-
-    def _slot_points(self) -> list[tuple[int, complex]]:
-        """The movable poles on the map (upper member of a pair), by slot."""
-        out = []
-        for index, slot in enumerate(self._slots):
-            values = [control.value for control in slot.controls.values()]
-            if slot.kind == "real":
-                out.append((index, complex(values[0], 0.0)))
-            elif self.scenario.discrete:
-                out.append((index, cmath.rect(values[0], math.radians(values[1]))))
-            else:
-                out.append((index, complex(values[0], values[1])))
-        return out
-
-    def on_press(self, event: Any) -> None:
-        """Grab the movable pole nearest to a press on the pole map (within a few pixels).
-
-        Parameters
-        ----------
-        event : matplotlib.backend_bases.MouseEvent
-            The press (``inaxes``, ``x``, ``y`` in pixels, ``button``).
-
-        Examples
-        --------
-        >>> from types import SimpleNamespace
-        >>> from uio_teach.explorers import widgets
-        >>> ex = widgets.case_study_explorer(static=False, drag=False)
-        >>> ax = ex.figure.axes["poles"]
-        >>> x, y = ax.transData.transform((0.0, 0.0))        # where pole 1 is drawn
-        >>> ex.on_press(SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=0.0, ydata=0.0))
-        >>> ex.on_motion(SimpleNamespace(inaxes=ax, x=x, y=y, button=1, xdata=0.3, ydata=0.1))
-        >>> ex.on_release(SimpleNamespace(inaxes=ax, button=1))
-        >>> ex.settings.poles
-        (0.3,)
-        """
-        ax = self.figure.axes["poles"]
-        if getattr(event, "inaxes", None) is not ax or getattr(event, "button", 1) not in (1, None):
-            return
-        if "mode" in self.controls and self.controls["mode"].value == "lmi":
-            return
-        best, where = None, float(_GRAB_PIXELS)
-        for index, p in self._slot_points():
-            for q in (p, p.conjugate()):
-                px, py = ax.transData.transform((q.real, q.imag))
-                gap = math.hypot(px - event.x, py - event.y)
-                if gap <= where:
-                    best, where = index, gap
-        self._dragging = None if best is None else (best, "grab")
-
-    def on_motion(self, event: Any) -> None:
-        """Move the grabbed pole to the pointer: its sliders follow, the figure updates.
-
-        Parameters
-        ----------
-        event : matplotlib.backend_bases.MouseEvent
-            The motion (``inaxes``, ``xdata``, ``ydata``).
-        """
-        if self._dragging is None:
-            return
-        ax = self.figure.axes["poles"]
-        if getattr(event, "inaxes", None) is not ax or event.xdata is None:
-            return
-        slot = self._slots[self._dragging[0]]
-        controls = list(slot.controls.values())
-        z = complex(float(event.xdata), float(event.ydata))
-        with self.hold():
-            if slot.kind == "real":
-                controls[0].value = _clamp(controls[0], z.real)
-            elif self.scenario.discrete:
-                controls[0].value = _clamp(controls[0], abs(z))
-                controls[1].value = _clamp(controls[1], math.degrees(abs(cmath.phase(z))))
-            else:
-                controls[0].value = _clamp(controls[0], z.real)
-                controls[1].value = _clamp(controls[1], abs(z.imag))
-
-    def on_release(self, event: Any) -> None:
-        """Let go of the grabbed pole.
-
-        Parameters
-        ----------
-        event : matplotlib.backend_bases.MouseEvent
-            The release.
-        """
-        self._dragging = None
-
     def close(self) -> None:
         """Close the figure's canvas and the widgets (frees their memory at once).
 
@@ -683,27 +558,6 @@ def _close_tree(widget: Any) -> None:
         if isinstance(sub, W.Widget):
             sub.close()
     widget.close()
-
-
-def _in_kernel() -> bool:
-    """True inside a Jupyter kernel (where a canvas widget can be shown)."""
-    try:
-        from IPython import get_ipython
-
-        shell = get_ipython()
-    except Exception:  # pragma: no cover - IPython comes with ipywidgets
-        return False
-    return shell is not None and hasattr(shell, "kernel")
-
-
-def _clamp(control: Any, value: float) -> float:
-    """A value inside the slider's range, on its step."""
-    step = control.step or 0
-    value = min(max(float(value), control.min), control.max)
-    if step:
-        value = control.min + round((value - control.min) / step) * step
-        value = round(value, max(0, 1 - math.floor(math.log10(step))) + 6)
-    return float(min(max(value, control.min), control.max))
 
 
 def _message_html(frame: Frame) -> str:
