@@ -123,9 +123,10 @@ def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
 
 @pytest.mark.parametrize("chapter", sorted(SCENARIOS))
 def test_built_explorer_pages_are_small(chapter):
-    page = HTML / f"{chapter}.html"
+    page = HTML / "book" / f"{chapter}.html"
     if not page.exists():
         pytest.skip("the book is not built (tests/test_book.py builds it)")
     text = page.read_text(encoding="utf-8")
     assert "uio-static-explorer" in text
+    assert "widget-state+json" not in text  # the unused widget state is left out
     assert page.stat().st_size <= MAX_PAGE, page.stat().st_size
