@@ -820,7 +820,7 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
         messages=tuple(notes),
         disturbance=description,
         movable_poles=movable,
-        fixed_poles=fixed if obs is not None else fixed,
+        fixed_poles=fixed,
         excited=excited,
         initial_error=e0,
         guides=guides,
