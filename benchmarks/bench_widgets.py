@@ -124,15 +124,15 @@ def main() -> None:
         ex = make()
         times, cpu, lmi_times, lmi_cpu = sweep(ex, args.steps)
         m0, m1 = memory(make)
-        for label, t, c, base in (
-            (name, times, cpu, rebuild(make)),
-            (f"{name}, LMI bound", lmi_times, lmi_cpu, rebuild(make, 3, lmi=True)),
+        for label, t, c, lmi in (
+            (name, times, cpu, False),
+            (f"{name}, LMI bound", lmi_times, lmi_cpu, True),
         ):
             if not t:
                 continue
             med = statistics.median(t)
             p95 = float(np.percentile(t, 95))
-            reb = statistics.median(base)
+            reb = statistics.median(rebuild(make, 3 if lmi else 5, lmi=lmi))
             rows.append(
                 f"| {label} | {len(t)} | {med:.0f} | {p95:.0f} | {reb:.0f} | "
                 f"{p95 / reb:.2f} | {statistics.median(c):.0f} | {np.percentile(c, 95):.0f} | "
