@@ -1,33 +1,33 @@
-"""Time the explorers: from a control change to the redrawn figure, against rebuilding the figure.
+"""Time the explorers over a sweep of every control, against rebuilding; memory over re-runs.
 
 Run from the repository root with the project's environment::
 
-    .venv/bin/python benchmarks/bench_widgets.py [--changes 50]
+    .venv/bin/python benchmarks/bench_widgets.py [--steps 12] [--write]
 
-For each explorer the same sequence of control changes (mostly pole moves, as a
-student drags a slider and lets go; then amplitude, frequency, disturbance type and
-noise) is timed four ways, on the Agg backend, without a kernel:
+For each explorer every control is swept over its whole range (each slider from its
+minimum to its maximum in ``--steps`` steps, each menu through its options, the LMI
+bound in LMI mode), one change at a time, as a student sets it; a change is timed from
+setting the control's ``value`` until its handler returns (design, both simulations,
+the in-place update including any axis rescale, the redraw and the PNG the widget
+shows). The baseline is **rebuilding**: a new explorer, built and drawn from scratch.
+Memory: the resident size after re-running an explorer cell 20 times (each run builds
+a new explorer; the previous one is closed).
 
-* **widget**: setting the control's ``value`` on the live explorer, until its handler
-  returns: design, both simulations, in-place update, redraw and the PNG the widget shows;
-* **in place**: ``compute_frame`` + ``ExplorerFigure.update`` + ``ExplorerFigure.draw``
-  (the redraw that blits or redraws only the panels whose range changed);
-* **in place, full draw**: the same update followed by a complete ``fig.canvas.draw()``;
-* **rebuild** (the baseline): ``compute_frame``, a new figure built from scratch and
-  ``fig.canvas.draw()``.
-
-Medians (and 90th percentiles) in milliseconds. Goals on a 2-core machine: the widget under
-50 ms, at least 3 times faster than the rebuild. The static frames (the whole grid of one
-explorer) are timed once.
+Goals on a 2-core machine: median at most 50 ms, 95th percentile at most a third of
+the rebuild, memory growth under 30 MiB over 20 re-runs. ``--write`` puts the table
+in ``benchmarks/WIDGETS.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
+import os
 import platform
 import statistics
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import matplotlib
 
@@ -35,132 +35,140 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 
-from uio_teach.explorers import DISTURBANCES, ExplorerFigure, compute_frame, widgets  # noqa: E402
-from uio_teach.explorers.static import static_explorer  # noqa: E402
+import uio_teach as ut  # noqa: E402
+from uio_teach.explorers import widgets  # noqa: E402
 
 
-def changes(ex: widgets.Explorer, count: int) -> list[tuple[str, object]]:
-    """A reproducible sequence of control changes: 60 % pole (or bound) moves, then the rest."""
-    rng = np.random.default_rng(0)
-    c = ex.controls
-    main = "decay" if c.get("mode") is not None and c["mode"].value == "lmi" else "pole 1"
-    lo, hi = c[main].min, c[main].max
-    start = c[main].value
-    out: list[tuple[str, object]] = []
-    n_main = int(0.6 * count)
-    # a drag: small steps around the start value, within the stable part of the range
-    top = min(hi, 0.95) if ex.scenario.discrete else min(hi, 0.0)
-    for value in start + np.cumsum(rng.normal(0, 0.04 * (hi - lo), n_main)):
-        out.append((main, float(np.clip(value, lo, top - 0.01 * (hi - lo)))))
-    others = ["amplitude", "frequency", "disturbance", "noise"]
-    for i in range(count - n_main):
-        name = others[i % len(others)]
-        if name == "disturbance":
-            out.append((name, DISTURBANCES[(i // len(others) + 1) % len(DISTURBANCES)]))
+def _own(static: bool = False) -> widgets.Explorer:
+    plant = ut.Plant([[0, 1], [-0.08, 0.6]], [[-0.5, 1]], E=[[0], [1]], dt=1)
+    return widgets.explorer(plant, "uio", static=static, drag=False)
+
+
+EXPLORERS: dict[str, Callable[[], widgets.Explorer]] = {
+    "PA9": lambda: widgets.pa9_explorer(static=False, drag=False),
+    "case study": lambda: widgets.case_study_explorer(static=False, drag=False),
+    "missile": lambda: widgets.missile_explorer(static=False, drag=False),
+    "own plant": _own,
+}
+
+
+def _rss_mib() -> float:
+    with open("/proc/self/statm") as f:
+        pages = int(f.read().split()[1])
+    return pages * 4096 / 2**20
+
+
+def sweep(
+    ex: widgets.Explorer, steps: int
+) -> tuple[list[float], list[float], list[float], list[float]]:
+    """Set every control over its range: wall and CPU times (ms), then those of the LMI bound."""
+    times: list[float] = []
+    cpu: list[float] = []
+
+    def timed_set(control, value) -> None:
+        c0, t0 = time.process_time(), time.perf_counter()
+        control.value = value
+        times.append(1e3 * (time.perf_counter() - t0))
+        cpu.append(1e3 * (time.process_time() - c0))
+
+    for name in list(ex.controls):
+        if name in ("pattern", "mode", "decay"):
+            continue
+        control = ex.controls[name]
+        start = control.value
+        if hasattr(control, "options"):
+            values = [o[1] if isinstance(o, tuple) else o for o in control.options]
         else:
-            ctl = c[name]
-            out.append((name, float(rng.uniform(ctl.min, ctl.max))))
+            values = list(np.linspace(control.min, control.max, steps))
+        for v in [*values, start]:
+            timed_set(control, v)
+    plain = (list(times), list(cpu))
+    del times[:], cpu[:]
+    if "mode" in ex.controls:
+        ex.controls["mode"].value = "lmi"
+        d = ex.controls["decay"]
+        for v in [*np.linspace(d.min, d.max, steps), d.value]:
+            timed_set(d, v)
+        ex.controls["mode"].value = "poles"
+    return (*plain, times, cpu)
+
+
+def rebuild(make: Callable[[], widgets.Explorer], count: int = 5, lmi: bool = False) -> list[float]:
+    out = []
+    for _ in range(count):
+        t0 = time.perf_counter()
+        ex = make()
+        if lmi:  # the explorer anew, showing the LMI design (one solve, as a bound change)
+            ex.set(mode="lmi", decay=0.85)
+        out.append(1e3 * (time.perf_counter() - t0))
     return out
 
 
-def timed(fn: Callable[[], object]) -> float:
-    start = time.perf_counter()
-    fn()
-    return (time.perf_counter() - start) * 1e3
-
-
-def bench(name: str, make: Callable[[], widgets.Explorer], count: int) -> dict[str, object]:
-    ex = make()
-    seq = changes(ex, count)
-    # widget: set each control as the slider would
-    t_widget, settings = [], []
-    for key, value in seq:
-        t_widget.append(timed(lambda k=key, v=value: setattr(ex.controls[k], "value", v)))
-        settings.append(ex.settings)
-    sc = ex.scenario
-    # pure, in place, with blitting / partial redraws
-    ef = ExplorerFigure(sc)
-    ef.update(compute_frame(sc, settings[0]))
-    ef.draw()
-    full0, partial0 = ef.full_draws, ef.partial_draws
-    t_inplace = [timed(lambda s=s: (ef.update(compute_frame(sc, s)), ef.draw())) for s in settings]
-    full, partial = ef.full_draws - full0, ef.partial_draws - partial0
-    # in place, complete canvas draw each time
-    t_full = [
-        timed(lambda s=s: (ef.update(compute_frame(sc, s)), ef.fig.canvas.draw())) for s in settings
-    ]
-
-    # baseline: a new figure for every change
-    def rebuild(s):
-        fresh = ExplorerFigure(sc)
-        fresh.update(compute_frame(sc, s))
-        fresh.fig.canvas.draw()
-
-    t_rebuild = [timed(lambda s=s: rebuild(s)) for s in settings]
-    t_compute = [timed(lambda s=s: compute_frame(sc, s)) for s in settings]
-    static_time = timed(lambda: static_explorer(sc, ex._base))
-    page = static_explorer(sc, ex._base)
-    return {
-        "name": name,
-        "widget": t_widget,
-        "in place": t_inplace,
-        "in place, full draw": t_full,
-        "rebuild": t_rebuild,
-        "compute only": t_compute,
-        "draws": (len(settings) - full - partial, partial, full),
-        "static": (static_time, page.count, len(page.html)),
-    }
-
-
-def med(values: list[float]) -> str:
-    return f"{statistics.median(values):.1f}"
-
-
-def p90(values: list[float]) -> str:
-    return f"{np.percentile(values, 90):.1f}"
+def memory(make: Callable[[], widgets.Explorer], runs: int = 20) -> tuple[float, float]:
+    make()
+    gc.collect()
+    before = _rss_mib()
+    for _ in range(runs):
+        make()
+    gc.collect()
+    return before, _rss_mib()
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--changes", type=int, default=50, help="control changes per explorer")
+    parser.add_argument("--steps", type=int, default=12)
+    parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
-
-    def lmi_case():
-        ex = widgets.case_study_explorer(static=False)
-        ex.controls["mode"].value = "lmi"
-        return ex
-
-    runs = [
-        ("PA9 (UIO, 3 poles)", lambda: widgets.pa9_explorer(static=False)),
-        ("Case study (PMO, 1 pole)", lambda: widgets.case_study_explorer(static=False)),
-        ("Case study, LMI bound", lmi_case),
-        ("Missile (PMO + reconstruction)", lambda: widgets.missile_explorer(static=False)),
-    ]
-    results = [bench(name, make, args.changes) for name, make in runs]
-    cpu = platform.processor() or platform.machine()
-    print(
-        f"{cpu}, Python {platform.python_version()}, matplotlib {matplotlib.__version__}; "
-        f"{args.changes} changes per explorer\n"
+    rows = []
+    for name, make in EXPLORERS.items():
+        ex = make()
+        times, cpu, lmi_times, lmi_cpu = sweep(ex, args.steps)
+        m0, m1 = memory(make)
+        for label, t, c, lmi in (
+            (name, times, cpu, False),
+            (f"{name}, LMI bound", lmi_times, lmi_cpu, True),
+        ):
+            if not t:
+                continue
+            med = statistics.median(t)
+            p95 = float(np.percentile(t, 95))
+            reb = statistics.median(rebuild(make, 3 if lmi else 5, lmi=lmi))
+            rows.append(
+                f"| {label} | {len(t)} | {med:.0f} | {p95:.0f} | {reb:.0f} | "
+                f"{p95 / reb:.2f} | {statistics.median(c):.0f} | {np.percentile(c, 95):.0f} | "
+                f"{m1 - m0:+.1f} |"
+            )
+            print(rows[-1], flush=True)
+    table = "\n".join(
+        [
+            "| explorer | changes | median (ms) | p95 (ms) | rebuild (ms) | p95 / rebuild "
+            "| CPU median (ms) | CPU p95 (ms) | memory, 20 re-runs (MiB) |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+            *rows,
+        ]
     )
-    print(
-        "| explorer | widget: change to new PNG | in place (blit) | in place, full draw | "
-        "rebuild (baseline) | speed-up vs rebuild | compute only | blits / partial / full |"
+    with open("/proc/loadavg") as f:
+        load = f.read().split()[0]
+    info = (
+        f"{platform.python_version()}, {platform.machine()}, {os.cpu_count()} cores "
+        f"(load average {load} at the end), Agg backend, no kernel"
     )
-    print("|---|---|---|---|---|---|---|---|")
-    for r in results:
-        speed = statistics.median(r["rebuild"]) / statistics.median(r["widget"])
-        blits, partial, full = r["draws"]
-        print(
-            f"| {r['name']} | {med(r['widget'])} (p90 {p90(r['widget'])}) | "
-            f"{med(r['in place'])} | {med(r['in place, full draw'])} | "
-            f"{med(r['rebuild'])} (p90 {p90(r['rebuild'])}) | {speed:.1f}x | "
-            f"{med(r['compute only'])} | {blits} / {partial} / {full} |"
+    print(table)
+    if args.write:
+        text = (
+            "# Explorer latency\n\n"
+            "`benchmarks/bench_widgets.py --write`: every control of each explorer swept over "
+            "its whole range, one change at a time (design, both simulations, in-place update "
+            "with any axis rescale, redraw, PNG), against rebuilding the explorer from scratch; "
+            "wall-clock time, and the CPU time of the process (which other programs on a "
+            "shared machine do not inflate); memory growth over 20 re-runs of the explorer's "
+            f"cell. Python {info}.\n\n"
+            "Goals: median at most 50 ms, p95 at most a third of the rebuild, memory growth "
+            "under 30 MiB. The LMI bound of the case study is timed on its own row: each new "
+            "bound is one LMI solve (cvxpy), and its rebuild is an explorer built anew in LMI "
+            "mode.\n\n" + table + "\n"
         )
-    print("\n| explorer | static frames | build time (s) | HTML size (kB) |")
-    print("|---|---|---|---|")
-    for r in results:
-        seconds, count, size = r["static"]
-        print(f"| {r['name']} | {count} | {seconds / 1e3:.2f} | {size / 1e3:.0f} |")
+        Path(__file__).with_name("WIDGETS.md").write_text(text, encoding="utf-8")
 
 
 if __name__ == "__main__":

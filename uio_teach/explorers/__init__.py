@@ -31,10 +31,11 @@ Examples
 
 from ..luenberger import luenberger_poles
 from ._figure import ExplorerFigure, render
-from .frames import Frame, compute_frame
+from .frames import Frame, compute_frame, error_grows, excited_modes
 from .model import (
     DISTURBANCES,
     FAMILIES,
+    STARTS,
     Channel,
     Scenario,
     Settings,
@@ -46,6 +47,7 @@ from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9
 __all__ = [
     "DISTURBANCES",
     "FAMILIES",
+    "STARTS",
     "Channel",
     "Settings",
     "Scenario",
@@ -59,5 +61,7 @@ __all__ = [
     "disturbance_signals",
     "luenberger_poles",
     "compute_frame",
+    "excited_modes",
+    "error_grows",
     "render",
 ]

@@ -34,7 +34,6 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["ExplorerFigure", "render"]
 
-_WRAP = 34  # characters per line of a message drawn inside a panel
 # Legends inside the panels are opaque and square: drawn over the curves, they hide exactly
 # their box, which lets the fast redraw paint them back from the stored background.
 _LEGEND = {
@@ -68,16 +67,53 @@ def _nice_range(arrays: Sequence[np.ndarray | None]) -> tuple[float, float]:
     return math.floor(lo / unit) * unit, math.ceil(hi / unit) * unit
 
 
+def _log_range(
+    arrays: Sequence[np.ndarray | None], current: tuple[float, float] | None, decades: int = 8
+) -> tuple[float, float]:
+    """Log-axis limits: the top snapped up to a decade, ``decades`` decades down; sticky."""
+    top = 0.0
+    for a in arrays:
+        if a is None or not np.size(a):
+            continue
+        a = np.abs(np.asarray(a, dtype=float))
+        a = a[np.isfinite(a)]
+        if a.size:
+            top = max(top, float(a.max()))
+    if top <= 0:
+        top = 1.0
+    if current is not None and current[1] >= top and current[1] <= 1e3 * top:
+        return current
+    hi = 10.0 ** math.ceil(math.log10(top * 1.2))
+    return hi * 10.0**-decades, hi
+
+
 def _keep_range(
     current: tuple[float, float], wanted: tuple[float, float], fresh: bool
 ) -> tuple[float, float]:
     """Keep the current limits while the data fit and fill at least a third of them."""
     lo, hi = wanted
-    if fresh or lo < current[0] or hi > current[1]:
+    if fresh:
         return wanted
+    if lo < current[0] or hi > current[1]:
+        # grow with room to spare, so that the next slightly larger curve fits as well
+        a, b = min(lo, current[0]), max(hi, current[1])
+        pad = 0.25 * (b - a)
+        return _nice_range([np.array([a - pad * (lo < current[0]), b + pad * (hi > current[1])])])
     if (hi - lo) < (current[1] - current[0]) / 3:
         return wanted
     return current
+
+
+def _finite_max(*arrays: np.ndarray | None) -> float:
+    best = 0.0
+    for a in arrays:
+        if a is None or not np.size(a):
+            continue
+        a = np.abs(np.asarray(a, dtype=float))
+        a = a[np.isfinite(a)]
+        if a.size:
+            best = max(best, float(a.max()))
+    return best
 
 
 def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
@@ -93,12 +129,15 @@ class ExplorerFigure:
     """The explorer's figure: built once, then updated in place for each frame.
 
     Columns: the unknown input observer, the Luenberger observer (rows: the
-    error ``e = x - xhat``, the residual ``r = y - C xhat`` and, when the
-    scenario reconstructs it, the unknown input with its reconstruction), and
-    a side column with the pole map (``x`` observer poles, ``+`` Luenberger
-    poles, ``o`` invariant zeros, which are the fixed poles; unit circle in
-    discrete time) and the applied unknown signals. Rows share their
-    vertical scale, so the two observers compare at a glance.
+    size of the error ``|e| = |x - xhat|`` on a log scale, with the rates of
+    the slowest moved and fixed poles or the LMI's certified envelope; the
+    residual ``r = y - C xhat`` and, when the scenario reconstructs it, the
+    unknown input with its reconstruction, the true input in grey), and a side
+    column with the pole map (``x`` observer poles, ``+`` Luenberger poles,
+    ``o`` invariant zeros, which are the fixed poles; unit circle in discrete
+    time) and the applied unknown signals. Each panel has its own vertical
+    scale, so a good estimate is not flattened by a bad one. Messages are
+    written under the panels, never over the curves.
 
     :meth:`update` only changes the data of existing lines and texts
     (``set_data``, ``set_text``) and rescales the axes; :meth:`draw` renders
@@ -117,6 +156,8 @@ class ExplorerFigure:
         Keep an axis range while the new data fit it and fill at least a
         third of it (fewer redraws, for live use); ``False`` gives every frame
         its own range (for pictures that must not depend on the previous one).
+    fontscale : float
+        Multiplies every font size (larger for pictures shown scaled down).
 
     Attributes
     ----------
@@ -151,6 +192,7 @@ class ExplorerFigure:
         dpi: float = 90,
         figsize: tuple[float, float] | None = None,
         sticky: bool = True,
+        fontscale: float = 1.0,
     ) -> None:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
@@ -164,15 +206,17 @@ class ExplorerFigure:
         if figsize is None:
             figsize = (9.0, 6.2) if scenario.reconstruct else (9.0, 4.8)
         fig = Figure(figsize=figsize, dpi=dpi)
+        k = float(fontscale)
+        self.fontscale = k
         FigureCanvasAgg(fig)
         axes = fig.subplot_mosaic(
             mosaic,
             gridspec_kw={
                 "width_ratios": [1.0, 1.0, 0.85],
                 "left": 0.075,
-                "right": 0.985,
-                "top": 0.86,
-                "bottom": 0.17 if not scenario.reconstruct else 0.13,
+                "right": 0.965,
+                "top": 0.84,
+                "bottom": 0.21 if not scenario.reconstruct else 0.16,
                 "wspace": 0.42,
                 "hspace": 0.5,
             },
@@ -182,10 +226,11 @@ class ExplorerFigure:
         self.lines: dict[str, list] = {}
         discrete = scenario.discrete
         style = {"drawstyle": "steps-post"} if discrete else {}
-        xlabel = time_label(plant.dt)
+        unit_step = plant.dt is True or (discrete and float(plant.dt) == 1.0)
+        xlabel = "step k" if unit_step else time_label(plant.dt)
         sym = scenario.input_symbol
-        for r in rows:
-            axes[f"lb.{r}"].sharey(axes[f"uio.{r}"])
+        for who in ("uio", "lb"):
+            axes[f"{who}.error"].set_yscale("log")
         counts = {"error": plant.n, "residual": plant.p, "input": plant.q}
         labels = {
             "error": lambda i: symbol("e", i),
@@ -198,50 +243,66 @@ class ExplorerFigure:
                 ax = axes[f"{who}.{r}"]
                 if r == "input":
                     self.lines[f"{who}.actual"] = [
-                        ax.plot([], [], color="0.45", lw=1.0, ls=":", **style)[0]
-                        for _ in range(plant.q)
+                        ax.plot(
+                            [],
+                            [],
+                            color="0.25",
+                            lw=2.4,
+                            alpha=0.45,
+                            label=f"{symbol(sym, i)} true",
+                            **style,
+                        )[0]
+                        for i in range(plant.q)
                     ]
                 self.lines[f"{who}.{r}"] = [
                     ax.plot([], [], color=f"C{i}", lw=1.1, label=labels[r](i), **style)[0]
                     for i in range(counts[r])
                 ]
                 ax.grid(True, alpha=0.3)
-                ax.yaxis.set_major_locator(MaxNLocator(5))
-                ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+                if r != "error":
+                    ax.yaxis.set_major_locator(MaxNLocator(5))
+                    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+                else:
+                    from matplotlib.ticker import LogLocator, NullFormatter
+
+                    ax.yaxis.set_major_locator(LogLocator(base=100.0, numticks=6))
+                    ax.yaxis.set_minor_locator(LogLocator(base=10.0, numticks=12))
+                    ax.yaxis.set_minor_formatter(NullFormatter())
                 if r != rows[-1]:
                     ax.tick_params(labelbottom=False)
+                if r == "error" and who == "uio":
+                    self.lines["guides"] = [
+                        ax.plot([], [], color=c, lw=1.3, ls=ls, label=lab)[0]
+                        for c, ls, lab in (
+                            ("k", "-.", "certified" if scenario.decay_limits else "_certified"),
+                            ("C3", "--", "slowest moved"),
+                            ("C2", ":", "slowest fixed" if scenario.fixed_poles.size else "_f"),
+                        )
+                    ]
                 if who == "uio":
-                    ax.set_ylabel(ylabels[r], fontsize=8)
-                    if counts[r]:
-                        ax.legend(**_LEGEND)
-            axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8)
+                    ax.set_ylabel(ylabels[r] if r != "error" else "|error| (log)", fontsize=8 * k)
+                if counts[r] and (who == "uio" or r == "input"):
+                    # the log error axis reaches a decade above the clipping bound, so its
+                    # top band is free of curves: a wide, flat legend sits there
+                    if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
+                        shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
+                        ax.legend(handles=shown, **{**_LEGEND, "fontsize": 6.5 * k, "ncol": 1})
+                    else:
+                        ax.legend(**{**_LEGEND, "fontsize": 6.5 * k})
+            axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8 * k)
         axes["uio.error"].set_title(
-            f"{scenario.observer_name} (decouples {sym})", fontsize=9, fontweight="bold"
+            f"{scenario.observer_name} (decouples {sym})", fontsize=9 * k, fontweight="bold"
         )
         axes["lb.error"].set_title(
-            f"Luenberger observer (ignores {sym})", fontsize=9, fontweight="bold"
+            f"Luenberger observer (ignores {sym})", fontsize=9 * k, fontweight="bold"
         )
-        self.notes = {
-            who: axes[f"{who}.error"].text(
-                0.5,
-                0.5,
-                "",
-                transform=axes[f"{who}.error"].transAxes,
-                ha="center",
-                va="center",
-                fontsize=7.5,
-                color="C3",
-                zorder=10,
-                bbox={"facecolor": "white", "edgecolor": "C3", "alpha": 0.9},
-                visible=False,
-            )
-            for who in ("uio", "lb")
-        }
+        # the observers' messages go under the panels (the footer), never over the curves
+        self.notes: dict[str, Any] = {}
 
         # side column: pole map and unknown signals
         pz = axes["poles"]
-        pz.set_xlabel("real part", fontsize=8)
-        pz.set_ylabel("imaginary part", fontsize=8)
+        pz.set_xlabel("real part", fontsize=8 * k)
+        pz.set_ylabel("imaginary part", fontsize=8 * k)
         pz.grid(True, alpha=0.3)
         if discrete:
             theta = np.linspace(0, 2 * np.pi, 181)
@@ -258,7 +319,7 @@ class ExplorerFigure:
             mfc="none",
             mec="C2",
             mew=1.5,
-            label="zeros = fixed poles",
+            label="fixed" if zeros.size else "_fixed",
         )
         self.lines["poles"] = pz.plot(
             [], [], "x", ms=8, mew=1.8, color="C3", label=scenario.observer_name
@@ -270,14 +331,14 @@ class ExplorerFigure:
             loc="lower center",
             bbox_to_anchor=(0.5, 1.0),
             ncol=2,
-            fontsize=6,
+            fontsize=6.5 * k,
             frameon=False,
             handlelength=1.0,
             columnspacing=0.8,
             borderaxespad=0.2,
         )
         sig = axes["signals"]
-        sig.set_ylabel("unknown inputs", fontsize=8)
+        sig.set_ylabel("unknown inputs", fontsize=8 * k)
         self.lines["d"] = [
             sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sym, i), **style)[0]
             for i in range(plant.q)
@@ -289,15 +350,18 @@ class ExplorerFigure:
             for i in range(plant.r)
         ]
         if plant.q + plant.r:
-            sig.legend(**_LEGEND)
-        sig.set_xlabel(xlabel, fontsize=8)
+            sig.legend(**{**_LEGEND, "fontsize": 6.5 * k})
+        sig.set_xlabel(xlabel, fontsize=8 * k)
         sig.grid(True, alpha=0.3)
         sig.yaxis.set_major_locator(MaxNLocator(5))
         sig.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
         for ax in axes.values():
-            ax.tick_params(labelsize=7)
-        self.title = fig.suptitle("", fontsize=10)
-        self.footer = fig.text(0.01, 0.005, "", fontsize=7.5, ha="left", va="bottom", color="C3")
+            ax.tick_params(labelsize=7 * k)
+        self.title = fig.suptitle("", fontsize=10 * k)
+        self.footer = fig.text(
+            0.01, 0.005, "", fontsize=7.5 * k, ha="left", va="bottom", color="C3"
+        )
+        self._wrap = int(150 / k)
         self.frame: Frame | None = None
         self.full_draws = 0
         self.partial_draws = 0
@@ -322,21 +386,32 @@ class ExplorerFigure:
         >>> s = case_study_scenario()
         >>> ef = ExplorerFigure(s)
         >>> ef.update(compute_frame(s, s.defaults.replace(poles=(1.05,))))
-        >>> ef.notes["uio"].get_visible()
+        >>> "the error grows" in ef.footer.get_text()
         True
         """
         self.frame = frame
         t = frame.time
         empty = np.zeros(0)
         for name, lines in self.lines.items():
-            if name in ("poles", "luenberger poles", "d", "v") or name.endswith(".actual"):
+            if name in ("poles", "luenberger poles", "d", "v", "guides") or name.endswith(
+                ".actual"
+            ):
                 continue
             arr = frame.curves.get(name)
+            if arr is not None and name.endswith(".error"):
+                arr = np.abs(arr)
             for i, line in enumerate(lines):
                 if arr is None:
                     line.set_data(empty, empty)
                 else:
                     line.set_data(t, arr[i])
+        guides = {"certified": None, "moved": None, "fixed": None}
+        for label, values in frame.guides.items():
+            for key in guides:
+                if key in label:
+                    guides[key] = values
+        for line, values in zip(self.lines["guides"], guides.values(), strict=True):
+            line.set_data((t, values) if values is not None else (empty, empty))
         for who in ("uio", "lb"):
             if f"{who}.actual" in self.lines:
                 show = frame.curves.get(f"{who}.input") is not None
@@ -349,24 +424,30 @@ class ExplorerFigure:
         self.lines["poles"][0].set_data(frame.poles.real, frame.poles.imag)
         lp = frame.luenberger_poles
         self.lines["luenberger poles"][0].set_data(lp.real, lp.imag)
-        for who, message in (("uio", frame.observer_message), ("lb", frame.luenberger_message)):
-            note = self.notes[who]
-            note.set_text(textwrap.fill(message, _WRAP))
-            note.set_visible(bool(message))
         self.title.set_text(
             f"{self.scenario.title}: {frame.disturbance}"
             + (f", noise {frame.settings.noise:.3g}" if frame.settings.noise else "")
         )
-        self.footer.set_text(textwrap.fill("; ".join(frame.messages), 150))
+        self.footer.set_text(
+            "\n".join(textwrap.fill(m, self._wrap) for m in frame.all_messages[:3])
+        )
         rows = {name.split(".")[1] for name in self.axes if name.startswith("uio.")}
+        fresh = self._fresh or not self.sticky
         for row in rows:
-            data = [frame.curves.get(f"{who}.{row}") for who in ("uio", "lb")]
-            if row == "input":
-                data.append(frame.d)
-            ax = self.axes[f"uio.{row}"]
-            ax.set_ylim(
-                *_keep_range(ax.get_ylim(), _nice_range(data), self._fresh or not self.sticky)
-            )
+            for who in ("uio", "lb"):
+                ax = self.axes[f"{who}.{row}"]
+                data = [frame.curves.get(f"{who}.{row}")]
+                if row == "error":
+                    # the curves are clipped at limits["error"], which the plant's own signals
+                    # set, not the poles: a range from it stays put while the poles move
+                    top = frame.limits.get("error")
+                    ranged = [np.array([top])] if top else data
+                    ax.set_ylim(*_log_range(ranged, None if fresh else ax.get_ylim()))
+                    continue
+                if row == "input":  # zoomed on the true input: a wild estimate runs off the panel
+                    size = _finite_max(frame.d) or 1.0
+                    data = [np.array([-1.6 * size, 1.6 * size])]
+                ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), fresh))
         sig = self.axes["signals"]
         wanted = _nice_range([frame.d, frame.v])
         sig.set_ylim(*_keep_range(sig.get_ylim(), wanted, self._fresh or not self.sticky))
@@ -427,6 +508,11 @@ class ExplorerFigure:
         1
         """
         canvas = self.fig.canvas
+        size = (canvas, self.fig.dpi, *self.fig.get_size_inches())
+        if size != getattr(self, "_size", None):  # a new canvas, or resized (HiDPI screen)
+            self._size = size
+            self._background = None
+            self._cells = None
         keys = {name: (*ax.get_xlim(), *ax.get_ylim()) for name, ax in self.axes.items()}
         keys["title"] = (self.title.get_text(),)
         keys["footer"] = (self.footer.get_text(),)

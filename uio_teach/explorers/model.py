@@ -36,6 +36,7 @@ from ..plant import Plant
 __all__ = [
     "DISTURBANCES",
     "FAMILIES",
+    "STARTS",
     "Channel",
     "Settings",
     "Scenario",
@@ -48,6 +49,20 @@ DISTURBANCES = ("sinusoid", "piecewise constant", "damped sinusoid", "random ste
 
 FAMILIES = {"uio": "UIO", "pmo": "PMO", "ginverse": "g-inverse observer"}
 """Observer families (argument value: display name)."""
+
+STARTS = {
+    "zero estimate": "the estimate starts at zero, so the first error is the state itself",
+    "zero observer state": "the observer's own state starts at zero",
+}
+"""Where the observers start (control value: what it means).
+
+``"zero estimate"`` (the default) starts both observers at ``xhat(0) = 0``: the
+initial error ``e(0) = x(0)`` then reaches every mode of the error dynamics that
+``x(0)`` reaches, the movable ones included. ``"zero observer state"`` starts the
+observer's state at zero (``z(0) = 0`` or ``q(0) = 0``): its first estimate is
+``xhat(0) = H y(0)`` (``M y(0)``), and the initial error may lie in the fixed
+modes alone, so that moving a pole changes nothing.
+"""
 
 
 # settings --------------------------------------------------------------------------------
@@ -122,6 +137,8 @@ class Settings:
         ``0`` takes the plain numerical derivative.
     seed : int
         Seed of the random steps and of the noise.
+    start : str
+        Where the observers start, one of ``STARTS``.
 
     Examples
     --------
@@ -141,6 +158,7 @@ class Settings:
     noise: float = 0.0
     tau: float = 0.0
     seed: int = 0
+    start: str = "zero estimate"
 
     def replace(self, **changes: Any) -> Settings:
         """A copy with some values changed (:func:`dataclasses.replace`).
@@ -183,7 +201,8 @@ class Scenario:
     timepts : numpy.ndarray
         The simulation grid.
     initial_state : numpy.ndarray
-        The plant's initial state (the observers start at zero).
+        The plant's initial state (where the observers start is a control,
+        ``Settings.start``).
     u : callable or None
         The known input.
     defaults : Settings

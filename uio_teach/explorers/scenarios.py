@@ -92,7 +92,7 @@ def pa9_scenario() -> Scenario:
         decay_limits=None,
         d_channels=(Channel(),),
         v_channels=(),
-        static_values=(0.5, -0.5, -1.0, -2.0, -4.0, -8.0),
+        static_values=(-8.0, -4.0, -2.0, -1.0, -0.5, -0.2, 0.2, 0.5),
         static_control="pole",
     )
 
@@ -145,7 +145,7 @@ def case_study_scenario() -> Scenario:
         decay_limits=(0.3, 1.0),
         d_channels=(Channel(),),
         v_channels=(Channel(gain=0.5, speed=2.0),),
-        static_values=(-0.9, -0.5, 0.0, 0.5, 0.9, 1.05),
+        static_values=(-0.9, -0.5, 0.0, 0.3, 0.5, 0.7, 0.9, 0.97, 1.05),
         static_control="pole",
     )
 
@@ -203,7 +203,7 @@ def missile_scenario() -> Scenario:
             for a, rate, w, kind in MISSILE.v_parameters
         ),
         v_channels=(),
-        static_values=(20.0, -20.0, -50.0, -100.0, -200.0, -400.0),
+        static_values=(-400.0, -200.0, -100.0, -50.0, -20.0, -5.0, 5.0, 20.0),
         static_control="pole",
         input_symbol="v",
     )

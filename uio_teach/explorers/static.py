@@ -60,6 +60,8 @@ class StaticFrame:
         The observer poles and any message of the frame.
     label : str
         The main control's value as shown next to the slider.
+    alt : str
+        The picture's text alternative: what its curves do.
 
     Examples
     --------
@@ -75,6 +77,7 @@ class StaticFrame:
     png: bytes
     caption: str
     label: str
+    alt: str = ""
 
     @property
     def data_url(self) -> str:
@@ -164,11 +167,39 @@ def frame_settings(
 
 def _caption(frame: Frame) -> str:
     name = frame.scenario.observer_name
-    parts = []
+    parts = [f"disturbance: {frame.disturbance}"] if frame.disturbance else []
     if frame.poles.size:
         parts.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     parts += frame.all_messages
-    return " ".join(p[:1].upper() + p[1:] + "." for p in parts)
+    text = " ".join(p[:1].upper() + p[1:] + "." for p in parts)
+    if frame.explanation:
+        text = (text + " " if text else "") + frame.explanation
+    return text
+
+
+def _ends(err: np.ndarray | None) -> tuple[float, float] | None:
+    if err is None or not np.size(err):
+        return None
+    size = np.max(np.abs(err), axis=0)
+    return float(size[0]), float(size[-1])
+
+
+def _alt(frame: Frame, label: str, value: str) -> str:
+    """What the picture shows, in a sentence: how each observer's error ends."""
+    sc = frame.scenario
+    parts = [f"{sc.title} explorer at {label} {value}."]
+    pairs = ((sc.observer_name, frame.response), ("Luenberger observer", frame.luenberger_response))
+    for who, resp in pairs:
+        ends = _ends(None if resp is None else resp.error)
+        if ends is None:
+            parts.append(f"{who}: no curve (no design).")
+            continue
+        a, b = ends
+        verb = "grows" if b > 1.5 * a else "decays" if b < 0.05 * a else "stays about as large"
+        parts.append(f"{who}: the largest error {verb}, from {a:.2g} to {b:.2g}.")
+    if frame.poles.size:
+        parts.append(f"Pole map: {sc.observer_name} poles {format_poles(frame.poles, 3)}.")
+    return " ".join(parts)
 
 
 def static_explorer(
@@ -176,8 +207,8 @@ def static_explorer(
     settings: Settings | None = None,
     *,
     values: Sequence[float] | None = None,
-    disturbances: Sequence[str] = DISTURBANCES,
-    dpi: float = 72,
+    disturbances: Sequence[str] | None = None,
+    dpi: float = 144,
     colors: int = 64,
     element_id: str | None = None,
 ) -> StaticExplorer:
@@ -193,12 +224,14 @@ def static_explorer(
         The values of the main control (``scenario.static_values`` by
         default); the slider starts at the value closest to the settings'
         own.
-    disturbances : sequence of str
-        The disturbance types offered (default: all of
+    disturbances : sequence of str, optional
+        The disturbance types offered (default: the settings' own type and
+        one that contrasts with it, random steps or a sinusoid; any of
         :data:`~uio_teach.explorers.DISTURBANCES`); the select starts at the
         settings' type when it is offered.
     dpi : float
-        Resolution of the pictures (72: about 650 x 350 pixels).
+        Resolution of the pictures (144: about 1300 pixels wide, twice the
+        density at which they are shown).
     colors : int
         Palette size of the PNGs (smaller files).
     element_id : str, optional
@@ -224,7 +257,11 @@ def static_explorer(
     (4, 4)
     """
     base = scenario.defaults if settings is None else settings
-    values = tuple(scenario.static_values if values is None else values)
+    # ascending: the slider moves right toward larger values, as the pole map's real axis
+    values = tuple(sorted(scenario.static_values if values is None else values))
+    if disturbances is None:
+        other = "sinusoid" if base.disturbance == "random steps" else "random steps"
+        disturbances = (base.disturbance, other)
     disturbances = tuple(disturbances)
     if not values or not disturbances:
         raise ValueError("a static explorer needs at least one value and one disturbance type")
@@ -235,7 +272,7 @@ def static_explorer(
     i0 = int(np.argmin([abs(v - current) for v in values]))
     j0 = disturbances.index(base.disturbance) if base.disturbance in disturbances else 0
 
-    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False)
+    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False, fontscale=1.45)
     frames = []
     for j, kind in enumerate(disturbances):
         for i, value in enumerate(values):
@@ -249,6 +286,7 @@ def static_explorer(
                     png=_png(figure, colors),
                     caption=_caption(frame),
                     label=f"{value:g}",
+                    alt=_alt(frame, main_control_label(scenario, base), f"{value:g}"),
                 )
             )
     eid = element_id or f"uio-explorer-{scenario.name}-{next(_IDS)}"
@@ -280,8 +318,8 @@ def static_html(
     settings: Settings | None = None,
     *,
     values: Sequence[float] | None = None,
-    disturbances: Sequence[str] = DISTURBANCES,
-    dpi: float = 72,
+    disturbances: Sequence[str] | None = None,
+    dpi: float = 144,
     colors: int = 64,
     element_id: str | None = None,
 ) -> str:
@@ -295,7 +333,7 @@ def static_html(
         The values of the other controls.
     values : sequence of float, optional
         The values of the main control.
-    disturbances : sequence of str
+    disturbances : sequence of str, optional
         The disturbance types offered.
     dpi : float
         Resolution of the pictures.
@@ -333,6 +371,7 @@ def static_html(
 _JS = (
     "var r=this.parentNode,f=r.querySelector('[data-k=\"'+this.main.value+'-'+this.dist.value"
     "+'\"]');if(f){r.querySelector('img.uio-frame').src=f.getAttribute('data-src');"
+    "r.querySelector('img.uio-frame').alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
     "this.mainval.value=f.getAttribute('data-label');}"
 )
@@ -357,15 +396,16 @@ def _html(
     )
     store = "".join(
         f'<span data-k="{f.index[0]}-{f.index[1]}" data-src="{f.data_url}" '
-        f'data-caption="{esc(f.caption)}" data-label="{esc(f.label)}"></span>'
+        f'data-caption="{esc(f.caption)}" data-alt="{esc(f.alt)}" '
+        f'data-label="{esc(f.label)}"></span>'
         for f in frames
     )
     label = esc(main_control_label(scenario, base))
     handler = esc(_JS, quote=True)
-    alt = esc(f"{scenario.title} explorer: {scenario.observer_name} and Luenberger observer")
+    alt = esc(first.alt)
     hidden_select = "" if len(disturbances) > 1 else ' style="display:none"'
     return (
-        f'<div id="{eid}" class="uio-static-explorer" style="max-width:660px">'
+        f'<div id="{eid}" class="uio-static-explorer" style="max-width:780px">'
         f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}" '
         'style="display:flex;flex-wrap:wrap;gap:0.3em 1.5em;align-items:center;margin:0.3em 0">'
         f'<label>{label}: <input type="range" name="main" min="0" max="{len(values) - 1}" '
@@ -374,9 +414,12 @@ def _html(
         f"<label{hidden_select}>disturbance: "
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
         "</form>"
+        # narrower than 600 px (a phone) the picture keeps 600 px and scrolls sideways
+        '<div style="overflow-x:auto">'
         f'<img class="uio-frame" src="{first.data_url}" alt="{alt}" '
-        'style="width:100%;height:auto">'
-        f'<p class="uio-caption" style="font-size:0.85em;margin:0.2em 0">{esc(first.caption)}</p>'
+        'style="width:100%;min-width:600px;height:auto"></div>'
+        '<p class="uio-caption" aria-live="polite" style="font-size:0.85em;margin:0.2em 0">'
+        f"{esc(first.caption)}</p>"
         '<p style="font-size:0.8em;opacity:0.75;margin:0.2em 0">Pre-computed pictures: move the '
         "slider or pick a disturbance. Open this page as a notebook with a Python kernel for "
         "the live explorer, where every control can be set.</p>"

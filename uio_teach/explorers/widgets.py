@@ -46,12 +46,25 @@ import numpy as np
 
 from .._display import format_poles
 from ..plant import Plant
+from ._drag import DragPoles, _in_kernel, drag_available
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
-from .model import DISTURBANCES, Scenario, Settings
+from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
 
-__all__ = ["Explorer", "pa9_explorer", "case_study_explorer", "missile_explorer", "explorer"]
+__all__ = [
+    "Explorer",
+    "pa9_explorer",
+    "case_study_explorer",
+    "missile_explorer",
+    "explorer",
+    "drag_available",
+]
+
+# The explorer on display for each scenario name: re-running a cell closes the previous one,
+# so its figure and widgets are freed instead of piling up.
+_LIVE: dict[str, Explorer] = {}
+
 
 _STYLE = {"description_width": "120px"}
 _WIDTH = "330px"
@@ -91,7 +104,7 @@ class _Slot:
         self.controls = controls
 
 
-class Explorer:
+class Explorer(DragPoles):
     """A live explorer: controls, the figure and messages, wired to :func:`compute_frame`.
 
     Build one with :func:`pa9_explorer`, :func:`case_study_explorer`,
@@ -111,6 +124,11 @@ class Explorer:
     static : bool
         Include the static frames in the display (needed for the static
         book; ``False`` displays faster in a live notebook).
+    drag : bool, optional
+        Show the figure as an ipympl canvas on which the movable poles can be
+        dragged on the pole map (besides the sliders). By default in a Jupyter
+        kernel with ipympl installed; otherwise the figure is a picture and the
+        sliders work alone.
 
     Attributes
     ----------
@@ -121,7 +139,8 @@ class Explorer:
         pair, ``"pole 2 real part"`` and ``"pole 2 frequency"``, in discrete
         time ``"pole 2 radius"`` and ``"pole 2 angle"``), ``"pattern"`` (how
         many complex pairs), ``"mode"`` and ``"decay"`` (LMI), ``"disturbance"``,
-        ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``.
+        ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``,
+        ``"start"`` (where the observers start, ``uio_teach.explorers.STARTS``).
     figure : ExplorerFigure
         The figure, updated in place.
     frame : Frame
@@ -141,8 +160,9 @@ class Explorer:
     >>> print(ex.frame.observer_message)
     this pole makes the PMO unstable: the error grows (pole 1.05 outside the unit circle)
     >>> ex.set(mode="lmi", decay=0.4)
-    >>> "infeasible" in ex.frame.observer_message
-    True
+    >>> print(ex.frame.observer_message)   # doctest: +NORMALIZE_WHITESPACE
+    no gain meets the bound radius 0.4: the fixed poles (invariant zeros, radius 0.5)
+    cannot move; choose a bound beyond them
     """
 
     def __init__(
@@ -152,7 +172,12 @@ class Explorer:
         *,
         dpi: float = 90,
         static: bool = True,
+        drag: bool | None = None,
     ) -> None:
+        old = _LIVE.pop(scenario.name, None)
+        if old is not None:
+            old.close()
+        _LIVE[scenario.name] = self
         self.scenario = scenario
         self._base = scenario.defaults if settings is None else settings
         self._static = static
@@ -164,6 +189,18 @@ class Explorer:
         self.frame: Frame | None = None
         self.image = W.Image(format="png", layout=W.Layout(width="100%", max_width="900px"))
         self.message = W.HTML()
+        self.canvas: Any = None
+        self._dragging: tuple[int, str] | None = None
+        if drag is None:
+            drag = _in_kernel() and drag_available() and scenario.movable > 0
+        if drag:
+            self.canvas = self._make_canvas()
+        fig = self.figure.fig
+        self._connections = [
+            fig.canvas.mpl_connect("button_press_event", self.on_press),
+            fig.canvas.mpl_connect("motion_notify_event", self.on_motion),
+            fig.canvas.mpl_connect("button_release_event", self.on_release),
+        ]
         self._build_controls()
         self.update()
 
@@ -225,6 +262,14 @@ class Explorer:
                                  base.frequency)  # fmt: skip
         c["period"] = _slider(f"switching ({unit})", *sc.period_limits, base.period)
         dist += [c["disturbance"], c["amplitude"], c["frequency"], c["period"]]
+        c["start"] = W.Dropdown(
+            options=[(k, k) for k in STARTS],
+            value=base.start if base.start in STARTS else "zero estimate",
+            description="observer start",
+            style=_STYLE,
+            layout=W.Layout(width=_WIDTH),
+        )
+        observer.append(c["start"])
         meas = [W.HTML("<b>Measurement</b>")]
         c["noise"] = _slider("noise (std)", *sc.noise_limits, base.noise, 100)
         meas.append(c["noise"])
@@ -238,7 +283,8 @@ class Explorer:
         self._show_relevant()
         boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in (observer, dist, meas)]
         controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
-        self.widget = W.VBox([controls, self.image, self.message])
+        view = self.canvas if self.canvas is not None else self.image
+        self.widget = W.VBox([controls, view, self.message])
 
     @staticmethod
     def _pattern_label(k: int, pairs: int) -> str:
@@ -346,6 +392,7 @@ class Explorer:
             "frequency": float(c["frequency"].value),
             "period": float(c["period"].value),
             "noise": float(c["noise"].value),
+            "start": c["start"].value,
         }
         if "mode" in c:
             changes["mode"] = c["mode"].value
@@ -417,7 +464,7 @@ class Explorer:
         Examples
         --------
         >>> from uio_teach.explorers import widgets
-        >>> ex = widgets.pa9_explorer(static=False)
+        >>> ex = widgets.pa9_explorer(static=False, drag=False)
         >>> ex.update()
         >>> bytes(ex.image.value[:4])
         b'\\x89PNG'
@@ -426,7 +473,11 @@ class Explorer:
         try:
             frame = compute_frame(self.scenario, self.settings)
             self.figure.update(frame)
-            self.image.value = self.figure.to_png(colors=128)
+            if self.canvas is not None:
+                self.figure.draw()
+                self.canvas.blit()  # sends the changed pixels to the page
+            else:
+                self.image.value = self.figure.to_png(colors=128, compress_level=1)
         except Exception as exc:  # pragma: no cover - compute_frame already turns errors into text
             self.message.value = (
                 f'<span style="color:#c0392b">could not update the picture: '
@@ -435,6 +486,33 @@ class Explorer:
             return
         self.frame = frame
         self.message.value = _message_html(frame)
+
+    def close(self) -> None:
+        """Close the figure's canvas and the widgets (frees their memory at once).
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import widgets
+        >>> ex = widgets.pa9_explorer(static=False, drag=False)
+        >>> ex.close()
+        """
+        if _LIVE.get(self.scenario.name) is self:
+            del _LIVE[self.scenario.name]
+        for cid in self._connections:
+            self.figure.fig.canvas.mpl_disconnect(cid)
+        for slot in self._slots:
+            for control in slot.controls.values():
+                control.unobserve_all()
+        for control in self.controls.values():
+            control.unobserve_all()
+        if self.canvas is not None:
+            _close_tree(self.canvas)
+        _close_tree(self.widget)
+        for control in list(self.controls.values()):
+            _close_tree(control)
+        _close_tree(self.image)
+        _close_tree(self.message)
+        self.figure._background = None  # the largest buffer: free it even if self is kept
 
     # display ------------------------------------------------------------------------------
     def static_html(self) -> str:
@@ -448,8 +526,8 @@ class Explorer:
         --------
         >>> from uio_teach.explorers import widgets
         >>> ex = widgets.case_study_explorer(static=False)
-        >>> ex.static_html().count('data-k="')
-        24
+        >>> ex.static_html().count('data-k="')     # 9 pole positions, 2 disturbance types
+        18
         """
         if self._static_html is None:
             from .static import static_html
@@ -471,9 +549,20 @@ class Explorer:
         return f"<Explorer {self.scenario.title!r}: {self.scenario.observer_name}>"
 
 
+def _close_tree(widget: Any) -> None:
+    """Close a widget, its children, its layout and its style (they are widgets too)."""
+    for child in getattr(widget, "children", ()) or ():
+        _close_tree(child)
+    for name in ("layout", "style"):
+        sub = getattr(widget, name, None)
+        if isinstance(sub, W.Widget):
+            sub.close()
+    widget.close()
+
+
 def _message_html(frame: Frame) -> str:
     name = html.escape(frame.scenario.observer_name)
-    lines = []
+    lines = [frame.explanation] if frame.explanation else []
     if frame.poles.size:
         lines.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     if frame.luenberger_poles.size:
@@ -485,7 +574,7 @@ def _message_html(frame: Frame) -> str:
     return f'<div style="font-size:0.9em">{text}</div>'
 
 
-def pa9_explorer(*, static: bool = True) -> Explorer:
+def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     """Explore the PA9 decoupling UIO against a Luenberger observer.
 
     Three movable poles (real, or one complex pair and a real pole), the
@@ -496,6 +585,9 @@ def pa9_explorer(*, static: bool = True) -> Explorer:
     ----------
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -509,10 +601,10 @@ def pa9_explorer(*, static: bool = True) -> Explorer:
     >>> sorted(n for n in ex.controls if n.startswith("pole"))
     ['pole 1', 'pole 2 frequency', 'pole 2 real part']
     """
-    return Explorer(pa9_scenario(), static=static)
+    return Explorer(pa9_scenario(), static=static, drag=drag)
 
 
-def case_study_explorer(*, static: bool = True) -> Explorer:
+def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     """Explore the discrete case study: one movable pole, or the LMI's radius bound.
 
     The two fixed poles at 0.5 are the invariant zeros; in ``"LMI bound"``
@@ -523,6 +615,9 @@ def case_study_explorer(*, static: bool = True) -> Explorer:
     ----------
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -536,10 +631,12 @@ def case_study_explorer(*, static: bool = True) -> Explorer:
     >>> bool(abs(ex.frame.poles).max() <= 0.8 + 1e-6)
     True
     """
-    return Explorer(case_study_scenario(), static=static)
+    return Explorer(case_study_scenario(), static=static, drag=drag)
 
 
-def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Explorer:
+def missile_explorer(
+    *, observer_family: str = "pmo", static: bool = True, drag: bool | None = None
+) -> Explorer:
     """Explore the missile autopilot: the observer, its residual and the reconstructed inputs.
 
     Two movable poles of the projection-operator observer (the other two
@@ -554,6 +651,9 @@ def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Ex
         poles are fixed: the main control is then the amplitude).
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -584,7 +684,7 @@ def missile_explorer(*, observer_family: str = "pmo", static: bool = True) -> Ex
             static_values=(0.0, 5.0, 10.0, 20.0, 40.0),
             _cache={},
         )
-    return Explorer(scenario, static=static)
+    return Explorer(scenario, static=static, drag=drag)
 
 
 def explorer(
@@ -597,6 +697,7 @@ def explorer(
     u: Any = None,
     reconstruct: bool = False,
     static: bool = True,
+    drag: bool | None = None,
 ) -> Explorer:
     """Explore your own plant: an unknown input observer against a Luenberger observer.
 
@@ -623,6 +724,9 @@ def explorer(
         Also reconstruct the unknown input (``E`` of full column rank).
     static : bool
         Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl); by default when
+        ipympl is installed.
 
     Returns
     -------
@@ -653,4 +757,4 @@ def explorer(
         reconstruct=reconstruct,
         name=(plant.name or "plant").replace(" ", "-"),
     )
-    return Explorer(scenario, static=static)
+    return Explorer(scenario, static=static, drag=drag)
