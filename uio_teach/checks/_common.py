@@ -352,16 +352,18 @@ def _read_matrix(
     return arr
 
 
-def _get_plant(result: CheckResult, plant: Any):
+def _get_plant(result: CheckResult, plant: Any, example: str = "pa9"):
+    """The plant a check works on: ``plant``, or the lab's example (``ut.examples.<example>()``)
+    when it is None; anything else is a ✗ that says what was expected."""
     from .. import examples
     from ..plant import Plant
 
     if plant is None:
-        return examples.pa9()
+        return getattr(examples, example)()
     if not isinstance(plant, Plant):
         result.add(
             False,
-            f"plant must be a uio_teach.Plant (e.g. ut.examples.pa9()), got "
+            f"plant must be a uio_teach.Plant (e.g. ut.examples.{example}()), got "
             f"{type(plant).__name__}.",
         )
         return None

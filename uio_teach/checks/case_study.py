@@ -29,7 +29,15 @@ from typing import Any
 import numpy as np
 
 from .._display import format_matrix_line, format_poles
-from ._common import CheckResult, _close, _never_raises, _numbers, _read_matrix, _up_to
+from ._common import (
+    CheckResult,
+    _close,
+    _get_plant,
+    _never_raises,
+    _numbers,
+    _read_matrix,
+    _up_to,
+)
 
 __all__ = [
     "case_study_projection",
@@ -38,18 +46,6 @@ __all__ = [
     "case_study_simulation",
     "case_study_residual",
 ]
-
-
-def _plant(result: CheckResult, plant: Any):
-    from .. import examples
-    from ..plant import Plant
-
-    if plant is None:
-        return examples.dt_case_study()
-    if not isinstance(plant, Plant):
-        result.add(False, f"plant must be a uio_teach.Plant, got {type(plant).__name__}.")
-        return None
-    return plant
 
 
 def _M_ref(plant) -> np.ndarray:
@@ -90,7 +86,7 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     True
     """
     result = CheckResult("Case study: the projection matrix M")
-    plant = _plant(result, plant)
+    plant = _get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p
@@ -190,7 +186,7 @@ def case_study_lmi(L: Any, P: Any = None, plant: Any = None, *, tol: float = 1e-
     True
     """
     result = CheckResult("Case study: the gain L from the LMI")
-    plant = _plant(result, plant)
+    plant = _get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p
@@ -267,7 +263,7 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
     True
     """
     result = CheckResult("Case study: moving the movable pole")
-    plant = _plant(result, plant)
+    plant = _get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from .._display import format_matrix_line, format_poles
-from ._common import CheckResult, _close, _never_raises, _read_matrix, _up_to
+from ._common import CheckResult, _close, _get_plant, _never_raises, _read_matrix, _up_to
 from .design import _same_poles
 
 __all__ = [
@@ -44,18 +44,6 @@ __all__ = [
 ]
 
 NAMES = ("x1", "x2", "x3", "x4", "v1", "v2")
-
-
-def _plant(result: CheckResult, plant: Any):
-    from .. import examples
-    from ..plant import Plant
-
-    if plant is None:
-        return examples.missile_autopilot()
-    if not isinstance(plant, Plant):
-        result.add(False, f"plant must be a uio_teach.Plant, got {type(plant).__name__}.")
-        return None
-    return plant
 
 
 def _fixed_poles(plant) -> np.ndarray:
@@ -99,7 +87,7 @@ def missile_pmo(
     True
     """
     result = CheckResult("Missile: the projection-operator observer")
-    plant = _plant(result, plant)
+    plant = _get_plant(result, plant, "missile_autopilot")
     if plant is None:
         return result
     n, p = plant.n, plant.p
@@ -191,7 +179,7 @@ def missile_ginverse(
     False
     """
     result = CheckResult("Missile: the generalized-inverse observer")
-    plant = _plant(result, plant)
+    plant = _get_plant(result, plant, "missile_autopilot")
     if plant is None:
         return result
     n, p = plant.n, plant.p
