@@ -344,6 +344,61 @@ def test_display_equations_fit_at_1280px(page: str, book_server: str, browser) -
     assert not too_wide, "display equations wider than their column:\n" + "\n".join(too_wide)
 
 
+# --- every visible line of code visible at 1280 px -----------------------------------------------
+
+# The code cells the reader sees (not those in a collapsed toggle): the lines whose text is wider
+# than the block's box, measured with a range over each line (the block scrolls sideways instead).
+_WIDE_CODE_JS = """
+() => {
+  const wide = [];
+  document.querySelectorAll("main div.cell_input pre").forEach((pre, i) => {
+    if (!pre.checkVisibility() || pre.closest(".tag_hide-input, .tag_hide-cell")) return;
+    const style = getComputedStyle(pre);
+    const inner = pre.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+    const lines = pre.textContent.split("\\n");
+    const probe = document.createElement("span");
+    probe.style.font = style.font;
+    probe.style.whiteSpace = "pre";
+    probe.style.position = "absolute";
+    probe.style.visibility = "hidden";
+    document.body.appendChild(probe);
+    lines.forEach((line) => {
+      probe.textContent = line;
+      const width = probe.getBoundingClientRect().width;
+      if (width > inner + 0.5) {
+        wide.push({cell: i + 1, width: Math.round(width), box: Math.round(inner),
+                   text: line.trim().slice(0, 60)});
+      }
+    });
+    probe.remove();
+  });
+  return wide;
+}
+"""
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_visible_code_lines_fit_at_1280px(page: str, book_server: str, browser) -> None:
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    tab = context.new_page()
+    host = urlsplit(book_server).hostname
+    tab.route(
+        "**/*",
+        lambda route: (
+            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
+        ),
+    )
+    try:
+        tab.goto(f"{book_server}/{page}.html", wait_until="load")
+        wide = tab.evaluate(_WIDE_CODE_JS)
+    finally:
+        context.close()
+    assert not wide, f"{page}: code lines wider than their column at 1280 px:\n" + "\n".join(
+        f"code cell {w['cell']}: {w['width']} px in {w['box']} px: {w['text']!r}" for w in wide
+    )
+
+
 @pytest.mark.browser
 @pytest.mark.parametrize("page", PAGES)
 def test_long_equations_scroll_on_a_phone(page: str, book_server: str, browser) -> None:

@@ -107,6 +107,50 @@ def test_hidden_checks_still_run() -> None:
         assert not skipped, f"{chapter.name}: checks that never run: {skipped}"
 
 
+# At 1280 px a code cell of the text column is 652 px wide inside its padding, and 630 px inside
+# an exercise or a solution dropdown; the code font (14 px monospace, 8.43 px a character in
+# Chromium with DejaVu Sans Mono) fits 77 and 74 characters. A longer line of a cell the reader
+# sees scrolls sideways, its end hidden. tests/test_book.py measures the built pages in a browser;
+# this is the same rule on the sources, without a build, at the narrower width.
+MAX_CODE_LINE = 74
+
+
+def wide_code_lines(chapter: Path, limit: int = MAX_CODE_LINE) -> list[str]:
+    """Lines longer than ``limit`` in the code cells of ``chapter`` that the page shows."""
+    notebook = read_myst_markdown_notebook(chapter.read_text(encoding="utf-8"), path=chapter)
+    found = []
+    for number, cell in enumerate(notebook.cells, start=1):
+        if cell.cell_type != "code" or HIDDEN_TAGS & set(cell.metadata.get("tags", [])):
+            continue
+        found += [
+            f"{chapter.name}, cell {number}: {len(line)} characters: {line.strip()[:60]}"
+            for line in cell.source.splitlines()
+            if len(line) > limit
+        ]
+    return found
+
+
+def test_wide_code_lines_are_found(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    long = "x = " + "1 + " * 30 + "1"
+    page.write_text(
+        "---\nkernelspec:\n  name: python3\n  display_name: Python 3\n---\n# Page\n\n"
+        f"```{{code-cell}} ipython3\n{long}\n```\n\n"
+        f"```{{code-cell}} ipython3\n:tags: [remove-input]\n{long}\n```\n",
+        encoding="utf-8",
+    )
+    assert len(long) > MAX_CODE_LINE
+    assert len(wide_code_lines(page)) == 1  # the hidden cell does not count
+
+
+def test_visible_code_fits_the_column() -> None:
+    wide = [line for chapter in CHAPTERS for line in wide_code_lines(chapter)]
+    assert not wide, (
+        f"{len(wide)} visible code lines longer than {MAX_CODE_LINE} characters (they scroll "
+        "sideways at 1280 px); wrap them:\n" + "\n".join(wide)
+    )
+
+
 # --- every chapter opens with its goals and closes with a summary and exercises -----------------
 
 

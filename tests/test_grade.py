@@ -19,7 +19,7 @@ import pytest
 
 from uio_teach import checks
 from uio_teach.checks import CheckResult
-from uio_teach.instructor import cli, grade
+from uio_teach.instructor import cli, grade, output
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
@@ -86,7 +86,7 @@ def test_the_solution_passes_and_the_untouched_student_notebook_fails(
     assert sol["lab"] == stu["lab"] == "pa9"
     assert all(sol[i] == grade.PASS for i in ids) and sol["total"] == sol["out_of"] == str(len(ids))
     assert all(stu[i] == grade.FAIL for i in ids) and stu["total"] == "0"
-    feedback = sorted((tmp_path / "grades_feedback").iterdir())
+    feedback = sorted((tmp_path / "grades_feedback").glob("*.txt"))
     assert len(feedback) == 2
     texts = {p.name: p.read_text(encoding="utf-8") for p in feedback}
     (text,) = [t for t in texts.values() if f"Submission: {student}" in t]
@@ -191,7 +191,8 @@ def test_every_submission_gets_a_row_and_none_is_touched(graded):
     header = list(next(iter(graded["rows"].values())))
     assert header == ["file", "lab", "group", "status", "demo.value", "total", "out_of"]
     feedback = graded["out"].parent / "grades_feedback"
-    assert len(list(feedback.iterdir())) == len(graded["subs"])
+    assert len(list(feedback.glob("*.txt"))) == len(graded["subs"])
+    assert sorted(p.name for p in feedback.iterdir() if p.suffix != ".txt") == ["manifest.json"]
     print(f"\n{len(graded['subs'])} small notebooks graded in {graded['seconds']:.1f} s")
 
 
@@ -264,3 +265,100 @@ def test_grade_usage_errors(tmp_path, capsys):
     assert not Path("g.csv").exists()
     assert cli.main(["grade", "--help"]) == 0
     assert "RUNS THE STUDENTS' CODE" in capsys.readouterr().out
+
+
+# the gradebook and its feedback folder are replaced together --------------------------------------
+
+
+def snapshot(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` (hidden ones too) -> its SHA-256."""
+    return {p.relative_to(folder).as_posix(): sha(p) for p in folder.rglob("*") if p.is_file()}
+
+
+def handed_in(folder: Path, *names: str) -> list[str]:
+    """Files that are not notebooks: graded "unreadable" at once, without a kernel."""
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = [folder / f"{name}.ipynb" for name in names]
+    for path in paths:
+        path.write_text(f"{path.stem}: not a notebook")
+    return [str(path) for path in paths]
+
+
+def test_a_second_grading_leaves_only_its_own_feedback(tmp_path, capsys):
+    out = tmp_path / "marks" / "grades.csv"
+    first = handed_in(tmp_path / "first", "demo_g01", "demo_g02")
+    second = handed_in(tmp_path / "second", "demo_g03")
+    assert cli.main(["grade", *first, "--out", str(out), "-q"]) == 0
+    feedback = out.parent / "grades_feedback"
+    assert sorted(p.name for p in feedback.glob("*.txt")) == ["demo_g01.txt", "demo_g02.txt"]
+    assert cli.main(["grade", *second, "--out", str(out), "-q"]) == 0, capsys.readouterr().err
+    assert [r["group"] for r in rows(out)] == ["g03"]
+    assert sorted(p.name for p in feedback.iterdir()) == ["demo_g03.txt", "manifest.json"]
+    assert f"Submission: {second[0]}" in (feedback / "demo_g03.txt").read_text(encoding="utf-8")
+    manifest = output.read_manifest(feedback)
+    assert manifest is not None and manifest["command"] == "uio-teach grade"
+    assert manifest["config"] == {"gradebook": "grades.csv", "gradebook_sha256": sha(out)}
+    assert [f["name"] for f in manifest["files"]] == ["demo_g03.txt"]
+    assert sorted(p.name for p in out.parent.iterdir()) == ["grades.csv", "grades_feedback"]
+
+
+@pytest.mark.parametrize("where", ["writing a feedback text", "swapping the folder in"])
+def test_a_failed_grading_leaves_the_previous_gradebook_and_feedback(tmp_path, monkeypatch, where):
+    out = tmp_path / "marks" / "grades.csv"
+    grade.grade(handed_in(tmp_path / "first", "demo_g01", "demo_g02"), out)
+    before = snapshot(out.parent)
+    assert "grades_feedback/demo_g02.txt" in before
+
+    def fail(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    if where == "writing a feedback text":
+        monkeypatch.setattr(grade.Submission, "feedback", fail)
+    else:  # the CSV is already in place when the folder cannot be: it is put back
+        monkeypatch.setattr(output.StagedFolder, "commit", fail)
+    with pytest.raises(OSError, match="No space left"):
+        grade.grade(handed_in(tmp_path / "second", "demo_g03"), out)
+    assert snapshot(out.parent) == before
+
+
+def test_a_failed_first_grading_writes_nothing(tmp_path, monkeypatch):
+    out = tmp_path / "grades.csv"
+    monkeypatch.setattr(output.StagedFolder, "commit", lambda self: 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        grade.grade(handed_in(tmp_path / "in", "demo_g01"), out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+
+
+@pytest.mark.parametrize("content", ["someone's notes", "figures"])
+def test_a_folder_that_is_not_earlier_feedback_is_left_alone(
+    tmp_path, monkeypatch, capsys, content
+):
+    out = tmp_path / "grades.csv"
+    folder = tmp_path / "grades_feedback"
+    folder.mkdir()
+    if content == "figures":  # an output of uio-teach, but not of grading
+        (folder / "a.png").write_bytes(b"png")
+        output.write_manifest(folder, command="uio-teach figures", config={})
+    else:
+        (folder / "notes.txt").write_text("mine")
+    before = snapshot(folder)
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a notebook ran although the gradebook cannot be written")
+
+    monkeypatch.setattr(grade, "_grade_one", must_not_run)
+    code = cli.main(["grade", *handed_in(tmp_path / "in", "demo_g01"), "--out", str(out), "-q"])
+    err = capsys.readouterr().err
+    assert code == 1 and "left alone" in err and str(folder) in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists() and snapshot(folder) == before
+    with pytest.raises(output.OutputError, match="left alone"):
+        grade.write_gradebook([grade.Submission("a.ipynb", "demo", "g01", "ok")], out)
+    assert not out.exists() and snapshot(folder) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grades_feedback", "in"]
+
+
+def test_a_gradebook_that_is_a_folder_is_refused(tmp_path):
+    (tmp_path / "grades.csv").mkdir()
+    with pytest.raises(output.OutputError, match="is a folder"):
+        grade.grade(handed_in(tmp_path / "in", "demo_g01"), tmp_path / "grades.csv")

@@ -47,6 +47,7 @@ import csv
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -78,6 +79,7 @@ END = "<<<uio-teach grade: end>>>"
 PASS, FAIL = "✓", "✗"
 _GROUP_NAME = re.compile(r"^(?P<lab>.+?)_(?P<group>g\d+)$")
 _TAG = "uio-teach-grade"
+_COMMAND = "uio-teach grade"
 
 
 class GradeError(ValueError):
@@ -504,6 +506,77 @@ def _grade_one(
     return sub
 
 
+def _feedback_folder(out: str | os.PathLike[str]) -> Path:
+    """The feedback folder that goes with the gradebook ``out``: ``<out stem>_feedback``.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The gradebook CSV.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.grade import _feedback_folder
+    >>> _feedback_folder("marks/grades.csv").as_posix()
+    'marks/grades_feedback'
+    """
+    out = Path(out)
+    return out.with_name(f"{out.stem}_feedback")
+
+
+def _check_gradebook_target(out: str | os.PathLike[str]) -> None:
+    """Raise :class:`~uio_teach.instructor.output.OutputError` unless ``out`` may be (re)written.
+
+    The gradebook must not be a folder, and its feedback folder must not exist,
+    be empty, or be the feedback folder of an earlier run (it has the
+    ``manifest.json`` that run wrote). A folder of that name holding anything
+    else is never replaced.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The gradebook CSV.
+
+    Raises
+    ------
+    uio_teach.instructor.output.OutputError
+        One line naming the file or folder and why.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.grade import _check_gradebook_target
+    >>> from uio_teach.instructor.output import OutputError
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     mine = pathlib.Path(tmp) / "grades_feedback"
+    ...     mine.mkdir()
+    ...     _ = (mine / "notes.txt").write_text("mine")
+    ...     try:
+    ...         _check_gradebook_target(pathlib.Path(tmp) / "grades.csv")
+    ...     except OutputError as err:
+    ...         print("left alone" in str(err))
+    True
+    """
+    from .output import MANIFEST, OutputError, check_output_folder, read_manifest
+
+    out = Path(out)
+    if out.is_dir():
+        raise OutputError(f"the gradebook {os.fspath(out)} is a folder, not a file")
+    folder = _feedback_folder(out)
+    check_output_folder(folder)
+    manifest = read_manifest(folder) if folder.is_dir() else None
+    if manifest is not None and manifest.get("command") != _COMMAND:
+        raise OutputError(
+            f"the feedback folder {os.fspath(folder)} holds the output of "
+            f"{manifest.get('command') or 'another command'} (its {MANIFEST}), not feedback "
+            "of an earlier grading; it is left alone: choose another gradebook name"
+        )
+
+
 def write_gradebook(
     submissions: Sequence[Submission], out: str | os.PathLike[str]
 ) -> tuple[Path, Path]:
@@ -511,7 +584,16 @@ def write_gradebook(
 
     Columns: ``file``, ``lab``, ``group``, ``status``, one per check id (✓ or
     ✗; empty for a check of another lab), ``total`` (checks passed) and
-    ``out_of``. The CSV is written to a temporary file first and moved in place.
+    ``out_of``.
+
+    The CSV and its feedback folder are replaced together: both are written
+    beside their targets first, and only once everything is written are they
+    moved in place, the folder whole, so no feedback text of an earlier run is
+    left next to this run's gradebook. If writing fails, the previous CSV and
+    folder stay exactly as they were. The folder holds a ``manifest.json``
+    (the gradebook's name and SHA-256, every feedback file with its SHA-256);
+    a folder of that name without one is not an earlier feedback folder, and
+    it is left alone.
 
     Parameters
     ----------
@@ -525,6 +607,12 @@ def write_gradebook(
     (pathlib.Path, pathlib.Path)
         The CSV and the feedback folder.
 
+    Raises
+    ------
+    uio_teach.instructor.output.OutputError
+        ``out`` is a folder, or its feedback folder exists and is not one of an
+        earlier run; nothing is written.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -535,35 +623,79 @@ def write_gradebook(
     ...     print(csv_path.read_text(encoding="utf-8").splitlines()[1])
     ...     print(sorted(p.name for p in folder.iterdir()))
     a.ipynb,pa9,g01,ok,✗,0,1
-    ['a.txt']
+    ['a.txt', 'manifest.json']
     """
+    from .output import StagedFolder, sha256_file, write_manifest
+
     out = Path(out)
+    folder = _feedback_folder(out)
+    _check_gradebook_target(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     columns: list[str] = []
     for sub in submissions:
         columns += [c for c in sub.verdicts() if c not in columns]
-    tmp_csv = out.with_name(f".{out.name}.new")
-    with open(tmp_csv, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(["file", "lab", "group", "status", *columns, "total", "out_of"])
+    with StagedFolder(folder, "feedback") as stage:
+        assert stage.path is not None
+        names: list[str] = []
         for sub in submissions:
-            verdicts = sub.verdicts()
-            marks = ["" if c not in verdicts else (PASS if verdicts[c] else FAIL) for c in columns]
-            row = [sub.file, sub.lab, sub.group, sub.status, *marks, sub.total, len(verdicts)]
-            writer.writerow(row)
-    os.replace(tmp_csv, out)
-    folder = out.with_name(f"{out.stem}_feedback")
-    folder.mkdir(exist_ok=True)
-    used: set[str] = set()
-    for sub in submissions:
-        path = Path(sub.file)
-        candidates = [path.stem, f"{path.parent.name}_{path.stem}"]
-        candidates += [f"{path.stem}-{n}" for n in range(2, len(submissions) + 2)]
-        name = next(f"{c}.txt" for c in candidates if f"{c}.txt" not in used)
-        used.add(name)
+            path = Path(sub.file)
+            candidates = [path.stem, f"{path.parent.name}_{path.stem}"]
+            candidates += [f"{path.stem}-{n}" for n in range(2, len(submissions) + 2)]
+            name = next(f"{c}.txt" for c in candidates if f"{c}.txt" not in names)
+            names.append(name)
+            (stage.path / name).write_text(sub.feedback(), encoding="utf-8")
+        new_csv = stage.path.parent / f".{out.name}.new"
+        try:
+            with open(new_csv, "w", newline="", encoding="utf-8") as fh:
+                writer = csv.writer(fh)
+                writer.writerow(["file", "lab", "group", "status", *columns, "total", "out_of"])
+                for sub in submissions:
+                    verdicts = sub.verdicts()
+                    marks = [
+                        "" if c not in verdicts else (PASS if verdicts[c] else FAIL)
+                        for c in columns
+                    ]
+                    writer.writerow(
+                        [sub.file, sub.lab, sub.group, sub.status, *marks, sub.total, len(verdicts)]
+                    )
+            write_manifest(
+                stage.path,
+                command=_COMMAND,
+                config={"gradebook": out.name, "gradebook_sha256": sha256_file(new_csv)},
+                options={"submissions": [sub.file for sub in submissions]},
+            )
+            _swap_in(new_csv, out, stage)
+        finally:
+            new_csv.unlink(missing_ok=True)
+    for sub, name in zip(submissions, names, strict=True):
         sub.feedback_file = folder / name
-        sub.feedback_file.write_text(sub.feedback(), encoding="utf-8")
     return out, folder
+
+
+def _swap_in(new_csv: Path, out: Path, stage: Any) -> None:
+    """Move the new CSV to ``out`` and commit ``stage``; on failure, put the old CSV back."""
+    backup = None
+    if out.exists():
+        backup = new_csv.with_name(f".{out.name}.old")
+        backup.unlink(missing_ok=True)
+        try:
+            os.link(out, backup)
+        except OSError:  # no hard links on this file system: a copy
+            shutil.copy2(out, backup)
+    try:
+        os.replace(new_csv, out)
+        try:
+            stage.commit()
+        except BaseException:
+            if backup is not None:
+                os.replace(backup, out)
+                backup = None
+            else:
+                out.unlink(missing_ok=True)
+            raise
+    finally:
+        if backup is not None:
+            backup.unlink(missing_ok=True)
 
 
 def grade(
@@ -582,7 +714,8 @@ def grade(
     submissions : sequence of path
         The notebooks handed in. They are only read.
     out : path
-        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it.
+        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it. Both
+        replace those of an earlier grading together (see :func:`write_gradebook`).
     answer_key : path, optional
         ``answer_key.csv`` of ``uio-teach labs --groups``: each notebook then
         runs with its group's parameters, whatever its parameters cell says.
@@ -603,6 +736,9 @@ def grade(
     ------
     GradeError
         The answer key cannot be read, or a time limit is not positive.
+    uio_teach.instructor.output.OutputError
+        ``out`` is a folder, or its feedback folder exists and is not one of
+        an earlier grading (checked before any notebook runs).
 
     Examples
     --------
@@ -617,6 +753,7 @@ def grade(
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
             raise GradeError(f"{name}: must be > 0 s, got {value!r}")
     key = read_answer_key(answer_key) if answer_key is not None else None
+    _check_gradebook_target(out)  # before the notebooks run, not after
     registry = _registry()
     graded: list[Submission] = []
     paths = [Path(p) for p in submissions]
