@@ -175,7 +175,7 @@ def graded(tmp_path_factory) -> dict:
     before = {name: sha(path) for name, path in subs.items()}
     out = folder / "out" / "grades.csv"
     start = time.perf_counter()
-    results = grade.grade(list(subs.values()), out, answer_key=key, timeout=120, cell_timeout=5)
+    results = grade.grade(list(subs.values()), out, answer_key=key, timeout=120, cell_timeout=15)
     return {
         "subs": subs,
         "before": before,
