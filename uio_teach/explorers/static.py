@@ -9,6 +9,13 @@ slider, a ``<select>`` for the disturbance type and one inline ``oninput``
 handler that swaps the displayed picture. No external script, stylesheet or
 URL is involved, so the page works offline and from ``file://``.
 
+The layout reflows with the screen (a few CSS rules in the HTML itself): on a
+wide screen the controls share a row above a picture at most 780 px wide; on a
+phone each control takes a row of its own and the picture shrinks to the
+column, keeping its aspect ratio, so the page never scrolls sideways. There,
+"enlarge the picture" (or a tap on the picture) shows it at the size its text
+is drawn for, scrolling sideways inside its own box.
+
 Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 :class:`uio_teach.explorers.ExplorerFigure`, exactly as in the live explorer.
 
