@@ -1,5 +1,7 @@
 """The static explorers in a browser: every position of the slider and the menu shows another
-picture, caption and text alternative; the pictures are HiDPI; each explorer page stays small.
+picture, caption and text alternative; the pictures are HiDPI; each explorer page stays small; on
+a 390 px phone the explorer fits the column (the picture scaled, the controls stacked and usable,
+the picture enlarged on a tap), and at 1280 px it keeps its one-row layout.
 
 Each explorer's static HTML (what the book embeds) is opened from a file in headless Chromium
 (Debian's ``/usr/bin/chromium``, driven by Playwright), with every request that leaves the page
