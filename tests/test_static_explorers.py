@@ -1,5 +1,7 @@
 """The static explorers in a browser: every position of the slider and the menu shows another
-picture, caption and text alternative; the pictures are HiDPI; each explorer page stays small.
+picture, caption and text alternative; the pictures are HiDPI; each explorer page stays small; on
+a 390 px phone the explorer fits the column (the picture scaled, the controls stacked and usable,
+the picture enlarged on a tap), and at 1280 px it keeps its one-row layout.
 
 Each explorer's static HTML (what the book embeds) is opened from a file in headless Chromium
 (Debian's ``/usr/bin/chromium``, driven by Playwright), with every request that leaves the page
@@ -9,6 +11,7 @@ its explorer pages are measured as well.
 
 from __future__ import annotations
 
+import itertools
 import os
 import threading
 from pathlib import Path
@@ -130,3 +133,207 @@ def test_built_explorer_pages_are_small(chapter):
     assert "uio-static-explorer" in text
     assert "widget-state+json" not in text  # the unused widget state is left out
     assert page.stat().st_size <= MAX_PAGE, page.stat().st_size
+
+
+# --- a phone: 390 x 844 CSS pixels ---------------------------------------------------------------
+
+PHONE = {"viewport": {"width": 390, "height": 844}, "is_mobile": True, "has_touch": True}
+DESKTOP = {"viewport": {"width": 1280, "height": 900}}
+VIEWPORT_META = '<meta name="viewport" content="width=device-width, initial-scale=1">'
+
+# Where each part of the k-th explorer is drawn (CSS pixels), the column it sits in (its parent's
+# content box) and how wide the document is.
+_LAYOUT_JS = """(k) => {
+  const root = document.querySelectorAll('.uio-static-explorer')[k];
+  const rect = (e) => { const r = e.getBoundingClientRect();
+    return {left: r.left, right: r.right, top: r.top, bottom: r.bottom,
+            width: r.width, height: r.height}; };
+  const shown = (e) => { const r = e.getBoundingClientRect(), s = getComputedStyle(e);
+    return r.width > 0 && r.height > 0 && s.visibility !== 'hidden' && s.display !== 'none'; };
+  const parent = root.parentElement, ps = getComputedStyle(parent);
+  const column = parent.clientWidth - parseFloat(ps.paddingLeft) - parseFloat(ps.paddingRight);
+  const picture = root.querySelector('.uio-picture'), img = root.querySelector('img.uio-frame');
+  const parts = {slider: 'input[type=range]', value: 'output', select: 'select',
+                 caption: '.uio-caption', zoom: '.uio-zoom-label'};
+  const controls = {};
+  for (const [name, sel] of Object.entries(parts)) {
+    const e = root.querySelector(sel);
+    controls[name] = Object.assign(rect(e), {shown: shown(e)});
+  }
+  return {inner: window.innerWidth, doc: document.documentElement.scrollWidth,
+          box: rect(root), column, img: rect(img),
+          natural: img.naturalWidth, naturalHeight: img.naturalHeight,
+          picture: {client: picture.clientWidth, scroll: picture.scrollWidth},
+          zoomed: root.classList.contains('uio-zoomed'), controls,
+          state: {src: img.src, alt: img.alt, value: root.querySelector('input[type=range]').value,
+                  caption: root.querySelector('.uio-caption').textContent}};
+}"""
+
+
+def _block_the_network(page) -> None:
+    page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file:") else r.abort())
+
+
+def _check_phone_layout(m: dict, where: str) -> None:
+    """The explorer fits a 390 px screen: nothing wider than the viewport, the picture scaled to
+    the column, every control on screen and stacked."""
+    inner = m["inner"]
+    assert m["box"]["left"] >= -0.5 and m["box"]["right"] <= inner + 0.5, (where, m["box"])
+    assert m["box"]["width"] <= m["column"] + 0.5, (where, m["box"], m["column"])
+    assert m["doc"] <= inner, f"{where}: the page scrolls sideways ({m['doc']} > {inner} px)"
+    assert m["img"]["width"] <= min(m["column"], m["box"]["width"]) + 0.5, (where, m["img"])
+    assert m["img"]["width"] > 300, (where, m["img"])
+    assert m["picture"]["scroll"] <= m["picture"]["client"], (where, m["picture"])
+    assert m["natural"] >= 1200
+    for name, c in m["controls"].items():
+        if name == "select" and not c["shown"]:
+            continue  # one disturbance type only: no menu
+        assert c["shown"], f"{where}: the {name} is not shown"
+        assert c["left"] >= -0.5 and c["right"] <= inner + 0.5, (where, name, c)
+    slider = m["controls"]["slider"]
+    assert slider["width"] >= 0.7 * m["box"]["width"], (where, slider)  # the whole row: easy to hit
+    assert slider["height"] >= 30, (where, slider)  # a finger-sized target
+    c = m["controls"]
+    assert c["zoom"]["height"] >= 30, (where, c["zoom"])
+    # stacked: the menu below the slider, the enlarge box below both, the picture below all
+    rows = (
+        [c["slider"], c["select"], c["zoom"]] if c["select"]["shown"] else [c["slider"], c["zoom"]]
+    )
+    for upper, lower in itertools.pairwise([*rows, m["img"]]):
+        assert lower["top"] >= upper["bottom"] - 0.5, (where, upper, lower)
+    _check_aspect(m, where)
+
+
+def _check_aspect(m: dict, where: str) -> None:
+    """The picture keeps its aspect ratio (to a pixel of rounding)."""
+    shown = m["img"]["height"] / m["img"]["width"]
+    drawn = m["naturalHeight"] / m["natural"]
+    assert shown == pytest.approx(drawn, abs=1 / m["img"]["width"]), (where, shown, drawn)
+
+
+def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
+    """Drive the k-th explorer as a reader would, by mouse, touch and keyboard: slider to either
+    end, the other disturbance type, the picture enlarged and back. Returns the states seen."""
+    root = page.locator(".uio-static-explorer").nth(k)
+    root.scroll_into_view_if_needed()
+    slider = root.locator("input[type=range]")
+    top = int(slider.get_attribute("max"))
+    seen = [page.evaluate(_LAYOUT_JS, k)]
+    _check_phone_layout(seen[0], where)
+    box = slider.bounding_box()
+    for x, want in ((2, 0), (box["width"] - 2, top)):
+        slider.click(position={"x": x, "y": box["height"] / 2})
+        page.wait_for_function("() => [...document.images].every((i) => i.complete)")
+        m = page.evaluate(_LAYOUT_JS, k)
+        assert m["state"]["value"] == str(want), (where, m["state"]["value"], want)
+        seen.append(m)
+    slider.focus()
+    page.keyboard.press("ArrowLeft")
+    seen.append(page.evaluate(_LAYOUT_JS, k))
+    assert seen[-1]["state"]["value"] == str(top - 1), where
+    if kinds > 1:
+        root.locator("select").select_option(index=1 - int(root.locator("select").input_value()))
+        seen.append(page.evaluate(_LAYOUT_JS, k))
+    for m in seen:
+        _check_phone_layout(m, where)
+    # the slider and the menu change the picture, its text alternative and the caption
+    for a, b in itertools.pairwise(seen[1:]):
+        for key in ("src", "alt", "caption"):
+            assert a["state"][key] != b["state"][key], (where, key, a["state"]["value"])
+    # a tap on the picture enlarges it to half its pixel width; it scrolls inside its own box
+    root.locator("img.uio-frame").tap()
+    big = page.evaluate(_LAYOUT_JS, k)
+    assert big["zoomed"], where
+    assert big["img"]["width"] >= big["natural"] / 2 - 0.5, (where, big["img"], big["natural"])
+    assert big["picture"]["scroll"] > big["picture"]["client"], (where, big["picture"])
+    assert big["box"]["right"] <= big["inner"] + 0.5 and big["doc"] <= big["inner"], where
+    root.locator(".uio-zoom").click()  # the check box clears it again
+    back = page.evaluate(_LAYOUT_JS, k)
+    assert not back["zoomed"] and back["img"]["width"] == seen[-1]["img"]["width"], where
+    return seen
+
+
+def _standalone(name: str, tmp_path: Path) -> tuple[Path, int]:
+    data = static_explorer(SCENARIOS[name]())
+    html = (
+        f"<!doctype html><html lang='en'><head>{VIEWPORT_META}</head>"
+        f"<body><p>Before the explorer.</p>{data.html}</body></html>"
+    )
+    path = tmp_path / f"{name}.html"
+    path.write_text(html, encoding="utf-8")
+    return path, 1 + max(f.index[1] for f in data.frames)
+
+
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
+    path, kinds = _standalone(name, tmp_path)
+    measured = {}
+
+    def work(browser) -> None:
+        context = browser.new_context(**PHONE)
+        page = context.new_page()
+        _block_the_network(page)
+        page.goto(path.as_uri())
+        measured["seen"] = _phone_walk(page, 0, name, kinds)
+        context.close()
+
+    _in_chromium(work)
+    first = measured["seen"][0]
+    print(
+        f"{name} at 390 px: explorer {first['box']['width']:.0f} px, picture "
+        f"{first['img']['width']:.0f} x {first['img']['height']:.0f} px"
+    )
+
+
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_wide_layout_is_kept(name, tmp_path):
+    """At 1280 px the controls share one row above a 780 px picture; no enlarge box."""
+    path, kinds = _standalone(name, tmp_path)
+    measured = {}
+
+    def work(browser) -> None:
+        context = browser.new_context(**DESKTOP)
+        page = context.new_page()
+        _block_the_network(page)
+        page.goto(path.as_uri())
+        measured["m"] = page.evaluate(_LAYOUT_JS, 0)
+        context.close()
+
+    _in_chromium(work)
+    m = measured["m"]
+    assert m["box"]["width"] == 780 and m["img"]["width"] == 780, m
+    assert not m["controls"]["zoom"]["shown"]
+    c = m["controls"]
+    if kinds > 1:  # one row: the menu right of the slider, on the same middle line
+        assert c["slider"]["right"] < c["select"]["left"], c
+        middle = [(c[k]["top"] + c[k]["bottom"]) / 2 for k in ("slider", "select")]
+        assert abs(middle[0] - middle[1]) < 4, c
+    assert abs(c["slider"]["height"] - 16) < 8 and c["select"]["height"] < 30
+    _check_aspect(m, name)
+
+
+@pytest.mark.parametrize("chapter", sorted(SCENARIOS))
+def test_built_explorer_pages_read_on_a_phone(chapter):
+    page_file = HTML / "book" / f"{chapter}.html"
+    if not page_file.exists():
+        pytest.skip("the book is not built (tests/test_book.py builds it)")
+    seen = {}
+
+    def work(browser) -> None:
+        context = browser.new_context(**PHONE)
+        page = context.new_page()
+        _block_the_network(page)
+        page.goto(page_file.as_uri())
+        count = page.locator(".uio-static-explorer").count()
+        assert count >= 1
+        for k in range(count):
+            kinds = page.locator(".uio-static-explorer").nth(k).locator("option").count()
+            seen[k] = _phone_walk(page, k, f"{chapter} explorer {k + 1}", kinds)[0]
+        context.close()
+
+    _in_chromium(work)
+    for k, m in seen.items():
+        print(
+            f"{chapter} explorer {k + 1} at 390 px: column {m['column']:.0f} px, picture "
+            f"{m['img']['width']:.0f} x {m['img']['height']:.0f} px"
+        )

@@ -9,6 +9,13 @@ slider, a ``<select>`` for the disturbance type and one inline ``oninput``
 handler that swaps the displayed picture. No external script, stylesheet or
 URL is involved, so the page works offline and from ``file://``.
 
+The layout reflows with the screen (a few CSS rules in the HTML itself): on a
+wide screen the controls share a row above a picture at most 780 px wide; on a
+phone each control takes a row of its own and the picture shrinks to the
+column, keeping its aspect ratio, so the page never scrolls sideways. There,
+"enlarge the picture" (or a tap on the picture) shows it at the size its text
+is drawn for, scrolling sideways inside its own box.
+
 Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 :class:`uio_teach.explorers.ExplorerFigure`, exactly as in the live explorer.
 
@@ -367,14 +374,62 @@ def static_html(
 
 
 # The one handler of the form (``this`` is the form): pick the frame of the slider's and the
-# select's values, show its picture, caption and value.
+# select's values, show its picture, caption and value; the check box enlarges the picture.
 _JS = (
     "var r=this.parentNode,f=r.querySelector('[data-k=\"'+this.main.value+'-'+this.dist.value"
     "+'\"]');if(f){r.querySelector('img.uio-frame').src=f.getAttribute('data-src');"
     "r.querySelector('img.uio-frame').alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
     "this.mainval.value=f.getAttribute('data-label');}"
+    "r.classList.toggle('uio-zoomed',this.zoom.checked);"
 )
+
+# The check box's words (also its accessible name: the picture is a second label of it).
+_ZOOM_TEXT = "enlarge the picture (it then scrolls sideways)"
+
+# Narrower than this (a phone), the controls stack and the picture may be enlarged.
+_NARROW = 700
+
+# The layout: on a wide screen the controls share a row above a picture at most 780 px wide; on a
+# narrow one each control takes a row of its own, the slider the full width, and the picture
+# shrinks to the column. "Enlarge the picture" (or a tap on it) shows it at half its pixel width,
+# the size its text is drawn for, scrolling sideways inside its own box, never the page.
+_CSS = """
+.uio-static-explorer{max-width:780px;box-sizing:border-box}
+.uio-static-explorer *{box-sizing:border-box}
+.uio-static-explorer form{display:flex;flex-wrap:wrap;gap:0.3em 1.5em;align-items:center;
+margin:0.3em 0}
+.uio-static-explorer .uio-main{display:flex;flex-wrap:wrap;align-items:center;gap:0 0.5em;
+max-width:100%}
+.uio-static-explorer .uio-slider{display:inline-flex;align-items:center;gap:0.5em}
+.uio-static-explorer input[type=range]{margin:0;vertical-align:middle}
+.uio-static-explorer .uio-zoom-label{display:none;align-items:center;gap:0.5em}
+.uio-static-explorer .uio-picture{max-width:100%;overflow-x:auto;overflow-y:hidden;
+scrollbar-width:thin}
+.uio-static-explorer img.uio-frame{display:block;width:100%;max-width:none;height:auto;margin:0}
+.uio-static-explorer.uio-zoomed img.uio-frame{width:max(100%, @ZOOM@px)}
+.uio-static-explorer .uio-caption{font-size:0.85em;margin:0.2em 0}
+.uio-static-explorer .uio-note{font-size:0.8em;opacity:0.75;margin:0.2em 0}
+@media (max-width:@NARROW@px){
+.uio-static-explorer form{flex-direction:column;align-items:stretch;gap:0.6em}
+.uio-static-explorer .uio-main,.uio-static-explorer .uio-dist{display:flex;flex-direction:column;
+align-items:stretch;gap:0.2em}
+.uio-static-explorer .uio-slider{display:flex;width:100%}
+.uio-static-explorer input[type=range]{flex:1 1 auto;min-width:0;width:100%;height:2.5em}
+.uio-static-explorer output{min-width:3em;text-align:right}
+.uio-static-explorer select{width:100%;min-height:2.5em;font-size:max(16px, 1em)}
+.uio-static-explorer .uio-zoom-label{display:flex;min-height:2.5em}
+.uio-static-explorer .uio-zoom{width:1.4em;height:1.4em;margin:0}
+.uio-static-explorer img.uio-frame{cursor:zoom-in}
+.uio-static-explorer.uio-zoomed img.uio-frame{cursor:zoom-out}
+.uio-static-explorer .uio-caption{font-size:0.95em}
+}
+"""
+
+
+def _png_width(png: bytes) -> int:
+    """The width in pixels of a PNG (from its header)."""
+    return int.from_bytes(png[16:20], "big")
 
 
 def _html(
@@ -404,23 +459,28 @@ def _html(
     handler = esc(_JS, quote=True)
     alt = esc(first.alt)
     hidden_select = "" if len(disturbances) > 1 else ' style="display:none"'
+    # enlarged, the picture is shown at half its pixel width: 2 pixels a CSS pixel, as designed
+    css = _CSS.replace("@ZOOM@", str(_png_width(first.png) // 2)).replace("@NARROW@", str(_NARROW))
+    css = "".join(line.strip() for line in css.splitlines())
+    zoom = f"{eid}-zoom"
     return (
-        f'<div id="{eid}" class="uio-static-explorer" style="max-width:780px">'
-        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}" '
-        'style="display:flex;flex-wrap:wrap;gap:0.3em 1.5em;align-items:center;margin:0.3em 0">'
-        f'<label>{label}: <input type="range" name="main" min="0" max="{len(values) - 1}" '
-        f'step="1" value="{i0}" aria-label="{label}" style="vertical-align:middle"> '
-        f'<output name="mainval">{esc(first.label)}</output></label>'
-        f"<label{hidden_select}>disturbance: "
+        f'<div id="{eid}" class="uio-static-explorer">'
+        f"<style>{css}</style>"
+        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}">'
+        f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
+        f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
+        f'step="1" value="{i0}" aria-label="{label}"> '
+        f'<output name="mainval">{esc(first.label)}</output></span></label>'
+        f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
+        f'<label class="uio-zoom-label"><input type="checkbox" name="zoom" id="{zoom}" '
+        f'class="uio-zoom" aria-label="{_ZOOM_TEXT}"> {_ZOOM_TEXT}</label>'
         "</form>"
-        # narrower than 600 px (a phone) the picture keeps 600 px and scrolls sideways
-        '<div style="overflow-x:auto">'
-        f'<img class="uio-frame" src="{first.data_url}" alt="{alt}" '
-        'style="width:100%;min-width:600px;height:auto"></div>'
-        '<p class="uio-caption" aria-live="polite" style="font-size:0.85em;margin:0.2em 0">'
-        f"{esc(first.caption)}</p>"
-        '<p style="font-size:0.8em;opacity:0.75;margin:0.2em 0">Pre-computed pictures: move the '
+        # a tap on the picture ticks or clears "enlarge the picture" (its label)
+        f'<div class="uio-picture"><label for="{zoom}">'
+        f'<img class="uio-frame" src="{first.data_url}" alt="{alt}"></label></div>'
+        f'<p class="uio-caption" aria-live="polite">{esc(first.caption)}</p>'
+        '<p class="uio-note">Pre-computed pictures: move the '
         "slider or pick a disturbance. Open this page as a notebook with a Python kernel for "
         "the live explorer, where every control can be set.</p>"
         f'<div hidden style="display:none">{store}</div>'
