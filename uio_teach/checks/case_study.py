@@ -49,8 +49,10 @@ __all__ = [
 
 
 def _M_ref(plant) -> np.ndarray:
-    C, B2, D = plant.C, plant.E, plant.D
-    return np.hstack([B2, np.zeros((plant.n, D.shape[1]))]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
+    """The projection matrix ``M = [B2 0][C B2 D]^+`` of the package's design."""
+    from ..existence import decoupling
+
+    return decoupling(plant).M
 
 
 def _small(X: np.ndarray, scale: float, tol: float) -> tuple[bool, float]:
@@ -130,8 +132,10 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
 
 
 def _error_matrix(plant, L: np.ndarray) -> np.ndarray:
-    M = _M_ref(plant)
-    return (np.eye(plant.n) - M @ plant.C) @ plant.A - L @ plant.C
+    """``F = (I - M C) A - L C`` with the package's ``M``."""
+    from ..existence import decoupling
+
+    return decoupling(plant).A1 - L @ plant.C
 
 
 def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
