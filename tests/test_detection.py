@@ -61,7 +61,7 @@ def test_fault_directions(pa9):
     np.testing.assert_array_equal(p.state_direction, pa9.E[:, 0])
     assert (a.name, s.name, p.name) == ("actuator 2", "sensor 1", "through E")
     fp = faulty_plant(pa9, s)
-    assert (fp.q, fp.r) == (pa9.q + 1, pa9.r + 1)
+    assert (fp.q, fp.nv) == (pa9.q + 1, pa9.nv + 1)
 
 
 @pytest.mark.parametrize(

@@ -81,7 +81,7 @@ def test_fixed_modes_are_observer_poles_whatever_the_placement(plant_fn):
     k = report.movable
     stable = 0.3 if plant.is_discrete else -50.0
     for poles in ([stable] * 0 + list(np.linspace(stable, stable * 1.5, k)),):
-        obs = ut.design_pmo(plant, poles=poles) if plant.r else ut.design_uio(plant, poles=poles)
+        obs = ut.design_pmo(plant, poles=poles) if plant.nv else ut.design_uio(plant, poles=poles)
         got = obs.poles()
         for zf in report.fixed_modes:
             assert np.min(np.abs(got - zf)) < 1e-6 * max(1, abs(zf))

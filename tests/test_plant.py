@@ -11,7 +11,7 @@ A2 = [[0.0, 1.0], [-2.0, -3.0]]
 
 def test_dimensions_and_defaults():
     plant = ut.Plant(A2, [[1, 0]], E=[0, 1])
-    assert (plant.n, plant.m, plant.q, plant.p, plant.r) == (2, 0, 1, 1, 0)
+    assert (plant.n, plant.m, plant.q, plant.p, plant.nv) == (2, 0, 1, 1, 0)
     assert plant.B.shape == (2, 0) and plant.D.shape == (1, 0)
     assert not plant.is_discrete
 

@@ -70,18 +70,18 @@ def test_random_designs(discrete, with_D):
         # the fixed modes are the invariant zeros
         assert _close_sets(report.fixed_modes, report.invariant_zeros, 1e-5)
         poles = _pick_poles(report.movable, discrete)
-        design = ut.design_pmo if plant.r else ut.design_uio
+        design = ut.design_pmo if plant.nv else ut.design_uio
         if report.movable:
             obs = design(plant, poles=poles)
         else:  # nothing to place: the observer has only its fixed modes
-            obs = design(plant, **{"L" if plant.r else "K1": np.zeros((plant.n, plant.p))})
+            obs = design(plant, **{"L" if plant.nv else "K1": np.zeros((plant.n, plant.p))})
         real = obs.realization()
         n = plant.n
         H = real.D_y
         scale = max(1.0, np.abs(H).max())
         # decoupling identities
         np.testing.assert_allclose((np.eye(n) - H @ plant.C) @ plant.E, 0, atol=1e-9 * scale)
-        if plant.r:
+        if plant.nv:
             np.testing.assert_allclose(H @ plant.D, 0, atol=1e-9 * scale)
             gain = obs.L
             np.testing.assert_allclose(gain @ plant.D, 0, atol=1e-9 * max(1.0, np.abs(gain).max()))

@@ -94,7 +94,7 @@ LUENBERGER_POLES = {
 
 def _unknown_inputs(plant: ut.Plant, t: np.ndarray) -> dict[str, dict]:
     """Unknown inputs (and measurement disturbances) of four kinds, sized for the plant."""
-    q, r = plant.q, plant.r
+    q, r = plant.q, plant.nv
     amp = 50.0 if plant.name == "missile autopilot" else 2.0
     span = t[-1] - t[0]
     rng = np.random.default_rng(20141)
@@ -271,7 +271,7 @@ def _forced_response(plant, obs, t, u, d, v, x0):
     n, nw = plant.n, A_o.shape[0]
     A = np.block([[plant.A, np.zeros((n, nw))], [B_y @ plant.C, A_o]])
     B = np.block(
-        [[plant.B, plant.E, np.zeros((n, plant.r))], [B_u, np.zeros((nw, plant.q)), B_y @ plant.D]]
+        [[plant.B, plant.E, np.zeros((n, plant.nv))], [B_u, np.zeros((nw, plant.q)), B_y @ plant.D]]
     )
     sys = ct.ss(A, B, np.eye(n + nw), 0, dt=0 if plant.dt is None else plant.dt)
     U = np.vstack([u, d, v])
@@ -288,9 +288,9 @@ def test_agrees_with_control_forced_response(name, make_plant, make_observer, gr
     u = rng.standard_normal((plant.m, t.size))
     inputs = _unknown_inputs(plant, t)["random"]
     d = inputs["d"]
-    v = inputs.get("v", np.zeros((plant.r, t.size)))
+    v = inputs.get("v", np.zeros((plant.nv, t.size)))
     run = ut.simulate(
-        plant, obs, t, u=u if plant.m else None, d=d, v=v if plant.r else None, initial_state=x0
+        plant, obs, t, u=u if plant.m else None, d=d, v=v if plant.nv else None, initial_state=x0
     )
     x, w = _forced_response(plant, obs, t, u, d, v, x0)
     assert np.abs(run.states - x).max() <= 1e-9 * np.abs(x).max()

@@ -263,7 +263,7 @@ def faulty_plant(plant: Plant, fault: Fault) -> Plant:
     >>> import uio_teach as ut
     >>> plant = ut.examples.pa9()
     >>> faulty_plant(plant, ut.sensor_fault(plant, 0, ut.signals.step(1.0)))
-    Plant('PA9 with sensor 1 fault', continuous-time, n=3, m=2, q=2, p=2, r=1)
+    Plant('PA9 with sensor 1 fault', continuous-time, n=3, m=2, q=2, p=2, nv=1)
     """
     plant = _check_plant(plant)
     if not isinstance(fault, Fault):
@@ -363,7 +363,7 @@ def simulate_fault(
     t = _check_timepts(timepts)
     f = _signal("fault.signal", fault.signal, 1, t)
     d_all = np.vstack([_signal("d", d, plant.q, t), f])
-    v_all = np.vstack([_signal("v", v, plant.r, t), f])
+    v_all = np.vstack([_signal("v", v, plant.nv, t), f])
     return simulate(
         true_plant,
         observer,

@@ -79,7 +79,7 @@ def dt_case_study() -> Plant:
     --------
     >>> from uio_teach import examples
     >>> examples.dt_case_study()
-    Plant('case study', discrete-time, dt=1, n=3, m=0, q=1, p=2, r=1)
+    Plant('case study', discrete-time, dt=1, n=3, m=0, q=1, p=2, nv=1)
     """
     return Plant(
         0.5 * np.eye(3),

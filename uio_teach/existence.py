@@ -79,7 +79,7 @@ class Decoupling:
 
 def decoupling(plant: Plant, Mv: np.ndarray | None = None) -> Decoupling:
     """Compute ``M``, ``A1`` and the observability split (rank condition assumed)."""
-    n, p, r = plant.n, plant.p, plant.r
+    n, p, r = plant.n, plant.p, plant.nv
     G = np.hstack([plant.C @ plant.E, plant.D])
     Eb = np.hstack([plant.E, np.zeros((n, r))])
     Gp = pinv(G)
@@ -211,7 +211,7 @@ def _boundary_note(values: np.ndarray, discrete: bool, A: np.ndarray) -> str:
 
 
 def _pair_name(plant: Plant) -> str:
-    return "(A1, N C)" if plant.r else "(TA, C)"
+    return "(A1, N C)" if plant.nv else "(TA, C)"
 
 
 def check_existence(plant: Plant) -> ExistenceReport:
@@ -264,7 +264,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
     rank_margin = min(dE.margin, dD.margin, dG.margin)
     conds: list[Condition] = []
 
-    if plant.r:
+    if plant.nv:
         lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
     else:
         lhs, rhs = f"rank(CE) = {rG}", f"rank(E) = {rE}"
@@ -283,7 +283,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
         )
     conds.append(Condition("rank condition", rank_ok, reason, margin=rank_margin))
 
-    Bz = np.hstack([E, np.zeros((plant.n, plant.r))])
+    Bz = np.hstack([E, np.zeros((plant.n, plant.nv))])
     Dz = np.hstack([np.zeros((plant.p, plant.q)), D])
     zeros = invariant_zeros(plant.A, Bz, C, Dz)
     bad = zeros[~is_stable(zeros, discrete)]

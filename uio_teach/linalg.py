@@ -191,7 +191,7 @@ def left_null(M: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    M : array_like, shape (p, r)
+    M : array_like, shape (p, nv)
         The matrix to annihilate from the left (e.g. a measurement-disturbance
         matrix ``D``).
 

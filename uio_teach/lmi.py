@@ -136,7 +136,7 @@ def lmi_gain(
         Matrix of the error dynamics before output injection.
     C : array_like, shape (p, n)
         Output matrix.
-    D : array_like, shape (p, r), optional
+    D : array_like, shape (p, nv), optional
         Measurement-disturbance matrix; adds ``L D = 0``.
     dt : None, True or float, optional
         ``None`` (or 0, False) for continuous time; ``True`` or a positive
@@ -194,7 +194,7 @@ def lmi_gain(
         raise ValueError(f"A1 has shape {A1.shape}, expected a square (n, n) matrix")
     C = as_matrix("C", C, None, n, vector="row", what="p x n")
     p = C.shape[0]
-    D = None if D is None else as_matrix("D", D, p, None, what="p x r")
+    D = None if D is None else as_matrix("D", D, p, None, what="p x nv")
     has_d = D is not None and D.shape[1] > 0
     discrete = _check_dt(dt)
     decay = _check_decay(decay, discrete)

@@ -496,7 +496,7 @@ class LuenbergerObserver(Observer):
 
     @property
     def decouples(self) -> bool:
-        return self.plant.q == 0 and self.plant.r == 0
+        return self.plant.q == 0 and self.plant.nv == 0
 
     @property
     def error_matrix(self) -> np.ndarray:
@@ -531,7 +531,7 @@ def _verify_projection(obs: _ProjectionObserver, what: str) -> None:
     if pl.q:
         check_identity("H C E = E", H @ pl.C @ pl.E - pl.E, max(nH * nC * nE, nE), what=what)
         check_identity("T E = 0", T @ pl.E, max(_norm(T) * nE, nE), what=what)
-    if pl.r:
+    if pl.nv:
         check_identity("H D = 0", H @ pl.D, nH * nD, what=what)
         check_identity("L D = 0", K1 @ pl.D, max(_norm(K1), 1.0) * nD, what=what)
 
@@ -558,7 +558,7 @@ def _decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
     """Check an explicit gain; one that meets ``gain D = 0`` only to printed precision
     (a gain copied from a document, rounded to 4 decimals) is projected onto it."""
     G = as_matrix(name, gain, plant.n, plant.p, what="n x p")
-    if not plant.r:
+    if not plant.nv:
         return G
     scale = max(1.0, float(np.abs(G).max()))
     GD = G @ plant.D
@@ -756,13 +756,13 @@ def design_pmo(
         raise ValueError("decay= is the LMI's bound: use it with method='lmi'")
     _require(plant, "a projection-operator observer")
     if Mv is not None:
-        if plant.r:
+        if plant.nv:
             raise ValueError("Mv is not supported together with a measurement disturbance D")
         Mv = as_matrix("Mv", Mv, plant.n, plant.p, what="n x p")
     dec = decoupling(plant, Mv)
     certificate = None
     if method == "lmi":
-        res = lmi_gain(dec.A1, plant.C, D=plant.D if plant.r else None, dt=plant.dt, decay=decay)
+        res = lmi_gain(dec.A1, plant.C, D=plant.D if plant.nv else None, dt=plant.dt, decay=decay)
         L, certificate = res.L, res.P
     requested = None
     if method == "lmi":
@@ -827,7 +827,7 @@ def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     array([-105.6-142.09j, -105.6+142.09j])
     """
     plant = _check_plant(plant)
-    if plant.r:
+    if plant.nv:
         raise ValueError(
             "design_ginverse does not handle measurement disturbances (D); use design_pmo"
         )

@@ -17,7 +17,7 @@ __all__ = ["Plant"]
 _ROWS = {
     "B": "n x m: one row per state",
     "E": "n x q: one row per state",
-    "D": "p x r: one row per output",
+    "D": "p x nv: one row per output",
 }
 
 
@@ -59,7 +59,7 @@ class Plant:
     E : array_like, shape (n, q), optional
         Unknown-input matrix (``B2`` in the discrete case study, ``E`` in
         Practical Assignment 9 and the missile paper). A 1-D array is a column.
-    D : array_like, shape (p, r), optional
+    D : array_like, shape (p, nv), optional
         Measurement-disturbance matrix. A 1-D array is a column.
     dt : None, True or float, optional
         ``None`` (or 0) for continuous time, ``True`` for discrete time with an
@@ -120,7 +120,7 @@ class Plant:
             "E", np.zeros((n, 0)) if E is None else E, n, None, what="n x q: one row per state"
         )
         D = as_matrix(
-            "D", np.zeros((p, 0)) if D is None else D, p, None, what="p x r: one row per output"
+            "D", np.zeros((p, 0)) if D is None else D, p, None, what="p x nv: one row per output"
         )
         object.__setattr__(self, "_A", A)
         object.__setattr__(self, "_B", B)
@@ -151,7 +151,7 @@ class Plant:
 
     @property
     def D(self) -> np.ndarray:
-        """Measurement-disturbance matrix, shape (p, r)."""
+        """Measurement-disturbance matrix, shape (p, nv)."""
         return self._D
 
     @property
@@ -191,7 +191,7 @@ class Plant:
         return self._C.shape[0]
 
     @property
-    def r(self) -> int:
+    def nv(self) -> int:
         """Number of measurement disturbances."""
         return self._D.shape[1]
 
@@ -295,12 +295,12 @@ class Plant:
         3
         """
         n, p = self.n, self.p
-        Bfull = np.hstack([self.B, self.E, np.zeros((n, self.r))])
+        Bfull = np.hstack([self.B, self.E, np.zeros((n, self.nv))])
         Dfull = np.hstack([np.zeros((p, self.m + self.q)), self.D])
         inputs = (
             [f"u[{i}]" for i in range(self.m)]
             + [f"d[{i}]" for i in range(self.q)]
-            + [f"v[{i}]" for i in range(self.r)]
+            + [f"v[{i}]" for i in range(self.nv)]
         )
         kwargs = {"dt": self.dt if self.dt is not None else 0}
         if self.name:
@@ -315,7 +315,7 @@ class Plant:
         if self.q:
             items.append(("E", self.E))
         items.append(("C", self.C))
-        if self.r:
+        if self.nv:
             items.append(("D", self.D))
         return items
 
@@ -326,7 +326,7 @@ class Plant:
             else ("discrete-time" if self.dt is True else f"discrete-time, dt={self.dt:g}")
         )
         name = f"{self.name!r}, " if self.name else ""
-        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, r={self.r})"
+        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, r={self.nv})"
 
     def __repr__(self) -> str:
         return self._title()

@@ -420,7 +420,7 @@ def joint_system(plant: Plant, observer: Observer) -> tuple[np.ndarray, np.ndarr
     """
     A_o, B_u, B_y, _, _ = observer.realization()
     n, nw = plant.n, A_o.shape[0]
-    q, r, p = plant.q, plant.r, plant.p
+    q, r, p = plant.q, plant.nv, plant.p
     Az = np.block([[plant.A, np.zeros((n, nw))], [B_y @ plant.C, A_o]])
     Bz = np.block(
         [
@@ -750,7 +750,7 @@ def simulate(
     h = _check_discrete_grid(plant, t) if plant.is_discrete else _uniform_step(t)
 
     # all inputs in one array s = [u; d; v; noise]; the recorded inputs are views of it
-    m, q, r, p = plant.m, plant.q, plant.r, plant.p
+    m, q, r, p = plant.m, plant.q, plant.nv, plant.p
     S = np.empty((m + q + r + p, N))
     S[:m] = _signal("u", u, m, t)
     S[m : m + q] = _signal("d", d, q, t)

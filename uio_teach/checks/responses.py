@@ -94,7 +94,7 @@ def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
         resp.observer,
         resp.time,
         u=resp.inputs.u if resp.plant.m else None,
-        v=resp.inputs.v if resp.plant.r else None,
+        v=resp.inputs.v if resp.plant.nv else None,
         initial_state=resp.states[:, 0],
         observer_state=resp.observer_states[:, 0],
     )

@@ -347,9 +347,9 @@ class ExplorerFigure:
             sig.plot(
                 [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
             )[0]
-            for i in range(plant.r)
+            for i in range(plant.nv)
         ]
-        if plant.q + plant.r:
+        if plant.q + plant.nv:
             sig.legend(**{**_LEGEND, "fontsize": 6.5 * k})
         sig.set_xlabel(xlabel, fontsize=8 * k)
         sig.grid(True, alpha=0.3)

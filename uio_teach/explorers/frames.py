@@ -444,7 +444,7 @@ def _observer_start(
 ) -> tuple[np.ndarray | None, np.ndarray]:
     """The observer state that realizes the start, and the initial error ``x(0) - xhat(0)``."""
     real = obs.realization()
-    y0 = plant.C @ x0 + (plant.D @ v0 if plant.r else 0.0)
+    y0 = plant.C @ x0 + (plant.D @ v0 if plant.nv else 0.0)
     if start == "zero observer state":
         w0 = None
         xhat0 = real.D_y @ y0
@@ -547,7 +547,7 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
             input_estimate=None,
             luenberger_input_estimate=None,
             d=np.zeros((plant.q, t.size)),
-            v=np.zeros((plant.r, t.size)),
+            v=np.zeros((plant.nv, t.size)),
             curves={},
             limits={},
             poles=np.zeros(0, complex),
@@ -603,7 +603,7 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
 
     # the unknown signals
     d = np.zeros((plant.q, N))
-    v = np.zeros((plant.r, N))
+    v = np.zeros((plant.nv, N))
     description = ""
     try:
         d_sig, v_sig = disturbance_signals(scenario, s)
@@ -625,7 +625,7 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
     kwargs: dict[str, Any] = {
         "u": scenario.u,
         "d": d if plant.q else None,
-        "v": v if plant.r else None,
+        "v": v if plant.nv else None,
         "initial_state": scenario.initial_state,
         "noise": float(noise) if noise > 0 else None,
         "seed": s.seed,
@@ -636,7 +636,7 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
     lb, lb_msg = _luenberger(scenario, s, obs)
 
     x0 = np.asarray(scenario.initial_state, dtype=float)
-    v0 = v[:, 0] if plant.r else np.zeros(0)
+    v0 = v[:, 0] if plant.nv else np.zeros(0)
     responses: dict[str, UIOResponse | None] = {"uio": None, "lb": None}
     starts: dict[str, np.ndarray] = {}
     for key, o in (("uio", obs), ("lb", lb)):

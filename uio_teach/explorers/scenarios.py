@@ -331,7 +331,7 @@ def make_scenario(
         tau_limits=(0.0, span / 20) if reconstruct else None,
         decay_limits=(0.3, 1.0) if observer_family == "pmo" and discrete else None,
         d_channels=tuple(Channel(speed=1.0 + 0.5 * i) for i in range(plant.q)),
-        v_channels=tuple(Channel(gain=0.5, speed=2.0 + 0.5 * i) for i in range(plant.r)),
+        v_channels=tuple(Channel(gain=0.5, speed=2.0 + 0.5 * i) for i in range(plant.nv)),
         static_values=static,
         static_control="pole" if real_first else "amplitude",
     )
