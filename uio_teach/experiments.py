@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from . import examples, signals
+from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
 
@@ -53,6 +54,8 @@ __all__ = [
     "PA9",
     "CASE_STUDY",
     "MISSILE",
+    "LAB_PLANTS",
+    "plant_from_params",
 ]
 
 
@@ -498,3 +501,104 @@ MISSILE = MissileExperiment(
 
 0.5 s on 10001 points, the paper's ``x0``, PMO poles -100, -120.
 """
+
+
+LAB_PLANTS: Mapping[str, Callable[[], Plant]] = MappingProxyType(
+    {
+        "pa9": examples.pa9,
+        "case_study": examples.dt_case_study,
+        "missile": examples.missile_autopilot,
+    }
+)
+"""The course's plant of each lab (``"pa9"``, ``"case_study"``, ``"missile"``), as a factory."""
+
+_PLANT_MATRICES = ("A", "B", "C", "D", "E")
+
+
+def plant_from_params(lab: str, params: Mapping[str, Any] | None = None) -> Plant:
+    """The plant of a lab: the course's, with the matrices of ``params["plant"]`` in their place.
+
+    A lab notebook's ``PARAMS`` may carry a group's own plant as
+    ``PARAMS["plant"] = {"A": [[...]], "E": [[...]], ...}`` (nested lists, as
+    JSON keeps them); a matrix that is not given is the course's. Every given
+    matrix must have the shape of the course's one (the lab's text and checks
+    rely on the sizes n, m, q, p, n_v).
+
+    Parameters
+    ----------
+    lab : {"pa9", "case_study", "missile"}
+        The lab (see :data:`LAB_PLANTS`).
+    params : mapping, optional
+        The lab's ``PARAMS``; only its ``"plant"`` entry is read. ``None``, or
+        no ``"plant"`` entry: the course's plant.
+
+    Returns
+    -------
+    Plant
+        A new plant, with the name, sampling period and sizes of the course's.
+
+    Raises
+    ------
+    ValueError
+        An unknown lab, a ``"plant"`` entry that is not a mapping of the
+        names ``A, B, C, D, E``, or a matrix that is not a finite real matrix
+        of the course's shape (the message names the matrix and the shape
+        expected).
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import plant_from_params
+    >>> plant_from_params("pa9") == plant_from_params("pa9", {"poles": [-1, -2, -3]})
+    True
+    >>> plant = plant_from_params("pa9", {"plant": {"E": [[1], [0], [2]]}})
+    >>> plant.E.ravel().tolist(), plant.A[1].tolist()
+    ([1.0, 0.0, 2.0], [-2.0, -3.0, 0.0])
+    >>> plant_from_params("pa9", {"plant": {"E": [[1, 0]]}})
+    Traceback (most recent call last):
+    ...
+    ValueError: PARAMS["plant"]["E"] of the pa9 lab has shape (1, 2), expected (3, 1) ...
+    """
+    if not isinstance(lab, str) or lab not in LAB_PLANTS:
+        raise ValueError(f"unknown lab {lab!r}: expected one of {', '.join(LAB_PLANTS)}")
+    course = LAB_PLANTS[lab]()
+    if params is None:
+        return course
+    if not isinstance(params, Mapping):
+        raise ValueError(f"params of the {lab} lab must be a mapping (PARAMS), got {params!r}")
+    given = params.get("plant")
+    if given is None:
+        return course
+    if not isinstance(given, Mapping):
+        raise ValueError(
+            f'PARAMS["plant"] of the {lab} lab must map matrix names ({", ".join(_PLANT_MATRICES)})'
+            f" to nested lists, got {type(given).__name__}"
+        )
+    unknown = sorted(str(k) for k in given if k not in _PLANT_MATRICES)
+    if unknown:
+        raise ValueError(
+            f'PARAMS["plant"] of the {lab} lab: unknown matrix {", ".join(map(repr, unknown))};'
+            f" expected some of {', '.join(_PLANT_MATRICES)}"
+        )
+    matrices = {name: getattr(course, name) for name in _PLANT_MATRICES}
+    for name, value in given.items():
+        label = f'PARAMS["plant"]["{name}"]'
+        expected = matrices[name].shape
+        try:
+            arr = as_matrix(label, value)
+        except ValueError as err:
+            raise ValueError(f"{err} (the {lab} lab)") from None
+        if arr.shape != expected:
+            raise ValueError(
+                f"{label} of the {lab} lab has shape {arr.shape}, expected {expected}"
+                f" (the shape of the course's {name})"
+            )
+        matrices[name] = arr
+    return Plant(
+        matrices["A"],
+        matrices["C"],
+        B=matrices["B"],
+        E=matrices["E"],
+        D=matrices["D"],
+        dt=course.dt,
+        name=course.name,
+    )
