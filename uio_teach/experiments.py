@@ -61,6 +61,7 @@ __all__ = [
     "experiment_params",
     "LAB_PLANTS",
     "plant_from_params",
+    "pole_text",
 ]
 
 PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
@@ -244,6 +245,29 @@ MAX_VALUE = 1e6
 
 SEED_DOC = "seed of every random number: PA9's measurement noise, the case study's v"
 STYLE_DOC = "matplotlib style: a name of matplotlib.style.available or a .mplstyle file"
+
+
+def pole_text(p: complex) -> float | str:
+    """A pole as JSON and TOML keep it: a float if real, else a string such as ``"-1+2j"``.
+
+    Parameters
+    ----------
+    p : complex
+
+    Returns
+    -------
+    float or str
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import pole_text
+    >>> pole_text(-2), pole_text(complex(-1, 2))
+    (-2.0, '-1+2j')
+    """
+    z = complex(p)
+    if z.imag == 0:
+        return float(z.real) + 0.0
+    return f"{z.real:g}{z.imag:+g}j"
 
 
 def _frozen(values: Any) -> np.ndarray:
@@ -889,10 +913,28 @@ MISSILE = MissileExperiment(name="missile", timepts=np.linspace(0.0, 0.5, 10_001
 """
 
 
-EXPERIMENTS: Mapping[str, Experiment] = MappingProxyType(
-    {"pa9": PA9, "case_study": CASE_STUDY, "missile": MISSILE}
-)
-"""The course's experiments by lab (and table of the term config)."""
+class _Experiments(Mapping):
+    """The course's experiments by lab, read from this module's names when asked."""
+
+    _names = {"pa9": "PA9", "case_study": "CASE_STUDY", "missile": "MISSILE"}
+
+    def __getitem__(self, lab: str) -> Experiment:
+        return globals()[self._names[lab]]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __repr__(self) -> str:
+        return f"EXPERIMENTS({', '.join(self._names)})"
+
+
+EXPERIMENTS: Mapping[str, Experiment] = _Experiments()
+"""The course's experiments by lab (and table of the term config): ``PA9``, ``CASE_STUDY``,
+``MISSILE`` (a view: replacing one of them in this module replaces it here)."""
+
 
 LAB_PLANTS: Mapping[str, Callable[[], Plant]] = MappingProxyType(
     {
