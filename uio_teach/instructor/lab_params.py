@@ -16,7 +16,7 @@ variant is a fair exercise, and the answer key.
 
 * :class:`PA9Params` -- the plant (``A``, ``E``), poles, initial state, the
   sinusoidal and the piecewise-constant disturbance of Practical Assignment 9;
-* :class:`CaseStudyParams` -- the plant (``A``, ``B2``, ``D``), the movable
+* :class:`CaseStudyParams` -- the plant (``B2``, ``D``), the movable
   pole, the unknown input ``u2``, the staircase ``v`` and its seed, the
   initial state of the case study;
 * :class:`MissileParams` -- the plant (``A``, ``B``, ``C``, ``E``), the PMO
@@ -510,25 +510,23 @@ class CaseStudyParams(LabParams):
 
     @classmethod
     def draw(cls, rng: np.random.Generator, base: CaseStudyParams | None = None) -> CaseStudyParams:
-        """A variant for one group: the plant's ``A``, ``B2``, ``D``; pole, ``u2``, ``v``, ``x[0]``.
+        """A variant for one group: the plant's ``B2`` and ``D``; pole, ``u2``, ``v``, ``x[0]``.
 
-        ``A = a I + b e_i e_j^T`` (a stable diagonal with one coupling), ``B2`` a
-        column of small integers and ``D = [1, d]^T``: ``M``, ``A1``, the
-        LMI's ``L`` (``L D = 0``) and the moved pole's gain differ between
-        groups; :meth:`problems` makes sure that ``M`` exists, the two fixed
-        modes are stable and the LMI is feasible. The pole lies in [-0.6, 0.3],
-        at least 0.1 from the fixed modes; ``d`` in ``D`` is a multiple of 0.05;
-        the unknown inputs have amplitudes of at least 0.5; ``x[0]`` has integer
-        entries and a nonzero initial error ``(I - MC) x[0]``.
+        ``A = 0.5 I`` stays (so the two fixed modes stay at 0.5, as the chapter
+        tells), ``B2`` is a column of small integers and ``D = [1, d]^T`` or
+        ``[d, 1]^T`` (``d`` a multiple of 0.05): ``M``, ``A1``, the LMI's ``L``
+        (``L D = 0``) and the moved pole's gain differ between groups;
+        :meth:`problems` makes sure that ``M`` exists, the two fixed modes are
+        stable and the LMI is feasible. The pole lies in [-0.6, 0.3], at least
+        0.1 from the fixed modes; the unknown inputs have amplitudes of at least
+        0.5; ``x[0]`` has integer entries and a nonzero initial error
+        ``(I - MC) x[0]``.
         """
         base = base or cls()
-        A = _choice(rng, [0.3, 0.4, 0.5, 0.6, 0.7]) * np.eye(3)
-        i, j = rng.choice(3, 2, replace=False)
-        A[i, j] = _choice(rng, [-0.2, -0.1, 0.0, 0.1, 0.2])
         B2 = [[_choice(rng, [1.0, 2.0])], *([_choice(rng, [-1.0, 1.0, 2.0])] for _ in range(2))]
         d = _choice(rng, [x for x in np.round(np.arange(-0.95, 0.96, 0.05), 2) if abs(x) > 0.01])
         D = [[1.0], [d]] if rng.integers(2) else [[d], [1.0]]
-        matrices = {"A": A.tolist(), "E": B2, "D": D}
+        matrices = {"E": B2, "D": D}
         plant = plant_from_params("case_study", {"plant": matrices})
         M = decoupling(plant).M
         Pi = np.eye(plant.n) - M @ plant.C
@@ -550,9 +548,9 @@ class CaseStudyParams(LabParams):
         )
 
     def distinct(self) -> dict[str, Any]:
-        """The direction of ``D`` (so no ``L`` with ``L D = 0`` serves two groups), and ``A``."""
+        """The direction of ``D``: no ``M D = 0`` or ``L D = 0`` holds for two groups."""
         plant = self.plant()
-        return {"D": _direction(plant.D), "A, B2": (tuple(plant.A.ravel()), _direction(plant.E))}
+        return {"D": _direction(plant.D)}
 
     def fixed_modes(self) -> np.ndarray:
         """The two error modes no gain with ``L D = 0`` moves (the invariant zeros)."""
@@ -650,7 +648,7 @@ class MissileParams(LabParams):
         ``A`` keeps the paper's structure (``x2' = -a x1 - b x3``, a fin
         actuator of natural frequency ``wn`` and damping ``zeta``), ``B`` its
         gain, ``E`` small integers, and ``C`` measures ``x1 + c x3`` and
-        ``x2 + c' x4`` (sensors that see a little of the fin), so that ``M``,
+        ``x2 + c' x3`` (sensors that see a little of the fin deflection), so that ``M``,
         ``Cg``, ``Pc``, ``K`` and the predicted noise differ between groups.
         :meth:`problems` makes sure that ``CE`` is square and invertible, the
         two invariant zeros (the fixed modes) are stable and actuator-like, and
@@ -675,7 +673,7 @@ class MissileParams(LabParams):
         E = rng.choice([-1.0, 1.0, 2.0, 3.0, 4.0, 5.0], (4, 2)).tolist()
         C = [
             [1.0, 0.0, round(_choice(rng, np.arange(-6, 7)) * 0.05, 2), 0.0],
-            [0.0, 1.0, 0.0, round(_choice(rng, np.arange(-6, 7)) * 0.0005, 4)],
+            [0.0, 1.0, round(_choice(rng, np.arange(-6, 7)) * 0.05, 2), 0.0],
         ]
         while True:
             a, b = sorted(rng.choice(np.arange(-170.0, -69.0, 5.0), 2, replace=False))
