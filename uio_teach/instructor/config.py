@@ -485,7 +485,7 @@ class FigureConfig(Mapping[str, Any]):
             if key in skip:
                 continue
             try:
-                _design(self, key)
+                design_observer(self, key)
             except ConfigError as err:
                 problems += [f"{key}: {p}" for p in err.problems]
             except ValueError as err:
@@ -662,8 +662,31 @@ def default_config_toml() -> str:
     return "\n".join(lines) + "\n"
 
 
-def _design(cfg: Mapping[str, Any], key: str):
-    """The observer that ``key`` configures (validated poles in, observer out)."""
+def design_observer(cfg: Mapping[str, Any], key: str):
+    """The observer that ``key`` configures (validated poles in, observer out).
+
+    Parameters
+    ----------
+    cfg : mapping
+        A configuration (:class:`FigureConfig`).
+    key : {"pa9.poles", "case_study.poles", "missile.pmo_poles"}
+        Which observer.
+
+    Returns
+    -------
+    uio_teach.UIO or uio_teach.PMO
+
+    Raises
+    ------
+    ConfigError
+        Not as many poles as the observer has movable poles.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import FigureConfig, design_observer
+    >>> design_observer(FigureConfig(), "pa9.poles").F.shape
+    (3, 3)
+    """
     import uio_teach as ut
 
     poles = cfg[key]
