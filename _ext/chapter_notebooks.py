@@ -13,21 +13,12 @@ from typing import Any
 
 import jupytext
 import nbformat
-import yaml
 from sphinx.application import Sphinx
+
+from uio_teach.instructor.book import split_front_matter
 
 NOTEBOOK_DIR = "_notebooks"
 LINK_TEXT = "Download this chapter as a notebook (.ipynb)"
-
-
-def _front_matter(text: str) -> dict:
-    if not text.startswith("---"):
-        return {}
-    end = text.find("\n---", 3)
-    if end < 0:
-        return {}
-    data = yaml.safe_load(text[3:end])
-    return data if isinstance(data, dict) else {}
 
 
 def chapter_source(app: Sphinx, pagename: str) -> Path | None:
@@ -37,7 +28,7 @@ def chapter_source(app: Sphinx, pagename: str) -> Path | None:
     source = Path(app.env.doc2path(pagename))
     if source.suffix != ".md" or not source.is_file():
         return None
-    if "kernelspec" not in _front_matter(source.read_text(encoding="utf-8")):
+    if "kernelspec" not in split_front_matter(source.read_text(encoding="utf-8"))[0]:
         return None
     return source
 

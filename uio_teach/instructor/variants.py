@@ -19,6 +19,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from .lab_registry import LABS, LabUsageError
+
 __all__ = ["ANSWER_KEY", "draw_variants", "write_answer_key"]
 
 ANSWER_KEY = "answer_key.csv"
@@ -57,10 +61,6 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
     >>> a != b and not a.problems() and not b.problems()
     True
     """
-    import numpy as np
-
-    from .labs import LABS, LabUsageError
-
     index = list(LABS).index(lab.id) if lab.id in LABS else 0
     rng = np.random.default_rng([int(seed), index])
     out: list[Any] = []
