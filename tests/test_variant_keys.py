@@ -11,7 +11,7 @@ import pytest
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.existence import decoupling
-from uio_teach.instructor.labs import LABS
+from uio_teach.instructor.lab_registry import LABS
 from uio_teach.instructor.variants import draw_variants
 
 GROUPS = 4
