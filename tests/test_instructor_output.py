@@ -212,9 +212,9 @@ def leftovers(parent: Path) -> list[str]:
 def uio_teach(*argv: str, kill_at: int | None = None, **kwargs) -> subprocess.CompletedProcess:
     """``python -m uio_teach ARGV`` in a child process (killed at its step ``kill_at``)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), *sys.path]))
-    env.pop(output._KILL_AT, None)
+    env.pop(output.KILL_AT_ENV, None)
     if kill_at is not None:
-        env[output._KILL_AT] = str(kill_at)
+        env[output.KILL_AT_ENV] = str(kill_at)
     return subprocess.run(
         [sys.executable, "-m", "uio_teach", *argv],
         capture_output=True,

@@ -30,6 +30,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn, TextIO
 
+import matplotlib
+
 from .. import __version__
 from .config import DPI_RANGE, ConfigError, FigureConfig, check_dpi, load_config
 from .output import FORMATS, MANIFEST, OutputError, check_output_folder
@@ -488,8 +490,6 @@ def _figures(args: argparse.Namespace) -> int:
     except OSError as err:
         _error("figures", str(err))
         return 1
-
-    import matplotlib
 
     matplotlib.use("Agg")  # no display needed, and the same pixels everywhere
 
