@@ -212,9 +212,9 @@ def leftovers(parent: Path) -> list[str]:
 def uio_teach(*argv: str, kill_at: int | None = None, **kwargs) -> subprocess.CompletedProcess:
     """``python -m uio_teach ARGV`` in a child process (killed at its step ``kill_at``)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), *sys.path]))
-    env.pop(output._KILL_AT, None)
+    env.pop(output.KILL_AT_ENV, None)
     if kill_at is not None:
-        env[output._KILL_AT] = str(kill_at)
+        env[output.KILL_AT_ENV] = str(kill_at)
     return subprocess.run(
         [sys.executable, "-m", "uio_teach", *argv],
         capture_output=True,
@@ -470,3 +470,107 @@ def test_a_closed_pipe_ends_quietly(argv):
         os.close(write)
     assert proc.returncode == 0
     assert proc.stderr == b""  # no BrokenPipeError, no "Exception ignored"
+
+
+# the student and the instructor edition of the book (_ext/editions.py) ---------------------------
+
+LAB_PAGE = """\
+---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+    format_version: 0.13
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+
+# A lab
+
+```{exercise}
+:label: ex-demo-1
+Compute `x`.
+```
+
+```{solution-start} ex-demo-1
+:class: dropdown
+```
+
+The model answer says SECRET-PROSE.
+
+```{code-cell} ipython3
+:tags: [solution]
+x = "SECRET-CODE"
+```
+
+```{solution-end}
+```
+
+```{code-cell} ipython3
+y = "VISIBLE-CHECK"
+```
+
+```{code-cell} ipython3
+:tags: [solution]
+z = "SECRET-LOOSE-CELL"
+```
+
+(sec-demo-instructor)=
+## Instructor notes
+
+Tutors only: SECRET-NOTE.
+
+### What the groups should find
+
+SECRET-FINDINGS.
+
+## Index
+
+See {ref}`sec-demo-instructor`.
+"""
+
+
+def build_edition(tmp_path: Path, edition: str) -> subprocess.CompletedProcess:
+    """Build LAB_PAGE with Sphinx (myst-nb, sphinx-exercise, the book's editions extension)."""
+    src = tmp_path / "src"
+    src.mkdir(exist_ok=True)
+    (src / "index.md").write_text(LAB_PAGE)
+    (src / "conf.py").write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(ROOT / '_ext')!r})\n"
+        "extensions = ['myst_nb', 'sphinx_exercise', 'editions']\n"
+        "nb_execution_mode = 'off'\n"
+    )
+    env = dict(os.environ, UIO_TEACH_EDITION=edition)
+    return subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "-E", "-q", "-b", "html", str(src),
+         str(tmp_path / "html")],
+        capture_output=True, text=True, env=env, check=False,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("edition", ["student", "instructor"])
+def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edition):
+    proc = build_edition(tmp_path, edition)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "html"
+    html = (out / "index.html").read_text(encoding="utf-8")
+    secrets = ["SECRET-PROSE", "SECRET-CODE", "SECRET-LOOSE-CELL", "SECRET-NOTE", "SECRET-FINDINGS"]
+    assert "VISIBLE-CHECK" in html and "Compute" in html
+    assert "Instructor notes" in html  # the heading stays, and references to it resolve
+    if edition == "student":
+        assert [s for s in secrets if s in html] == []
+        assert "instructor edition" in html and "book-instructor" in html
+        assert not (out / "_sources").exists()  # no copy of the page's source
+        assert "SECRET" not in (out / "searchindex.js").read_text(encoding="utf-8")
+    else:
+        assert [s for s in secrets if s not in html] == []
+        assert (out / "_sources").exists()
+
+
+def test_an_unknown_edition_is_refused(tmp_path):
+    proc = build_edition(tmp_path, "teachers")
+    assert proc.returncode != 0
+    assert "UIO_TEACH_EDITION must be one of student, instructor, got 'teachers'" in proc.stderr

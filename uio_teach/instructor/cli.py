@@ -24,10 +24,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import textwrap
 import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn, TextIO
+
+import matplotlib
 
 from .. import __version__
 from .config import DPI_RANGE, ConfigError, FigureConfig, check_dpi, load_config
@@ -139,10 +142,13 @@ is still missing; a question answered in words gets a "Your answer" cell.
 The numbers of each lab (poles, disturbances, switching times, noise, seeds)
 are in its cell tagged `parameters` (`PARAMS = {...}`); the code and the checks
 read them from there. --config takes them from the term config (the keys of
-`uio-teach figures --print-config`: pa9.*, case_study.*, seed,
-missile.pmo_poles). --groups N --seed S draws numbers of its own for every
-group, each a fair exercise (the observer exists, poles distinct and stable,
-disturbances visible), and writes
+`uio-teach figures --print-config`). These keys go into PARAMS but the notebooks
+do not read them:
+{unread}
+
+--groups N --seed S draws numbers of its own for every group, each a fair
+exercise (the observer exists, poles distinct and stable, disturbances
+visible), and writes
 
   DIR/<lab>/student/<lab>_g01.ipynb, DIR/<lab>/solution/<lab>_g01.ipynb, ...
   DIR/answer_key.csv        one row per lab and group: lab, group, params,
@@ -297,6 +303,17 @@ def _dpi(text: str) -> int:
         raise argparse.ArgumentTypeError(str(err).removeprefix("dpi: ")) from None
 
 
+def _labs_description() -> str:
+    from .labs import UNREAD_CONFIG_KEYS  # deferred on purpose (see the imports)
+
+    lines = []
+    for entry in UNREAD_CONFIG_KEYS:
+        lines += textwrap.wrap(
+            entry.text(), width=76, initial_indent="  * ", subsequent_indent="    "
+        )
+    return _LABS_DESCRIPTION.replace("{unread}", "\n".join(lines))
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``uio-teach`` (with the ``figures`` and ``labs`` commands).
 
@@ -364,7 +381,7 @@ def build_parser() -> argparse.ArgumentParser:
     labs = commands.add_parser(
         "labs",
         help="write the lab notebooks (student and solution versions)",
-        description=_LABS_DESCRIPTION,
+        description=_labs_description(),
         epilog=_LABS_EPILOG,
         formatter_class=_Formatter,
     )
@@ -473,8 +490,6 @@ def _figures(args: argparse.Namespace) -> int:
     except OSError as err:
         _error("figures", str(err))
         return 1
-
-    import matplotlib
 
     matplotlib.use("Agg")  # no display needed, and the same pixels everywhere
 

@@ -46,6 +46,8 @@ from .output import MANIFEST, StagedFolder, write_manifest
 from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
 __all__ = [
+    "UNREAD_CONFIG_KEYS",
+    "UnreadKeys",
     "ANSWER_KEY",
     "MANIFEST",
     "VERSIONS",
@@ -64,6 +66,57 @@ __all__ = [
     "make_notebook",
     "write_labs",
 ]
+
+
+@dataclass(frozen=True)
+class UnreadKeys:
+    """Keys of the term config that a lab's notebooks are given (in PARAMS) but do not read.
+
+    Attributes
+    ----------
+    keys : tuple of str
+        The config keys.
+    labs : tuple of str
+        The labs (ids of :data:`LABS`) whose notebooks do not read them.
+    why : str
+        The reason, for the help and the instructors' page.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.labs import UNREAD_CONFIG_KEYS
+    >>> "style" in UNREAD_CONFIG_KEYS[0].keys
+    True
+    """
+
+    keys: tuple[str, ...]
+    labs: tuple[str, ...]
+    why: str
+
+    def text(self) -> str:
+        """One sentence: the keys, the labs, why."""
+        labs = "every lab" if set(self.labs) == set(LABS) else " and ".join(self.labs)
+        return f"{' and '.join(self.keys)} ({labs}): {self.why}"
+
+
+UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (
+    UnreadKeys(
+        ("style",),
+        tuple(LABS),
+        "the notebooks draw with the matplotlib settings of the Jupyter they run in, the "
+        "student's own",
+    ),
+    UnreadKeys(
+        ("pa9.noise", "seed"),
+        ("pa9",),
+        "the noise exercise states its noise level and seed in its text (noise=0.01, seed=1), "
+        "and its question and model answer are written for them",
+    ),
+)
+"""What ``labs --config`` puts into PARAMS but the notebooks do not read, and why.
+
+``uio-teach labs --help`` and the instructors' page say so; a test checks, key by key, that
+the notebooks read every other key of the term config that changes their PARAMS.
+"""
 
 
 @dataclass(frozen=True)

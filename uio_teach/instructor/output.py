@@ -15,6 +15,13 @@ output, and it may hold someone's work. :func:`write_manifest` records what a
 run used and made (the configuration and its hash, the versions, every file
 with its SHA-256).
 
+:class:`StagedFolder` is the one way the instructor's commands write a folder
+(``figures``, ``labs`` and the graders' feedback): it also holds a
+:class:`FolderLock` (one run per folder at a time), removes what killed runs
+left beside the folder (:func:`clean_leftovers`), gives the folder the user's
+usual permissions and swaps it in with one atomic exchange on Linux, so a run
+killed at any point leaves the old set or the new set of files, never a mix.
+
 Examples
 --------
 >>> from uio_teach.instructor.output import FORMATS
@@ -52,6 +59,7 @@ __all__ = [
     "StagedFolder",
     "FolderLock",
     "clean_leftovers",
+    "KILL_AT_ENV",
     "save_figure",
     "prepare_output_dir",
     "write_manifest",
@@ -432,16 +440,18 @@ class FolderLock:
         self.release()
 
 
-_KILL_AT = "UIO_TEACH_KILL_AT"
-"""Testing aid: ``UIO_TEACH_KILL_AT=k`` makes a run kill itself (SIGKILL) at its k-th step."""
+KILL_AT_ENV = "UIO_TEACH_KILL_AT"
+"""A testing aid: with ``UIO_TEACH_KILL_AT=k`` in its environment, a run kills itself (SIGKILL)
+at its k-th step (a file written into the staging folder, or a point of the swap), so that the
+tests can check what a kill at that moment leaves. Unset, it does nothing."""
 _steps = 0
 
 
 def _step() -> None:
-    """One step of a staged run: a file written, or a point of the swap (see ``_KILL_AT``)."""
+    """One step of a staged run: a file written, or a point of the swap (see ``KILL_AT_ENV``)."""
     global _steps
     _steps += 1
-    wanted = os.environ.get(_KILL_AT)
+    wanted = os.environ.get(KILL_AT_ENV)
     if wanted and wanted.isdigit() and int(wanted) == _steps:
         os.kill(os.getpid(), signal.SIGKILL)
 
