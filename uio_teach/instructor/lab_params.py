@@ -518,10 +518,10 @@ class CaseStudyParams(LabParams):
         (``L D = 0``) and the moved pole's gain differ between groups;
         :meth:`problems` makes sure that ``M`` exists, the two fixed modes are
         stable and the LMI is feasible. The pole lies in [-0.6, 0.3], at least
-        0.1 from the fixed modes and from the eigenvalues of ``A1`` (so that
-        moving it takes a gain); the unknown inputs have amplitudes of at least
-        0.5; ``x[0]`` has integer entries and a nonzero initial error
-        ``(I - MC) x[0]``.
+        0.1 from the fixed modes and from the eigenvalues of ``A1`` (moving it
+        takes a gain; a term's own pole must be 0.05 from them); the unknown
+        inputs have amplitudes of at least 0.5; ``x[0]`` has integer entries
+        and a nonzero initial error ``(I - MC) x[0]``.
         """
         base = base or cls()
         B2 = [[_choice(rng, [1.0, 2.0])], *([_choice(rng, [-1.0, 1.0, 2.0])] for _ in range(2))]
@@ -586,7 +586,7 @@ class CaseStudyParams(LabParams):
         if np.max(np.abs(decoupling(plant).M)) > 10:
             out.append("M has entries too large for a fair hand computation")
         natural = np.linalg.eigvals(decoupling(plant).A1)
-        if np.min(np.abs(natural - self.pole)) < 0.1:
+        if np.min(np.abs(natural - self.pole)) < 0.05:
             # the mode is there already: L = 0 would "move" it, for every group alike
             out.append("the movable pole must be moved: away from the eigenvalues of A1")
         if not out:
