@@ -88,7 +88,8 @@ def test_wrong_H_is_named():
     result = checks.pa9_design(np.zeros((3, 2)), np.eye(3), K1)
     assert not result.passed
     assert "H does not satisfy (I - HC)E = 0" in result.failures[0]
-    assert "np.linalg.pinv(C @ E)" in result.failures[0]
+    assert "generalized inverse" in result.failures[0]
+    assert "pinv(C @ E)" not in result.failures[0]  # the idea, not the solution line
 
 
 def test_printed_two_decimal_matrices_are_explained():
@@ -138,8 +139,8 @@ def test_unstable_F_names_the_eigenvalue():
     result = checks.pa9_design(bad.H, bad.T, bad.K1, bad.F, bad.K2)
     assert result.failures == [
         "F is not stable: the eigenvalue 0.5 is not in the open left half-plane, so the error "
-        "e' = F e does not decay. Choose K1 so that TA - K1C has the poles you want, e.g. "
-        "K1 = ct.place((T @ A).T, C.T, [-1, -2, -3]).T."
+        "e' = F e does not decay. Choose K1 so that TA - K1C has the poles of the exercise "
+        "(pole placement for the pair (TA, C), by duality)."
     ]
 
 
@@ -147,7 +148,7 @@ def test_unstable_F_names_the_eigenvalue():
     ("args", "message"),
     [
         ((H.T, T, K1), "H has shape (2, 3) but must be a 3 x 2 matrix"),
-        ((H.T, T, K1), "It looks transposed: use H.T."),
+        ((H.T, T, K1), "It looks transposed: use H.T instead."),
         ((H, T[:2], K1), "T has shape (2, 3) but must be a 3 x 3 matrix"),
         ((H, T, K1.ravel()), "K1 is a 1-D array of shape (6,)"),
         ((H, T, [[1, 2], [3]]), "K1 could not be read as a matrix of numbers"),
@@ -251,7 +252,7 @@ def test_piecewise_passes_and_matches_the_sinusoid(steps_response, sine_response
 def test_piecewise_needs_jumps(uio, sine_response):
     assert "not piecewise constant" in failures_text(checks.pa9_piecewise(sine_response))
     const = ut.simulate(PLANT, uio, TIME, d=ut.signals.step(1.0), initial_state=X0)
-    assert "at least one jump" in failures_text(checks.pa9_piecewise(const))
+    assert "needs jumps" in failures_text(checks.pa9_piecewise(const))
 
 
 def test_piecewise_comparison_needs_the_same_start_and_grid(uio, sine_response):
