@@ -236,11 +236,10 @@ def case_study_lmi(
     else:
         Pm = read_matrix(result, "P", P, n, n, f"n x n = {n} x {n}")
     Ym = read_matrix(result, "Y", Y, n, p, f"n x p = {n} x {p}") if Y is not None else None
-    if L is None or Pm is None or (Y is not None and Ym is None):
+    if L is None:
         return result
-    if not _P_definite(result, Pm, tol):
-        return result
-    from_solve = _L_from_solve(result, L, Pm, Ym, tol)
+    certified = Pm is not None and (Y is None or Ym is not None) and _P_definite(result, Pm, tol)
+    from_solve = _L_from_solve(result, L, Pm, Ym, tol) if certified else False
     _LD(result, L, plant, tol)
     F = _error_matrix(plant, L)
     eig = np.linalg.eigvals(F)
@@ -258,7 +257,7 @@ def case_study_lmi(
             f"{worst:.4g} in magnitude, on or outside the unit circle. The LMI as printed is "
             "non-strict and accepts such a gain: the exercise's margin excludes it.",
         )
-    if from_solve is not False:
+    if certified and from_solve is not False:
         block = np.block([[-Pm, F.T @ Pm], [Pm @ F, -Pm]])
         top = float(np.max(np.linalg.eigvalsh((block + block.T) / 2)))
         if top <= -float(margin) + tol * max(1.0, float(np.max(np.abs(Pm)))):
@@ -304,8 +303,6 @@ def _L_from_solve(
         hint = " Your L is Y itself: Y = PL, so P must be divided out."
     elif close(L, Pm @ Ym, tol):
         hint = " Your L is P Y: Y = PL, so L is P^-1 Y, not P Y."
-    elif close(L, Ym @ np.linalg.inv(Pm), tol):
-        hint = " Your L is Y P^-1: the factors are in the wrong order (Y = PL)."
     else:
         hint = " Are L, P and Y from the same solve?"
     result.add(False, f"L is not P^-1 Y with the solver's P and Y.{hint}")
@@ -712,12 +709,17 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
         }
 
     def shows_Nr(ax: Any) -> bool:
+        tiny = float(np.max(np.abs(Nr))) <= 1e-9 * scale
         for ln in ax.get_lines():
             y = np.asarray(ln.get_ydata(), float)
-            if y.shape != (N,) or not np.any(Nr):
+            if y.shape != (N,):
+                continue
+            if tiny:
+                if float(np.max(np.abs(y))) <= 1e-8 * scale:
+                    return True
                 continue
             k = float(np.dot(Nr, y) / np.dot(Nr, Nr))
-            if abs(k) > 1e-9 and np.allclose(y, k * Nr, rtol=0, atol=1e-8 * abs(k) * scale):
+            if abs(k) > 1e-9 and np.linalg.norm(y - k * Nr) <= 1e-6 * np.linalg.norm(y):
                 return True
         return False
 

@@ -228,7 +228,16 @@ def curves_against_time(
         result.add(False, "the panels draw time in different units: use one unit throughout.")
         return False
     (k,) = factors
-    if units and not discrete_index:
+    if units and discrete_index:
+        wrong = sorted(u for u in units if u not in ("steps", "s"))
+        if wrong:
+            result.add(
+                False,
+                f"the x-label says time in {_UNIT_NAME[wrong[0]]}, but the curves are drawn "
+                "against the steps k of the run: the label's unit must be the unit of the data.",
+            )
+            return False
+    elif units:
         wrong = sorted(u for u in units if _SCALE[u] != k or u == "steps")
         drawn = {1.0: "s", 1e3: "ms", 1e6: "µs"}[k]
         if wrong:
