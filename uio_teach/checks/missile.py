@@ -334,10 +334,11 @@ def _run_as_asked(
     if initial_state is not None:
         want = np.asarray(initial_state, float).ravel()
         if want.shape != x0.shape or not np.allclose(x0, want, rtol=0, atol=1e-9):
+            dropped = " (initial_state was left out?)" if not np.any(x0) else ""
             result.add(
                 False,
                 f"the plant starts from x(0) = {numbers(x0)}, but the exercise asks for the "
-                "paper's x0 (the set-up cell's x0): pass it as initial_state.",
+                f"paper's x0 (the set-up cell's x0){dropped}.",
             )
             ok = False
     elif not np.any(x0):
