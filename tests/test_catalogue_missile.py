@@ -282,7 +282,7 @@ CATALOGUE = {
         ),
         "are not those of the run",
     ),
-    # the figure of v and v̂ --------------------------------------------------------------------------
+    # the figure of v and v̂ ----------------------------------------------------------------------
     "figure left out": (lambda: plot(None), "fig is missing (None)"),
     "only the estimates": (lambda: plot(figure(rows=())), "the figure lacks v1, v2"),
     "only v, no estimate": (lambda: plot(figure(est=False)), "the figure lacks v̂1, v̂2"),

@@ -152,7 +152,7 @@ def test_unstable_F_names_the_eigenvalue():
         ((H, T[:2], K1), "T has shape (2, 3) but must be a 3 x 3 matrix"),
         ((H, T, K1.ravel()), "K1 is a 1-D array of shape (6,)"),
         ((H, T, [[1, 2], [3]]), "K1 could not be read as a matrix of numbers"),
-        ((H, T, "K1"), "K1 must hold numbers, got 'K1'"),
+        ((H, T, "K1"), "K1 must hold numbers, got text"),
         ((None, T, K1), "H is missing"),
         ((H, T, K1 * 1j), "K1 has complex entries"),
         ((H, T, np.full((3, 2), np.nan)), "K1[0, 0] is nan"),

@@ -447,7 +447,7 @@ def read_matrix(
     >>> result = CheckResult("demo")
     >>> read_matrix(result, "H", [[1, 2, 3]], 3, 1, "one column") is None
     True
-    >>> result.failures[0][-15:]
+    >>> result.failures[0][-16:]
     'use H.T instead.'
     """
     expected = f"a {rows} x {cols} matrix ({what})"
@@ -474,8 +474,8 @@ def read_matrix(
     try:
         arr = arr.astype(float)
     except (TypeError, ValueError):
-        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
-        result.add(False, f"{name} must hold numbers, got {shown}; it must be {expected}.")
+        got = "text" if isinstance(value, str) else type(value).__name__
+        result.add(False, f"{name} must hold numbers, got {got}; it must be {expected}.")
         return None
     if arr.ndim == 0 and rows == cols == 1:
         arr = arr.reshape(1, 1)
@@ -551,7 +551,7 @@ def read_response(result: CheckResult, response: Any, name: str = "response") ->
     --------
     >>> from uio_teach.checks.common import CheckResult, read_response
     >>> result = CheckResult("demo")
-    >>> read_response(result, [1, 2]) is None, result.failures[0][-8:]
+    >>> read_response(result, [1, 2]) is None, result.failures[0][-9:]
     (True, 'got list.')
     """
     if response is None or not all(hasattr(response, a) for a in RESPONSE_FIELDS):
