@@ -623,7 +623,7 @@ class Lab:
     --------
     >>> from uio_teach.instructor.labs import LABS
     >>> LABS["pa9"].check_ids
-    ('pa9.design', 'pa9.simulation', 'pa9.plot', 'pa9.piecewise')
+    ('pa9.design', 'pa9.simulation', 'pa9.plot', 'pa9.piecewise', 'pa9.piecewise_plot')
     """
 
     id: str
@@ -640,7 +640,7 @@ def _registry() -> dict[str, Lab]:
             "pa9",
             "lab_pa9.md",
             PA9Params,
-            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise"),
+            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise", "pa9.piecewise_plot"),
         ),
         "case_study": Lab(
             "case_study",
@@ -652,6 +652,7 @@ def _registry() -> dict[str, Lab]:
                 "case_study.pole",
                 "case_study.simulation",
                 "case_study.residual",
+                "case_study.plot",
             ),
         ),
         "missile": Lab(
@@ -662,6 +663,7 @@ def _registry() -> dict[str, Lab]:
                 "missile.pmo",
                 "missile.ginverse",
                 "missile.reconstruction",
+                "missile.plot",
                 "missile.catch_times",
                 "missile.noise",
             ),
