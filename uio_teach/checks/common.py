@@ -42,6 +42,7 @@ __all__ = [
     "same_plant",
     "check_plant_of",
     "same_poles",
+    "same_observer",
     "as_poles",
 ]
 
@@ -639,3 +640,27 @@ def as_poles(poles: Any) -> np.ndarray:
     [(-1+0j), (-1+2j)]
     """
     return np.array([complex(p) for p in np.ravel(np.asarray(poles, dtype=object))])
+
+
+def same_observer(a: Any, b: Any) -> bool:
+    """True if two observers are of one family with the same matrices (``H``, ``K1``, ``M``, ``L``...).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.checks.common import same_observer
+    >>> plant = ut.examples.pa9()
+    >>> same_observer(ut.design_uio(plant, poles=[-1, -2, -3]), ut.design_uio(plant, poles=[-1, -2, -3]))
+    True
+    """  # noqa: E501
+    if a is b:
+        return True
+    if type(a) is not type(b) or getattr(a, "family", None) != getattr(b, "family", None):
+        return False
+    for name in ("F", "H", "T", "K1", "K2", "L", "M", "error_matrix"):
+        x, y = getattr(a, name, None), getattr(b, name, None)
+        if x is None and y is None:
+            continue
+        if x is None or y is None or np.shape(x) != np.shape(y) or not np.allclose(x, y):
+            return False
+    return True

@@ -47,6 +47,7 @@ from .common import (
     numbers,
     read_matrix,
     read_response,
+    same_observer,
     same_poles,
     up_to,
 )
@@ -276,20 +277,6 @@ def _paper_v(result: CheckResult, resp) -> bool:
     return False
 
 
-def _same_observer(a: Any, b: Any) -> bool:
-    if a is b:
-        return True
-    if getattr(a, "family", None) != getattr(b, "family", None):
-        return False
-    for name in ("M", "L", "F", "error_matrix"):
-        x, y = getattr(a, name, None), getattr(b, name, None)
-        if x is None and y is None:
-            continue
-        if x is None or y is None or np.shape(x) != np.shape(y) or not np.allclose(x, y):
-            return False
-    return True
-
-
 def _run_as_asked(
     result: CheckResult,
     resp: Any,
@@ -313,7 +300,7 @@ def _run_as_asked(
             "asks for the PMO of the first exercise.",
         )
         ok = False
-    elif observer is not None and not _same_observer(resp.observer, observer):
+    elif observer is not None and not same_observer(resp.observer, observer):
         result.add(
             False,
             "the run simulates another PMO than yours of the first exercise (its M or L "

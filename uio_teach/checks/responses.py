@@ -32,6 +32,7 @@ from .common import (
     numbers,
     plural,
     read_response,
+    same_observer,
     same_poles,
     stability,
     up_to,
@@ -406,7 +407,7 @@ def _compare(result: CheckResult, resp, other) -> None:
             "initial_state in both.",
         )
         return
-    if not _same_observer(resp.observer, other.observer):
+    if not same_observer(resp.observer, other.observer):
         result.add(
             False,
             f"the two simulations use different observers (a {resp.observer.family} here, "
@@ -436,20 +437,6 @@ def _compare(result: CheckResult, resp, other) -> None:
             f"the error differs from the sinusoidal test by up to {diff:.3g}: are both "
             "simulations made with the same decoupling observer?",
         )
-
-
-def _same_observer(a: Any, b: Any) -> bool:
-    if a is b:
-        return True
-    if type(a) is not type(b) or getattr(a, "family", None) != getattr(b, "family", None):
-        return False
-    for name in ("F", "H", "T", "K1", "K2", "L", "M", "error_matrix"):
-        x, y = getattr(a, name, None), getattr(b, name, None)
-        if x is None and y is None:
-            continue
-        if x is None or y is None or np.shape(x) != np.shape(y) or not np.allclose(x, y):
-            return False
-    return True
 
 
 def _asked_signal(result: CheckResult, got: np.ndarray, want: np.ndarray, what: str) -> None:
