@@ -248,7 +248,7 @@ CATALOGUE = {
     ),
     "poles as a string": (
         lambda: checks.pa9_simulation(SINE_RESP, poles="-1, -2, -3"),
-        "could not read your answer",
+        "could not read your answer: text where numbers are expected",
     ),
     # requirement 3: the figure -----------------------------------------------------------------
     "figure left out": (lambda: plot(None), "fig is missing (None)"),

@@ -263,6 +263,10 @@ def likely_cause(exc: BaseException) -> str:
     'a matrix or signal of the wrong size'
     """
     text = str(exc).lower()
+    if isinstance(exc, (ValueError, TypeError)) and any(
+        w in text for w in ("string", "str'", "could not convert")
+    ):
+        return "text where numbers are expected (write numbers, or take them from PARAMS)"
     if isinstance(exc, AttributeError):
         return (
             "an argument is not the kind of object asked for (e.g. a matrix where a "
