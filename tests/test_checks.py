@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.checks import CheckResult
+from uio_teach.checks.common import likely_cause, never_raises
 
 matplotlib.use("Agg")
 
@@ -373,3 +374,67 @@ def test_stacked_axes_need_only_the_bottom_x_label(sine_response):
     assert checks.pa9_plot(fig).passed
     ax_e.set_xlim(0, 5)  # a different time range needs its own label
     assert "axes 1 (error) has no x-label" in failures_text(checks.pa9_plot(fig))
+
+
+# no traceback, whatever a group passes -----------------------------------------------------------
+
+GARBAGE = [None, "H", 3, [[1, 2], [3]], {"a": 1}, np.zeros((7, 7)), object()]
+CHECK_CALLS = {
+    "pa9_design": lambda x: checks.pa9_design(x, x, x, x, x, plant=PLANT, poles=[-1, -2, -3]),
+    "pa9_simulation": lambda x: checks.pa9_simulation(x, H=x, K1=x, plant=PLANT),
+    "pa9_plot": lambda x: checks.pa9_plot(x, x, plant=PLANT),
+    "pa9_piecewise": lambda x: checks.pa9_piecewise(x, x, plant=PLANT),
+    "pa9_piecewise_plot": lambda x: checks.pa9_piecewise_plot(x, x),
+    "case_study_projection": lambda x: checks.case_study_projection(x),
+    "case_study_lmi": lambda x: checks.case_study_lmi(x, x, Y=x),
+    "case_study_pole": lambda x: checks.case_study_pole(x, 0.3),
+    "case_study_simulation": lambda x: checks.case_study_simulation(x, observer=x),
+    "case_study_residual": lambda x: checks.case_study_residual(x, x, x),
+    "case_study_plot": lambda x: checks.case_study_plot(x, x),
+    "missile_pmo": lambda x: checks.missile_pmo(x, x, x, poles=[-100, -120]),
+    "missile_ginverse": lambda x: checks.missile_ginverse(x, x, x),
+    "missile_reconstruction": lambda x: checks.missile_reconstruction(x, x, observer=x),
+    "missile_catch_times": lambda x: checks.missile_catch_times(x, x, x),
+    "missile_noise": lambda x: checks.missile_noise(x, x, sigma=0.01),
+    "missile_plot": lambda x: checks.missile_plot(x, x),
+}
+
+
+def test_every_public_check_is_exercised_here():
+    public = {n for n in checks.__all__ if n.startswith(("pa9_", "case_study_", "missile_"))}
+    assert public == set(CHECK_CALLS)
+
+
+@pytest.mark.parametrize("name", list(CHECK_CALLS))
+@pytest.mark.parametrize("garbage", range(len(GARBAGE)))
+def test_garbage_gets_a_cross_not_a_traceback(name, garbage):
+    result = CHECK_CALLS[name](GARBAGE[garbage])
+    assert isinstance(result, checks.CheckResult)
+    assert not result.passed and result.failures
+    assert result.check_id == getattr(checks, name).check_id
+
+
+@pytest.mark.parametrize(
+    ("exc", "cause"),
+    [
+        (ValueError("matmul: Input operand 1 has a mismatch in its core dimension"), "wrong size"),
+        (ValueError("could not convert string to float: 'x'"), "text where numbers"),
+        (AttributeError("'PMO' object has no attribute 'time'"), "not the kind of object"),
+        (TypeError("unsupported operand type(s)"), "of the wrong type"),
+        (np.linalg.LinAlgError("Singular matrix"), "singular"),
+    ],
+)
+def test_an_exception_is_named_by_its_likely_cause(exc, cause):
+    assert cause in likely_cause(exc)
+
+
+def test_a_raising_check_names_the_cause_in_its_cross():
+    @never_raises("demo", check_id="demo.shape")
+    def check(x):
+        return checks.CheckResult(
+            "demo", [(bool(np.ones((2, 3)) @ np.asarray(x) is not None), "ok")]
+        )
+
+    result = check(np.ones(4))
+    assert result.failures[0].startswith("the check could not read your answer: a matrix")
+    assert result.check_id == "demo.shape"
