@@ -431,6 +431,13 @@ def case_study_simulation(
     if resp is None or not check_plant_of(result, resp, plant):
         return result
     _observer_as_asked(result, resp, observer)
+    _signals_as_asked(result, resp, u2, v, initial_state)
+    _ignores_and_decays(result, resp, decay)
+    return result
+
+
+def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_state: Any) -> None:
+    """✓/✗ on u2 (the plant's d), the staircase v and x[0], as the exercise asks."""
     t = np.asarray(resp.time, float)
     d = np.asarray(resp.inputs.d, float)
     vv = np.asarray(resp.inputs.v, float)
@@ -473,6 +480,11 @@ def case_study_simulation(
                 f"asks for {numbers(want_x0)}"
                 + (" (initial_state left out?)." if not np.any(resp.states[:, 0]) else "."),
             )
+
+
+def _ignores_and_decays(result: CheckResult, resp: Any, decay: float) -> None:
+    """✓/✗: the error is the same without u2 and v, and decays."""
+    t = np.asarray(resp.time, float)
     quiet = simulate(
         resp.plant,
         resp.observer,
@@ -513,7 +525,6 @@ def case_study_simulation(
             f"the error has not decayed: {e1:.3g} at the end against {e0:.3g} at k = 0; run more "
             "steps.",
         )
-    return result
 
 
 def _observer_as_asked(result: CheckResult, resp: Any, observer: Any) -> None:

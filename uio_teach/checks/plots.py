@@ -474,52 +474,47 @@ def _curves(ax, N: int) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def _panel_content(ax: Any, resp: Any, tol: float) -> dict:
+    """Which rows of e, -e, r, y, x, x̂ (and the norm of e) the curves of one panel are."""
+    N = resp.time.size
+    err = np.asarray(resp.error, float)
+    found: dict = {"e": set(), "-e": set(), "r": set(), "y": set(), "x": set(), "xhat": set()}
+    found["norm"] = False
+    found["other"] = 0
+    for _, cy in _curves(ax, N):
+        hit = False
+        for key, M in (
+            ("e", err),
+            ("-e", -err),
+            ("r", resp.residual),
+            ("y", resp.outputs),
+            ("x", resp.states),
+            ("xhat", resp.estimates),
+        ):
+            rows = _match_rows(cy, np.asarray(M, float), tol)
+            found[key].update(rows)
+            hit = hit or bool(rows)
+        if np.allclose(cy, np.linalg.norm(err, axis=0), rtol=0, atol=tol):
+            found["norm"] = hit = True
+        found["other"] += not hit
+    return found
+
+
 def _check_curves(
     result: CheckResult, axes: Sequence, kinds: Sequence[str], resp: Any, units: set
 ) -> None:
-    N = resp.time.size
     err = np.asarray(resp.error, float)
-    res = np.asarray(resp.residual, float)
-    x = np.asarray(resp.states, float)
-    xhat = np.asarray(resp.estimates, float)
-    yy = np.asarray(resp.outputs, float)
-    tol = 1e-9 * max(1.0, float(np.max(np.abs(x))))
-    n, p = err.shape[0], res.shape[0]
-    t = np.asarray(resp.time, float)
-
-    if not curves_against_time(result, axes, t, units):
+    tol = 1e-9 * max(1.0, float(np.max(np.abs(resp.states))))
+    n, p = err.shape[0], np.shape(resp.residual)[0]
+    if not curves_against_time(result, axes, np.asarray(resp.time, float), units):
         return
-
-    def content(ax) -> dict:
-        found = {"e": set(), "-e": set(), "r": set(), "y": set(), "x": set(), "xhat": set()}
-        found["norm"] = False
-        found["other"] = 0
-        for _, cy in _curves(ax, N):
-            hit = False
-            for key, M in (
-                ("e", err),
-                ("-e", -err),
-                ("r", res),
-                ("y", yy),
-                ("x", x),
-                ("xhat", xhat),
-            ):
-                rows = _match_rows(cy, M, tol)
-                found[key].update(rows)
-                hit = hit or bool(rows)
-            if np.allclose(cy, np.linalg.norm(err, axis=0), rtol=0, atol=tol):
-                found["norm"] = hit = True
-            found["other"] += not hit
-        return found
-
     e_axes = [ax for ax, k in zip(axes, kinds, strict=True) if k == "e"]
     r_axes = [ax for ax, k in zip(axes, kinds, strict=True) if k == "r"]
     if not e_axes or not r_axes:
         return  # already a ✗ for the labels; the curves cannot be told apart
-    fe = content(e_axes[0])
-    fr = content(r_axes[0])
+    fe = _panel_content(e_axes[0], resp, tol)
+    fr = _panel_content(r_axes[0], resp, tol)
     all_e = fe["norm"] or len(fe["e"]) == n
-    all_r = len(fr["r"]) == p
     if not all_e and len(fr["e"]) == n and len(fe["r"]) == p and n != p:
         result.add(
             False,
@@ -528,6 +523,11 @@ def _check_curves(
         )
         return
     zero_e = {i for i in range(n) if np.allclose(err[i], 0, rtol=0, atol=tol)}
+    _error_panel(result, fe, all_e, zero_e, n)
+    _residual_panel(result, fr, n, p)
+
+
+def _error_panel(result: CheckResult, fe: dict, all_e: bool, zero_e: set, n: int) -> None:
     if all_e:
         result.add(True, "the error panel shows the error e = x - x̂ of the response.")
     elif len(fe["-e"] - zero_e) and not (fe["-e"] - zero_e) <= fe["e"]:
@@ -554,7 +554,10 @@ def _check_curves(
         result.add(
             False, "no curve of the error panel is the error e of the response (resp.error)."
         )
-    if all_r:
+
+
+def _residual_panel(result: CheckResult, fr: dict, n: int, p: int) -> None:
+    if len(fr["r"]) == p:
         result.add(True, "the residual panel shows the residual r = y - C x̂ of the response.")
     elif fr["y"] - fr["r"]:
         result.add(
