@@ -12,12 +12,18 @@ a list of ✓ / ✗ messages that say what is right, what is not, and how to fix
   ``e`` and the residual ``r``.
 * :func:`pa9_piecewise` -- a response with a piecewise-constant disturbance:
   the same error as with the sinusoid; :func:`pa9_piecewise_plot` its figure.
-* :mod:`uio_teach.checks.common` -- the result and the helpers every check
-  shares (reading matrices, runs and poles).
 * ``case_study_*`` -- the case-study lab (module ``uio_teach.checks.case_study``).
 * ``missile_*`` -- the missile lab (module ``uio_teach.checks.missile``).
+* :mod:`uio_teach.checks.common` -- the result and the helpers every check
+  shares (reading matrices, runs and poles); :mod:`uio_teach.checks.plots`
+  reads figures (time axes and their units, titles).
 
-Every result carries a ``check_id`` such as ``"pa9.design"``.
+Every graded quantity is checked by its defining property and against the
+group's own earlier answers (any valid ``H``, any solver's ``P`` and ``Y``),
+and a simulation by what the exercise fixes (observer, initial states,
+inputs). A ✗ names the mistake and the idea, never a solution line or the
+expected number. Every result carries a ``check_id`` such as
+``"pa9.design"``.
 
 Examples
 --------
