@@ -1,6 +1,8 @@
 """The lab checks: they pass on a right answer and name each kind of mistake, never raising."""
 
+import re
 import warnings
+from pathlib import Path
 
 import matplotlib
 import numpy as np
@@ -438,3 +440,29 @@ def test_a_raising_check_names_the_cause_in_its_cross():
     result = check(np.ones(4))
     assert result.failures[0].startswith("the check could not read your answer: a matrix")
     assert result.check_id == "demo.shape"
+
+
+# the lab chapters call every check on the set-up cell's plant -------------------------------------
+
+BOOK = Path(__file__).resolve().parent.parent / "book"
+
+
+def check_calls(text: str) -> list[str]:
+    """The text of every ``checks.<name>(...)`` call in the code cells of a chapter."""
+    calls = []
+    for cell in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S):
+        for start in re.finditer(r"\bchecks\.\w+\(", cell):
+            depth, i = 1, start.end()
+            while depth:
+                depth += {"(": 1, ")": -1}.get(cell[i], 0)
+                i += 1
+            calls.append(cell[start.start() : i])
+    return calls
+
+
+@pytest.mark.parametrize("chapter", ["lab_pa9.md", "lab_case_study.md", "lab_missile.md"])
+def test_every_check_cell_passes_the_set_up_plant(chapter):
+    calls = check_calls((BOOK / chapter).read_text(encoding="utf-8"))
+    assert len(calls) >= 5
+    assert [c for c in calls if "plant=plant" not in c] == []
+    assert all("PARAMS" in c or "poles" not in c for c in calls)
