@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import warnings
+
+import cvxpy as cp
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 
 import uio_teach as ut
 from uio_teach import checks
@@ -37,6 +41,49 @@ def staircase(amplitude, hold, seed):
 V_SIGNAL = staircase(*V)
 
 
+def solve_lmi(solver="CLARABEL"):
+    """The exercise's LMI, solved as a lab group does: the solver's P and Y."""
+    P_var = cp.Variable((n, n), symmetric=True)
+    Y_var = cp.Variable((n, p))
+    block = cp.bmat([[-P_var, A1.T @ P_var - C.T @ Y_var.T], [P_var @ A1 - Y_var @ C, -P_var]])
+    constraints = [block << -0.01 * np.eye(2 * n), Y_var @ D == 0, P_var >> 0.01 * EYE]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cp.Problem(cp.Minimize(0), constraints).solve(solver=solver)
+    return P_var.value, Y_var.value
+
+
+P_SOLVED, Y_SOLVED = solve_lmi()
+L_SOLVED = np.linalg.solve(P_SOLVED, Y_SOLVED)
+P_SCS, Y_SCS = solve_lmi("SCS")
+
+
+def lmi(gain=L_SOLVED, P=P_SOLVED, Y=Y_SOLVED):
+    return checks.case_study_lmi(gain, P, Y=Y, plant=PLANT)
+
+
+def plot_residual(r=None, dv=None, nr=None, xlabel="step k", x=None, run=None):
+    run = RUN if run is None else run
+    fig = Figure()
+    ax_r, ax_n = fig.subplots(2, 1, sharex=True)
+    x = run.time if x is None else x
+    r = run.residual if r is None else r
+    dv = D @ run.inputs.v if dv is None else dv
+    nr = N @ run.residual if nr is None else nr
+    ax_r.plot(x, r.T, label=[f"r{i + 1}" for i in range(r.shape[0])])
+    ax_r.plot(x, dv.T, "k--", label=[f"(Dv){i + 1}" for i in range(dv.shape[0])])
+    ax_r.set_ylabel("residual r and Dv")
+    ax_r.legend()
+    ax_n.plot(x, nr.T)
+    ax_n.set_ylabel("N r")
+    ax_n.set_xlabel(xlabel)
+    return fig
+
+
+def plot(fig, run=None):
+    return checks.case_study_plot(fig, RUN if run is None else run, plant=PLANT)
+
+
 def sim(observer=LMI, d=U2_SIGNAL, v=V_SIGNAL, x0=X0, steps=STEPS):
     return ut.simulate(PLANT, observer, steps, d=d, v=v, initial_state=x0)
 
@@ -44,8 +91,10 @@ def sim(observer=LMI, d=U2_SIGNAL, v=V_SIGNAL, x0=X0, steps=STEPS):
 RUN = sim()
 
 
-def simulation(resp):
-    return checks.case_study_simulation(resp, u2=U2, v=V, initial_state=X0)
+def simulation(resp, observer=None):
+    return checks.case_study_simulation(
+        resp, u2=U2, v=V, initial_state=X0, plant=PLANT, observer=observer
+    )
 
 
 def residual(Dv=None, Nr=None, run=RUN):
@@ -70,7 +119,7 @@ CATALOGUE = {
         lambda: checks.case_study_projection(B2 @ np.linalg.pinv(C @ B2)),
         "which ignores D",
     ),
-    "M with a minus sign": (lambda: checks.case_study_projection(-M), "drop the minus sign"),
+    "M with a minus sign": (lambda: checks.case_study_projection(-M), "check the sign"),
     "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(I - MC)B2 is not 0"),
     "M with a NaN": (
         lambda: checks.case_study_projection(np.where(M > 0.4, np.nan, M)),
@@ -78,24 +127,52 @@ CATALOGUE = {
     ),
     # L from the LMI ------------------------------------------------------------------------------
     "L left out": (lambda: checks.case_study_lmi(None), "L is missing"),
+    "L = Y_var.value (P divided out forgotten)": (
+        lambda: lmi(gain=Y_SOLVED),
+        "Your L is Y itself",
+    ),
+    "L = P_lmi @ Y_var.value": (lambda: lmi(gain=P_SOLVED @ Y_SOLVED), "Your L is P Y"),
+    "the LMI skipped (P_lmi = None), the package's gain": (
+        lambda: lmi(gain=L, P=None, Y=None),
+        "P is missing",
+    ),
+    "Y not passed": (lambda: lmi(Y=None), "Y is not given"),
+    "L of another solve": (
+        lambda: lmi(gain=np.linalg.solve(P_SCS, Y_SCS) + 0.05 * L_MOVED),
+        "L is not P^-1 Y",
+    ),
+    "P and Y of another solve": (
+        lambda: lmi(gain=L_SOLVED, P=P_SCS, Y=Y_SCS + 0.01),
+        "L is not P^-1 Y",
+    ),
     "L transposed": (lambda: checks.case_study_lmi(L.T), "It looks transposed"),
     "the printed L, rounded": (
-        lambda: checks.case_study_lmi(ut.examples.DT_CASE_STUDY_PUBLISHED.L),
+        lambda: lmi(gain=ut.examples.DT_CASE_STUDY_PUBLISHED.L),
         "rounded to 4 decimals",
     ),
-    "L without YD = 0": (lambda: checks.case_study_lmi(L + 0.1), "Add the constraint Y @ D == 0"),
+    "L without YD = 0": (
+        lambda: lmi(gain=L + 0.1, P=P_LMI, Y=P_LMI @ (L + 0.1)),
+        "is it in your LMI?",
+    ),
     "a gain on the unit circle": (
-        lambda: checks.case_study_lmi(L_EDGE),
+        lambda: lmi(gain=L_EDGE, P=P_LMI, Y=P_LMI @ L_EDGE),
         "F = A1 - LC is not stable",
     ),
-    "P not symmetric": (lambda: checks.case_study_lmi(L, P_BAD), "P is not symmetric positive"),
+    "P not symmetric": (
+        lambda: lmi(gain=L, P=P_BAD, Y=P_BAD @ L),
+        "P is not symmetric positive",
+    ),
     "P of another gain": (
-        lambda: checks.case_study_lmi(L_EDGE + 0.5 * L_MOVED, P_LMI),
+        lambda: lmi(L_EDGE + 0.5 * L_MOVED, P_LMI, P_LMI @ (L_EDGE + 0.5 * L_MOVED)),
         "P does not certify this L",
     ),
     "P negative definite": (
-        lambda: checks.case_study_lmi(L, -P_LMI),
+        lambda: lmi(gain=L, P=-P_LMI, Y=-P_LMI @ L),
         "P is not symmetric positive",
+    ),
+    "P as a cvxpy variable, not its value": (
+        lambda: lmi(P=cp.Variable((n, n), symmetric=True)),
+        "P could not be read as a matrix",
     ),
     # the movable pole ----------------------------------------------------------------------------
     "L_moved left out": (lambda: checks.case_study_pole(None, POLE), "L is missing"),
@@ -106,6 +183,10 @@ CATALOGUE = {
     "the pole moved elsewhere": (
         lambda: checks.case_study_pole(ut.design_pmo(PLANT, poles=[-0.3]).L, POLE),
         "F = A1 - LC has the poles -0.3, 0.5, 0.5",
+    ),
+    "the pole as a string": (
+        lambda: checks.case_study_pole(L_MOVED, "0.3 please"),
+        "could not read your answer",
     ),
     "a gain on y1 alone": (lambda: checks.case_study_pole(L_Y1, POLE), "LD is not 0"),
     "the factor l instead of L": (
@@ -142,6 +223,38 @@ CATALOGUE = {
         "the error depends on the unknown signals",
     ),
     "too few steps": (lambda: simulation(sim(steps=np.arange(3))), "the error has not decayed"),
+    "x0 dropped": (lambda: simulation(sim(x0=None)), "initial_state left out?"),
+    "the observer started from z[0] = -M y[0]": (
+        lambda: simulation(
+            ut.simulate(
+                PLANT,
+                LMI,
+                STEPS,
+                d=U2_SIGNAL,
+                v=V_SIGNAL,
+                initial_state=X0,
+                observer_state=-M @ C @ np.asarray(X0),
+            )
+        ),
+        "but the exercise asks for z[0] = 0",
+    ),
+    "the moved-pole observer instead of the LMI one": (
+        lambda: simulation(sim(observer=ut.design_pmo(PLANT, L=L_MOVED)), observer=LMI),
+        "another PMO than the one built from your LMI gain",
+    ),
+    "a run of another plant": (
+        lambda: simulation(
+            ut.simulate(
+                ut.Plant(0.9 * A, C, E=B2, D=D, dt=1.0),
+                ut.design_pmo(ut.Plant(0.9 * A, C, E=B2, D=D, dt=1.0), poles=[0.2]),
+                STEPS,
+                d=U2_SIGNAL,
+                v=V_SIGNAL,
+                initial_state=X0,
+            )
+        ),
+        "another plant than the one of the set-up cell",
+    ),
     # the residual --------------------------------------------------------------------------------
     "Dv left out": (
         lambda: checks.case_study_residual(None, N @ RUN.residual, RUN),
@@ -157,7 +270,7 @@ CATALOGUE = {
     ),
     "the residual instead of Dv": (
         lambda: residual(Dv=RUN.residual),
-        "Dv is not D @ resp.inputs.v",
+        "Dv is not D times the v of this run",
     ),
     "y seen through N": (
         lambda: residual(Nr=N @ RUN.outputs),
@@ -167,11 +280,77 @@ CATALOGUE = {
         lambda: residual(Nr=RUN.residual[:1]),
         "Nr is not the residual seen through a row N with N D = 0",
     ),
+    # the figure of r, D v and N r ---------------------------------------------------------------
+    "figure left out": (lambda: plot(None), "fig is missing (None)"),
+    "the residual without D v": (
+        lambda: plot(plot_residual(dv=np.zeros((0, STEPS.size)))),
+        "but not next to D v",
+    ),
+    "y instead of r": (lambda: plot(plot_residual(r=RUN.outputs)), "shows the outputs y"),
+    "no N r panel": (
+        lambda: plot(plot_residual(nr=RUN.outputs[:1])),
+        "no panel shows N r",
+    ),
+    "steps labelled as time in ms": (
+        lambda: plot(plot_residual(xlabel="time (ms)")),
+        "the x-label says time in ms",
+    ),
+    "an x-label without a unit": (
+        lambda: plot(plot_residual(xlabel="time")),
+        "has no unit",
+    ),
+    "curves against shifted steps": (
+        lambda: plot(plot_residual(x=STEPS + 1.0)),
+        "not plotted against the time points of the run",
+    ),
+    "the residual panel without labels": (
+        lambda: plot(_unlabelled(plot_residual())),
+        "does not say which curve is which",
+    ),
 }
 
 
+def _unlabelled(fig):
+    ax = fig.axes[0]
+    ax.set_ylabel("")
+    ax.get_legend().remove()
+    for line in ax.get_lines():
+        line.set_label("_nolegend_")
+    return fig
+
+
+# right answers that differ from the book's ------------------------------------------------------
+RIGHT_BUT_DIFFERENT = {
+    "the book's solve": lambda: lmi(),
+    "another solver (SCS): another P, Y and L": lambda: lmi(
+        np.linalg.solve(P_SCS, Y_SCS), P_SCS, Y_SCS
+    ),
+    "L = inv(P) @ Y": lambda: lmi(gain=np.linalg.inv(P_SOLVED) @ Y_SOLVED),
+    "the package's LMI gain with its certificate": lambda: lmi(L, P_LMI, P_LMI @ L),
+    "M from the package": lambda: checks.case_study_projection(
+        ut.existence.decoupling(PLANT).M, plant=PLANT
+    ),
+    "the moved pole from a hand-made l N": lambda: checks.case_study_pole(
+        (L_MOVED @ np.linalg.pinv(N)) @ N, POLE, plant=PLANT
+    ),
+    "the run of the observer built from the solver's gain": lambda: simulation(
+        sim(observer=ut.design_pmo(PLANT, L=L_SOLVED)),
+        observer=ut.design_pmo(PLANT, L=L_SOLVED),
+    ),
+    "N r with N scaled by -2": lambda: residual(Nr=-2 * N @ RUN.residual),
+    "the figure with the step axis labelled 'k'": lambda: plot(plot_residual(xlabel="k")),
+    "the figure with N r scaled by -2": lambda: plot(plot_residual(nr=-2 * N @ RUN.residual)),
+}
+
+
+@pytest.mark.parametrize("name", list(RIGHT_BUT_DIFFERENT))
+def test_a_right_but_different_answer_passes(name):
+    result = RIGHT_BUT_DIFFERENT[name]()
+    assert result.passed, f"{name}: failed\n{result}"
+
+
 def test_the_catalogue_is_large_enough():
-    assert len(CATALOGUE) >= 25
+    assert len(CATALOGUE) >= 45 and len(RIGHT_BUT_DIFFERENT) >= 10
 
 
 @pytest.mark.parametrize("name", list(CATALOGUE))
@@ -185,10 +364,11 @@ def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
 def test_the_right_answer_passes_every_check():
     results = [
         checks.case_study_projection(M),
-        checks.case_study_lmi(L, P_LMI),
+        lmi(),
         checks.case_study_pole(L_MOVED, POLE),
-        simulation(RUN),
+        simulation(RUN, observer=LMI),
         residual(),
+        plot(plot_residual()),
     ]
     for result in results:
         assert result.passed, str(result)
@@ -198,6 +378,7 @@ def test_the_right_answer_passes_every_check():
         "case_study.pole",
         "case_study.simulation",
         "case_study.residual",
+        "case_study.plot",
     ]
 
 

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import matplotlib
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.instructor.lab_params import MissileParams
+
+matplotlib.use("Agg")
 
 P = MissileParams().to_params()
 POLES = P["pmo_poles"]
@@ -56,6 +60,46 @@ def catch_times(run=RUN0, vhat=VHAT0, tol=TOL):
 
 CATCH = catch_times()
 L_A = ut.design_pmo(PLANT, poles=[-200, -220], Mv=PUB.Mv).L  # other poles
+GOBS = ut.design_ginverse(PLANT)
+RUN_G = sim(observer=GOBS)
+VHAT_G = ut.reconstruct_input(PLANT, RUN_G)
+RUN_G0 = sim(observer=GOBS, observer_state=-M @ C @ X0)
+VHAT_G0 = ut.reconstruct_input(PLANT, RUN_G0)
+RUN_NO_X0 = ut.simulate(PLANT, PMO, T, d=V)
+VHAT_NO_X0 = ut.reconstruct_input(PLANT, RUN_NO_X0)
+PMO_OTHER = ut.design_pmo(PLANT, poles=[-200, -220], Mv=PUB.Mv)
+RUN_OTHER0 = sim(observer=PMO_OTHER, observer_state=-M @ C @ X0)
+VHAT_OTHER0 = ut.reconstruct_input(PLANT, RUN_OTHER0)
+ASKED = {"plant": PLANT, "observer": PMO, "poles": POLES, "initial_state": X0}
+
+
+def reconstruction(vhat=VHAT, run=RUN, **kw):
+    return checks.missile_reconstruction(vhat, run, **{**ASKED, **kw})
+
+
+def catch_check(catch=None, run=RUN0, vhat=VHAT0, **kw):
+    catch = CATCH if catch is None else catch
+    return checks.missile_catch_times(catch, run, vhat, tol=TOL, **{**ASKED, **kw})
+
+
+def figure(vhat=VHAT, scale=1.0, xlabel="time (s)", title="v and v̂, PMO", rows=(0, 1), est=True):
+    fig = Figure()
+    axes = fig.subplots(2, 1, sharex=True)
+    for i, ax in enumerate(axes):
+        if i in rows:
+            ax.plot(scale * vhat.time, vhat.actual[i], label=f"v{i + 1}")
+        if est:
+            ax.plot(scale * vhat.time, vhat.estimates[i], "--", label=f"v̂{i + 1}")
+        ax.set_ylabel(f"v{i + 1}")
+        ax.legend()
+    axes[-1].set_xlabel(xlabel)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot(fig, vhat=VHAT):
+    return checks.missile_plot(fig, vhat, plant=PLANT)
 
 
 def pmo(m=M, gain=L, f=F, poles=POLES):
@@ -111,6 +155,34 @@ CATALOGUE = {
         lambda: checks.missile_reconstruction(VHAT, RUN0),
         "vhat is not the reconstruction of this run",
     ),
+    "the g-inverse observer simulated where the PMO was asked": (
+        lambda: reconstruction(VHAT_G, RUN_G),
+        "the run simulates a g-inverse observer",
+    ),
+    "x0 dropped": (
+        lambda: reconstruction(VHAT_NO_X0, RUN_NO_X0),
+        "initial_state was left out?",
+    ),
+    "x0 dropped, no initial state given to the check": (
+        lambda: reconstruction(VHAT_NO_X0, RUN_NO_X0, initial_state=None),
+        "the plant starts from x(0) = 0",
+    ),
+    "z(0) = -M C x0 where z(0) = 0 was asked": (
+        lambda: reconstruction(VHAT0, RUN0),
+        "does not start from z(0) = 0",
+    ),
+    "a PMO with other poles": (
+        lambda: reconstruction(ut.reconstruct_input(PLANT, sim(PMO_OTHER)), sim(PMO_OTHER)),
+        "another PMO than yours",
+    ),
+    "a run of another plant": (
+        lambda: reconstruction(VHAT, RUN, plant=ut.examples.pa9()),
+        "another plant than the one of the set-up cell",
+    ),
+    "the observer passed where the run was asked": (
+        lambda: reconstruction(VHAT, PMO),
+        "must be the result of ut.simulate",
+    ),
     "the noisy run": (
         lambda: checks.missile_reconstruction(VHAT_NOISY, NOISY),
         "the run has measurement noise",
@@ -132,13 +204,37 @@ CATALOGUE = {
         lambda: checks.missile_catch_times(dict(PUB.catch_pmo), RUN0, VHAT0),
         "catch times that differ from the run",
     ),
-    "catch times of the run from q(0) = 0": (
-        lambda: checks.missile_catch_times(catch_times(RUN, VHAT), RUN, VHAT),
-        "not at x̂(0) = 0",
+    "catch times of the run from z(0) = 0": (
+        lambda: catch_check(catch_times(RUN, VHAT), RUN, VHAT),
+        "x̂(0) = z(0) + M y(0) is not 0",
     ),
     "x3 in milliseconds": (
-        lambda: checks.missile_catch_times(changed(x3=CATCH["x3"] * 1000), RUN0, VHAT0),
-        "x3:",
+        lambda: catch_check(changed(x3=CATCH["x3"] * 1000)),
+        "is it in ms instead of s?",
+    ),
+    "x1 typed one band too early": (
+        lambda: catch_check(changed(x1=CATCH["x1"] - 0.01)),
+        "x1 is too early",
+    ),
+    "v2 read too late": (lambda: catch_check(changed(v2=CATCH["v2"] + 0.01)), "v2 is too late"),
+    "catch times of the g-inverse observer": (
+        lambda: catch_check(catch_times(RUN_G0, VHAT_G0), RUN_G0, VHAT_G0),
+        "the run simulates a g-inverse observer",
+    ),
+    "catch times of a PMO with other poles": (
+        lambda: catch_check(catch_times(RUN_OTHER0, VHAT_OTHER0), RUN_OTHER0, VHAT_OTHER0),
+        "another PMO than yours",
+    ),
+    "catch times of a PMO with other poles, no observer given": (
+        lambda: catch_check(
+            catch_times(RUN_OTHER0, VHAT_OTHER0), RUN_OTHER0, VHAT_OTHER0, observer=None
+        ),
+        "does not have the poles",
+    ),
+    "catch as a list": (lambda: catch_check(list(CATCH.values())), "catch must be a dict"),
+    "catch times as arrays of the wrong size": (
+        lambda: catch_check(changed(x1=np.array([0.1, 0.2]))),
+        "not a number",
     ),
     "a time as text": (
         lambda: checks.missile_catch_times(changed(v1="soon"), RUN0, VHAT0),
@@ -149,6 +245,16 @@ CATALOGUE = {
     "noise of another seed": (
         lambda: checks.missile_noise(RMS, sim(noise=SIGMA, seed=SEED + 1), sigma=SIGMA, seed=SEED),
         "the noise of the run is not the one of seed",
+    ),
+    "noise on the run from x̂(0) = 0": (
+        lambda: checks.missile_noise(
+            RMS, sim(noise=SIGMA, seed=SEED, observer_state=-M @ C @ X0), sigma=SIGMA
+        ),
+        "does not start from z(0) = 0",
+    ),
+    "noise on the g-inverse observer": (
+        lambda: checks.missile_noise(RMS, sim(GOBS, noise=SIGMA, seed=SEED), sigma=SIGMA),
+        "the run simulates a g-inverse observer",
     ),
     "the noise-free run": (
         lambda: checks.missile_noise(RMS, RUN, sigma=SIGMA),
@@ -164,6 +270,10 @@ CATALOGUE = {
         ),
         "are not those of the run's plain-derivative reconstruction",
     ),
+    "rms as text": (
+        lambda: checks.missile_noise("60, 90", NOISY, sigma=SIGMA),
+        "rms must hold numbers",
+    ),
     "the predicted numbers instead of the measured ones": (
         lambda: checks.missile_noise(
             SIGMA / (np.sqrt(2) * (T[1] - T[0])) * np.linalg.norm(np.linalg.inv(CE), axis=1),
@@ -172,11 +282,67 @@ CATALOGUE = {
         ),
         "are not those of the run",
     ),
+    # the figure of v and v̂ ----------------------------------------------------------------------
+    "figure left out": (lambda: plot(None), "fig is missing (None)"),
+    "only the estimates": (lambda: plot(figure(rows=())), "the figure lacks v1, v2"),
+    "only v, no estimate": (lambda: plot(figure(est=False)), "the figure lacks v̂1, v̂2"),
+    "no title": (lambda: plot(figure(title="")), "the figure has no title"),
+    "time in s labelled in ms": (
+        lambda: plot(figure(xlabel="time (ms)")),
+        "the x-label says time in ms, but the curves are drawn against time in s",
+    ),
+    "time in ms labelled in s": (
+        lambda: plot(figure(scale=1000.0)),
+        "the x-label says time in s, but the curves are drawn against time in ms",
+    ),
+    "an x-label that is not time": (lambda: plot(figure(xlabel="v")), "does not say it is time"),
+    "the g-inverse named in the title": (
+        lambda: plot(figure(title="v and v̂, g-inverse observer")),
+        "names the g-inverse observer",
+    ),
+    "the figure of another reconstruction": (
+        lambda: plot(figure(vhat=VHAT0)),
+        "the figure lacks",
+    ),
 }
 
 
+# right answers that differ from the book's ------------------------------------------------------
+RIGHT_BUT_DIFFERENT = {
+    "the package's plot": lambda: plot(VHAT.plot(title="v and its reconstruction")),
+    "time in ms labelled 'time (ms)'": lambda: plot(figure(scale=1000.0, xlabel="time (ms)")),
+    "time labelled 't [s]'": lambda: plot(figure(xlabel="t [s]")),
+    "the PMO from ut.design_pmo with the paper's Mv, checked by its poles": lambda: reconstruction(
+        observer=None
+    ),
+    "catch times rounded to 4 decimals": lambda: catch_check(
+        {k: round(v, 4) for k, v in CATCH.items()}
+    ),
+    "catch times as numpy floats": lambda: catch_check(
+        {k: np.float64(v) for k, v in CATCH.items()}
+    ),
+    "catch times of another group's poles, against its own PMO": lambda: catch_check(
+        catch_times(RUN_OTHER0, VHAT_OTHER0),
+        RUN_OTHER0,
+        VHAT_OTHER0,
+        observer=PMO_OTHER,
+        poles=[-200, -220],
+    ),
+    "K with a Kv term (here CE is invertible, so it does nothing)": lambda: checks.missile_ginverse(
+        Cg, Pc, Pc @ E @ CEg + np.ones((n, p)) @ (np.eye(p) - CE @ CEg)
+    ),
+    "rms as a list": lambda: checks.missile_noise(list(RMS), NOISY, sigma=SIGMA, seed=SEED),
+}
+
+
+@pytest.mark.parametrize("name", list(RIGHT_BUT_DIFFERENT))
+def test_a_right_but_different_answer_passes(name):
+    result = RIGHT_BUT_DIFFERENT[name]()
+    assert result.passed, f"{name}: failed\n{result}"
+
+
 def test_the_catalogue_is_large_enough():
-    assert len(CATALOGUE) >= 25
+    assert len(CATALOGUE) >= 55 and len(RIGHT_BUT_DIFFERENT) >= 9
 
 
 @pytest.mark.parametrize("name", list(CATALOGUE))
@@ -191,9 +357,10 @@ def test_the_right_answer_passes_every_check():
     results = [
         pmo(),
         checks.missile_ginverse(Cg, Pc, K),
-        checks.missile_reconstruction(VHAT, RUN),
-        checks.missile_catch_times(CATCH, RUN0, VHAT0, tol=TOL),
-        checks.missile_noise(RMS, NOISY, sigma=SIGMA, seed=SEED),
+        reconstruction(),
+        catch_check(),
+        checks.missile_noise(RMS, NOISY, sigma=SIGMA, seed=SEED, plant=PLANT, observer=PMO),
+        plot(figure()),
     ]
     for result in results:
         assert result.passed, str(result)
@@ -203,6 +370,7 @@ def test_the_right_answer_passes_every_check():
         "missile.reconstruction",
         "missile.catch_times",
         "missile.noise",
+        "missile.plot",
     ]
 
 

@@ -46,17 +46,45 @@ STEPS_RESP = sim(d=STEPS)
 
 
 def design(h=H, t=T, k1=K1, f=F, k2=K2):
-    return checks.pa9_design(h, t, k1, f, k2, poles=POLES)
+    return checks.pa9_design(h, t, k1, f, k2, plant=PLANT, poles=POLES)
 
 
-def simulation(resp):
-    return checks.pa9_simulation(resp, poles=POLES, amplitude=AMP, frequency=FREQ, initial_state=X0)
-
-
-def piecewise(resp, sinusoidal=SINE_RESP):
-    return checks.pa9_piecewise(
-        resp, sinusoidal=sinusoidal, times=TIMES, values=VALUES, poles=POLES, initial_state=X0
+def simulation(resp, h=H, k1=K1, plant=PLANT):
+    return checks.pa9_simulation(
+        resp,
+        poles=POLES,
+        amplitude=AMP,
+        frequency=FREQ,
+        initial_state=X0,
+        H=h,
+        K1=k1,
+        plant=plant,
     )
+
+
+def piecewise(resp, sinusoidal=SINE_RESP, h=H, k1=K1):
+    return checks.pa9_piecewise(
+        resp,
+        sinusoidal=sinusoidal,
+        times=TIMES,
+        values=VALUES,
+        poles=POLES,
+        initial_state=X0,
+        H=h,
+        K1=k1,
+        plant=PLANT,
+    )
+
+
+# a valid H other than E (CE)^+: any h with h CE = 1 gives H = E h with HCE = E
+CE = C @ E
+H_OTHER = E @ (np.array([[1.0, 1.0]]) / (np.array([[1.0, 1.0]]) @ CE).item())
+T_OTHER = np.eye(3) - H_OTHER @ C
+K1_OTHER = ct.place((T_OTHER @ A).T, C.T, POLES).T
+F_OTHER = T_OTHER @ A - K1_OTHER @ C
+OBS_OTHER = ut.UIO(PLANT, H_OTHER, K1_OTHER)
+SINE_OTHER = sim(OBS_OTHER)
+STEPS_OTHER = sim(OBS_OTHER, d=STEPS)
 
 
 def figure(
@@ -85,8 +113,32 @@ def figure(
     return fig
 
 
-def plot(fig):
-    return checks.pa9_plot(fig, response=SINE_RESP)
+def plot(fig, response=SINE_RESP):
+    return checks.pa9_plot(fig, response=response, plant=PLANT)
+
+
+def steps_figure(resp=STEPS_RESP, d_panel=True, title="UIO with a piecewise-constant disturbance"):
+    fig = Figure()
+    axes = fig.subplots(3 if d_panel else 2, 1, sharex=True)
+    if d_panel:
+        axes[0].plot(TIME, resp.inputs.d.T, color="k")
+        axes[0].set_ylabel("disturbance d")
+    axes[-2].plot(TIME, resp.error.T, label=["e1", "e2", "e3"])
+    axes[-2].set_ylabel("error e = x - x̂")
+    axes[-1].plot(TIME, resp.residual.T, label=["r1", "r2"])
+    axes[-1].set_ylabel("residual r = y - C x̂")
+    axes[-1].set_xlabel("time (s)")
+    axes[0].set_title(title)
+    return fig
+
+
+def steps_plot(fig, response=STEPS_RESP):
+    return checks.pa9_piecewise_plot(fig, response, plant=PLANT)
+
+
+def titled(fig, title, panel=0):
+    fig.axes[panel].set_title(title)
+    return fig
 
 
 R = SINE_RESP
@@ -106,7 +158,19 @@ CATALOGUE = {
     "K2 left out": (lambda: design(k2=None), "K2 is missing"),
     "H transposed": (lambda: design(h=H.T), "It looks transposed"),
     "H copied with 2 decimals": (lambda: design(h=np.round(H, 2)), "2 decimals"),
-    "H with a minus sign": (lambda: design(h=-H), "drop the minus sign"),
+    "H with a minus sign": (lambda: design(h=-H), "check the sign"),
+    "H with another h, but T and K1 of E (CE)^+": (
+        lambda: design(h=H_OTHER),
+        "T is not I - HC",
+    ),
+    "poles given as words": (
+        lambda: checks.pa9_design(H, T, K1, poles=["slow", "medium", "fast"]),
+        "poles must be a list of 3 numbers",
+    ),
+    "the plant as a dict": (
+        lambda: checks.pa9_design(H, T, K1, plant={"A": A}),
+        "plant must be a uio_teach.Plant",
+    ),
     "H with a NaN": (lambda: design(h=H_NAN), "every entry must be a finite number"),
     "H as ragged lists": (lambda: design(h=[[1, 2], [3]]), "could not be read as a matrix"),
     "H as text": (lambda: design(h="E @ pinv(C @ E)"), "must hold numbers"),
@@ -156,7 +220,35 @@ CATALOGUE = {
     ),
     "an observer with other poles": (
         lambda: simulation(sim(ut.design_uio(PLANT, poles=[-4, -5, -6]))),
-        "the observer has the poles -6, -5, -4, but the exercise asks for -1, -2, -3",
+        "the simulated observer has the poles -6, -5, -4, not the -1, -2, -3 of the exercise",
+    ),
+    "a valid other H, but design_uio(K1=K1) simulated": (
+        lambda: simulation(sim(ut.design_uio(PLANT, K1=K1_OTHER)), h=H_OTHER, k1=K1_OTHER),
+        "its H differs from yours",
+    ),
+    "x0 dropped": (
+        lambda: simulation(ut.simulate(PLANT, OBS, TIME, d=SINE)),
+        "was initial_state left out of ut.simulate?",
+    ),
+    "a run of another plant": (
+        lambda: simulation(
+            ut.simulate(
+                ut.Plant(2 * A, B=PLANT.B, C=C, E=E),
+                ut.design_uio(ut.Plant(2 * A, B=PLANT.B, C=C, E=E), poles=POLES),
+                TIME,
+                d=SINE,
+                initial_state=X0,
+            )
+        ),
+        "another plant than the one of the set-up cell",
+    ),
+    "the observer passed instead of the run": (
+        lambda: simulation(OBS),
+        "must be the result of ut.simulate",
+    ),
+    "poles as a string": (
+        lambda: checks.pa9_simulation(SINE_RESP, poles="-1, -2, -3"),
+        "could not read your answer: text where numbers are expected",
     ),
     # requirement 3: the figure -----------------------------------------------------------------
     "figure left out": (lambda: plot(None), "fig is missing (None)"),
@@ -200,6 +292,34 @@ CATALOGUE = {
         lambda: plot(figure(R.error, R.residual, xlabel="")),
         "have no x-label",
     ),
+    "time in s labelled in ms": (
+        lambda: plot(figure(R.error, R.residual, xlabel="time (ms)")),
+        "the x-label says time in ms, but the curves are drawn against time in s",
+    ),
+    "time in ms labelled in s": (
+        lambda: plot(figure(R.error, R.residual, x=1000 * TIME)),
+        "the x-label says time in s, but the curves are drawn against time in ms",
+    ),
+    "a title naming the states over the error": (
+        lambda: plot(titled(figure(R.error, R.residual), "states x and their estimates")),
+        "does not fit the panel",
+    ),
+    "a title naming the residual over the error": (
+        lambda: plot(titled(figure(R.error, R.residual), "residual")),
+        "no panel is labelled as the error alone",
+    ),
+    "the title of the other experiment": (
+        lambda: plot(titled(figure(R.error, R.residual), "piecewise-constant disturbance")),
+        "the title names a piecewise-constant disturbance",
+    ),
+    "a UIO figure titled as the Luenberger observer": (
+        lambda: plot(titled(figure(R.error, R.residual), "Luenberger observer, sinusoid")),
+        "the title names a Luenberger observer",
+    ),
+    "the figure of another run": (
+        lambda: plot(figure(STEPS_OTHER.error, STEPS_OTHER.residual)),
+        "no curve of the error panel is the error e of the response",
+    ),
     # requirement 4: the piecewise-constant test --------------------------------------------------
     "the sinusoid again": (lambda: piecewise(SINE_RESP), "so it is not piecewise constant"),
     "a constant d": (
@@ -222,11 +342,98 @@ CATALOGUE = {
         lambda: piecewise(sim(d=STEPS, timepts=np.linspace(0, P["duration"], 1001))),
         "use the same timepts in both",
     ),
+    "x0 dropped in requirement 4": (
+        lambda: piecewise(ut.simulate(PLANT, OBS, TIME, d=STEPS)),
+        "was initial_state left out of ut.simulate?",
+    ),
+    # requirement 4: its figure ------------------------------------------------------------------
+    "figure of requirement 4 left out": (lambda: steps_plot(None), "fig is missing (None)"),
+    "the sinusoidal run in the figure of requirement 4": (
+        lambda: steps_plot(steps_figure(), response=SINE_RESP),
+        "the title names a piecewise-constant disturbance, but the run's d is a sinusoid",
+    ),
+    "states in the error panel of requirement 4": (
+        lambda: steps_plot(
+            _replace_curves(steps_figure(), 1, STEPS_RESP.states),
+        ),
+        "the error panel shows the states x",
+    ),
+    "requirement 4 titled as the sinusoidal test": (
+        lambda: steps_plot(steps_figure(title="UIO with a sinusoidal disturbance")),
+        "the title names a sinusoidal disturbance",
+    ),
 }
 
 
+def _replace_curves(fig, panel, rows):
+    for line, row in zip(fig.axes[panel].get_lines(), rows, strict=True):
+        line.set_ydata(row)
+    return fig
+
+
+# right answers that differ from the book's ------------------------------------------------------
+def _ms_figure():
+    fig = figure(R.error, R.residual, xlabel="time (ms)", x=1000 * TIME)
+    return fig
+
+
+def _norm_figure():
+    fig = figure(np.linalg.norm(R.error, axis=0)[None, :], R.residual)
+    return fig
+
+
+def _legend_only_figure():
+    fig = figure(R.error, R.residual, e_label="", r_label="")
+    ax_e, ax_r = fig.axes
+    for line, name in zip(ax_e.get_lines(), ["e1", "e2", "e3"], strict=True):
+        line.set_label(name)
+    for line, name in zip(ax_r.get_lines(), ["r1", "r2"], strict=True):
+        line.set_label(name)
+    ax_e.legend()
+    ax_r.legend()
+    return fig
+
+
+OBS_OTHER_K1 = ut.UIO(PLANT, H, K1 + 0 * K1)
+
+RIGHT_BUT_DIFFERENT = {
+    "a valid other H: the design": lambda: design(
+        h=H_OTHER, t=T_OTHER, k1=K1_OTHER, f=F_OTHER, k2=F_OTHER @ H_OTHER
+    ),
+    "a valid other H: the sinusoidal test": lambda: simulation(SINE_OTHER, h=H_OTHER, k1=K1_OTHER),
+    "a valid other H: the figure": lambda: plot(
+        figure(SINE_OTHER.error, SINE_OTHER.residual), response=SINE_OTHER
+    ),
+    "a valid other H: the piecewise test": lambda: piecewise(
+        STEPS_OTHER, sinusoidal=SINE_OTHER, h=H_OTHER, k1=K1_OTHER
+    ),
+    "a valid other H: the figure of requirement 4": lambda: steps_plot(
+        steps_figure(STEPS_OTHER), response=STEPS_OTHER
+    ),
+    "F and K2 left to the check": lambda: checks.pa9_design(H, T, K1, plant=PLANT, poles=POLES),
+    "the poles in another order": lambda: checks.pa9_design(
+        H, T, K1, F, K2, plant=PLANT, poles=POLES[::-1]
+    ),
+    "time in ms labelled 'time (ms)'": lambda: plot(_ms_figure()),
+    "time labelled 't [s]'": lambda: plot(figure(R.error, R.residual, xlabel="t [s]")),
+    "the norm of the error instead of its components": lambda: plot(_norm_figure()),
+    "labels in the legends only": lambda: plot(_legend_only_figure()),
+    "a figure title that fits": lambda: plot(
+        titled(figure(R.error, R.residual), "UIO, sinusoidal disturbance")
+    ),
+    "requirement 4 without the d panel": lambda: steps_plot(steps_figure(d_panel=False)),
+    "the observer built with ut.UIO from the book's H": lambda: simulation(sim(OBS_OTHER_K1)),
+}
+
+
+@pytest.mark.parametrize("name", list(RIGHT_BUT_DIFFERENT))
+def test_a_right_but_different_answer_passes(name):
+    result = RIGHT_BUT_DIFFERENT[name]()
+    assert result.passed, f"{name}: failed\n{result}"
+
+
 def test_the_catalogue_is_large_enough():
-    assert len(CATALOGUE) >= 25
+    assert len(CATALOGUE) >= 65 and len(RIGHT_BUT_DIFFERENT) >= 14
 
 
 @pytest.mark.parametrize("name", list(CATALOGUE))
@@ -239,7 +446,14 @@ def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
 
 def test_the_right_answer_passes_every_check():
     fig = figure(R.error, R.residual)
-    for result in (design(), simulation(SINE_RESP), plot(fig), piecewise(STEPS_RESP)):
+    results = (
+        design(),
+        simulation(SINE_RESP),
+        plot(fig),
+        piecewise(STEPS_RESP),
+        steps_plot(steps_figure()),
+    )
+    for result in results:
         assert result.passed, str(result)
 
 

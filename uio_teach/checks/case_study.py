@@ -24,20 +24,30 @@ True
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
 
+from .. import examples
 from .._display import format_matrix_line, format_poles
-from ._common import (
+from ..existence import check_existence, decoupling
+from ..linalg import left_null
+from ..signals import piecewise_constant
+from ..simulation import simulate
+from .common import (
     CheckResult,
-    _close,
-    _get_plant,
-    _never_raises,
-    _numbers,
-    _read_matrix,
-    _up_to,
+    check_plant_of,
+    close,
+    get_plant,
+    never_raises,
+    numbers,
+    read_matrix,
+    read_response,
+    same_poles,
+    up_to,
 )
+from .plots import curves_against_time, read_figure, xlabels
 
 __all__ = [
     "case_study_projection",
@@ -45,13 +55,12 @@ __all__ = [
     "case_study_pole",
     "case_study_simulation",
     "case_study_residual",
+    "case_study_plot",
 ]
 
 
 def _M_ref(plant) -> np.ndarray:
     """The projection matrix ``M = [B2 0][C B2 D]^+`` of the package's design."""
-    from ..existence import decoupling
-
     return decoupling(plant).M
 
 
@@ -60,7 +69,7 @@ def _small(X: np.ndarray, scale: float, tol: float) -> tuple[bool, float]:
     return big <= tol * max(1.0, scale), big
 
 
-@_never_raises("Case study: the projection matrix M", "case_study.projection")
+@never_raises("Case study: the projection matrix M", "case_study.projection")
 def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> CheckResult:
     """Check ``M``: it removes ``u2``, ``(I - MC)B2 = 0``, and the disturbance, ``MD = 0``.
 
@@ -88,11 +97,11 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     True
     """
     result = CheckResult("Case study: the projection matrix M")
-    plant = _get_plant(result, plant, "dt_case_study")
+    plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p
-    M = _read_matrix(result, "M", M, n, p, f"n x p = {n} x {p}")
+    M = read_matrix(result, "M", M, n, p, f"n x p = {n} x {p}")
     if M is None:
         return result
     C, B2, D = plant.C, plant.E, plant.D
@@ -100,14 +109,17 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     ok, big = _small((np.eye(n) - M @ C) @ B2, scale, tol)
     ref = _M_ref(plant)
     if ok:
-        result.add(True, f"(I - MC)B2 = 0{_up_to(big, 'largest entry')}: u2 is projected out.")
+        result.add(True, f"(I - MC)B2 = 0{up_to(big, 'largest entry')}: u2 is projected out.")
     else:
-        if _close(M, np.round(ref, 4), 1e-9) or _close(M, np.round(ref, 2), 1e-9):
+        if close(M, np.round(ref, 4), 1e-9) or close(M, np.round(ref, 2), 1e-9):
             hint = " Your M is the printed one, rounded: compute it at full precision."
-        elif _close(M, -ref, 1e-9):
-            hint = " Your M is -[B2 0][CB2 D]^+: drop the minus sign."
+        elif close(M, -ref, 1e-9):
+            hint = " Your M is -[B2 0][CB2 D]^+: check the sign."
         else:
-            hint = " M must satisfy M [CB2 D] = [B2 0]: M = [B2 0] [CB2 D]^+ (np.linalg.pinv)."
+            hint = (
+                " M must satisfy M [CB2 D] = [B2 0]; [CB2 D] is square here: which inverse "
+                "solves it?"
+            )
         result.add(
             False,
             f"(I - MC)B2 is not 0: it is {format_matrix_line((np.eye(n) - M @ C) @ B2)} "
@@ -115,13 +127,13 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
         )
     ok, big = _small(M @ D, scale, tol)
     if ok:
-        result.add(True, f"MD = 0{_up_to(big, 'largest entry')}: v does not enter x̂ through My.")
+        result.add(True, f"MD = 0{up_to(big, 'largest entry')}: v does not enter x̂ through My.")
     else:
         only_b2 = B2 @ np.linalg.pinv(C @ B2)
         hint = (
-            " Your M is B2 (CB2)^+, which ignores D: stack [CB2 D] and [B2 0] instead."
-            if _close(M, only_b2, 1e-9)
-            else " M must also satisfy MD = 0: M = [B2 0] [CB2 D]^+."
+            " Your M is B2 (CB2)^+, which ignores D: M must remove u2 and v together."
+            if close(M, only_b2, 1e-9)
+            else " M must also satisfy MD = 0, together with MCB2 = B2."
         )
         result.add(
             False,
@@ -133,8 +145,6 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
 
 def _error_matrix(plant, L: np.ndarray) -> np.ndarray:
     """``F = (I - M C) A - L C`` with the package's ``M``."""
-    from ..existence import decoupling
-
     return decoupling(plant).A1 - L @ plant.C
 
 
@@ -142,16 +152,14 @@ def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
     LD = L @ plant.D
     ok, big = _small(LD, float(np.max(np.abs(L))), tol)
     if ok:
-        result.add(True, f"LD = 0{_up_to(big, 'largest entry')}: v does not enter through y - Cx̂.")
+        result.add(True, f"LD = 0{up_to(big, 'largest entry')}: v does not enter through y - Cx̂.")
         return True
-    from .. import examples
-
     pub = examples.DT_CASE_STUDY_PUBLISHED.L
     hint = (
         " Your L is the printed one, rounded to 4 decimals; rounding moves it off LD = 0. Use "
         "the gain of your solver."
-        if _close(L, pub, 1e-9)
-        else " Add the constraint Y @ D == 0 to the LMI (Y = PL), or build L as l N with N D = 0."
+        if close(L, pub, 1e-9)
+        else " With Y = PL, LD = 0 is the linear constraint YD = 0: is it in your LMI?"
     )
     result.add(
         False,
@@ -161,21 +169,41 @@ def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
     return False
 
 
-@_never_raises("Case study: the gain L from the LMI", "case_study.lmi")
-def case_study_lmi(L: Any, P: Any = None, plant: Any = None, *, tol: float = 1e-6) -> CheckResult:
-    """Check the LMI gain ``L``: ``LD = 0``, ``F = A1 - LC`` stable; with ``P``, the LMI holds.
+@never_raises("Case study: the gain L from the LMI", "case_study.lmi")
+def case_study_lmi(
+    L: Any,
+    P: Any = None,
+    plant: Any = None,
+    *,
+    tol: float = 1e-6,
+    Y: Any = None,
+    margin: float = 0.0,
+) -> CheckResult:
+    """Check the LMI gain ``L``: the solved ``P``, ``Y`` certify it and give it, ``LD = 0``.
+
+    The checks: ``P`` (the solver's value) is symmetric positive definite;
+    ``L = P^{-1} Y`` with the solver's ``Y`` (so ``L = Y`` or ``L = PY`` fail,
+    even where ``P`` is close to the identity); ``LD = 0``; ``F = A1 - LC``
+    stable; ``P`` certifies the LMI ``[[-P, F^T P], [P F, -P]] <= -margin I``.
+    Any solver's ``P`` and ``Y`` pass: the gain is not unique.
 
     Parameters
     ----------
     L : array_like, shape (n, p)
         Your gain (``L = P^{-1} Y`` from the solver).
-    P : array_like, shape (n, n), optional
-        Your certificate: symmetric positive definite with
-        ``[[-P, F^T P], [P F, -P]] <= 0``.
+    P : array_like, shape (n, n)
+        The solver's ``P``. Without it (``None``, the LMI skipped) the check fails.
     plant : Plant, optional
         The plant; :func:`uio_teach.examples.dt_case_study` by default.
     tol : float, optional
-        Tolerance of ``LD = 0`` and of the LMI (a solver meets them to about 1e-8).
+        Tolerance of ``LD = 0``, of ``L = P^{-1} Y`` (relative) and of the LMI
+        (a solver meets them to about 1e-8).
+    Y : array_like, shape (n, p), optional
+        The solver's ``Y``: the gain must be ``P^{-1} Y``. Without it, ``L``
+        cannot be traced to the solve, and the check says so (a ✗).
+    margin : float, optional
+        The margin the exercise puts on the LMI block (``0.01``); the block's
+        largest eigenvalue must be at most ``-margin`` (to ``tol``).
 
     Returns
     -------
@@ -186,18 +214,32 @@ def case_study_lmi(L: Any, P: Any = None, plant: Any = None, *, tol: float = 1e-
     >>> import uio_teach as ut
     >>> from uio_teach import checks
     >>> pmo = ut.design_pmo(ut.examples.dt_case_study(), method="lmi")
-    >>> checks.case_study_lmi(pmo.L, pmo.lmi_certificate).passed
+    >>> P = pmo.lmi_certificate
+    >>> checks.case_study_lmi(pmo.L, P, Y=P @ pmo.L).passed
     True
+    >>> checks.case_study_lmi(pmo.L, None).failures[0][:40]
+    'P is missing: the gain must come from th'
     """
     result = CheckResult("Case study: the gain L from the LMI")
-    plant = _get_plant(result, plant, "dt_case_study")
+    plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p
-    L = _read_matrix(result, "L", L, n, p, f"n x p = {n} x {p}")
-    Pm = _read_matrix(result, "P", P, n, n, f"n x n = {n} x {n}") if P is not None else None
-    if L is None or (P is not None and Pm is None):
+    L = read_matrix(result, "L", L, n, p, f"n x p = {n} x {p}")
+    if P is None:
+        result.add(
+            False,
+            "P is missing: the gain must come from the solved LMI, and P (the solver's value) "
+            "is what certifies it. Solve the LMI and pass P's value.",
+        )
+        Pm = None
+    else:
+        Pm = read_matrix(result, "P", P, n, n, f"n x n = {n} x {n}")
+    Ym = read_matrix(result, "Y", Y, n, p, f"n x p = {n} x {p}") if Y is not None else None
+    if L is None:
         return result
+    certified = Pm is not None and (Y is None or Ym is not None) and _P_definite(result, Pm, tol)
+    from_solve = _L_from_solve(result, L, Pm, Ym, tol) if certified else False
     _LD(result, L, plant, tol)
     F = _error_matrix(plant, L)
     eig = np.linalg.eigvals(F)
@@ -213,33 +255,61 @@ def case_study_lmi(L: Any, P: Any = None, plant: Any = None, *, tol: float = 1e-
             False,
             f"F = A1 - LC is not stable: its eigenvalues {format_poles(eig)} include "
             f"{worst:.4g} in magnitude, on or outside the unit circle. The LMI as printed is "
-            "non-strict and accepts such a gain: add a margin (block << -0.01 I).",
+            "non-strict and accepts such a gain: the exercise's margin excludes it.",
         )
-    if Pm is not None:
-        sym = float(np.max(np.abs(Pm - Pm.T)))
-        low = float(np.min(np.linalg.eigvalsh((Pm + Pm.T) / 2)))
-        if sym > tol * max(1.0, float(np.max(np.abs(Pm)))) or low <= 0:
+    if certified and from_solve is not False:
+        block = np.block([[-Pm, F.T @ Pm], [Pm @ F, -Pm]])
+        top = float(np.max(np.linalg.eigvalsh((block + block.T) / 2)))
+        if top <= -float(margin) + tol * max(1.0, float(np.max(np.abs(Pm)))):
+            result.add(True, "P certifies the LMI: [[-P, F'P], [PF, -P]] <= 0 for your L.")
+        else:
             result.add(
                 False,
-                f"P is not symmetric positive definite (smallest eigenvalue {low:.3g}, "
-                f"asymmetry {sym:.2g}): declare it cp.Variable((n, n), symmetric=True) with "
-                "P >> 0.01 I.",
+                f"P does not certify this L: the LMI block has the eigenvalue {top:.3g}, above "
+                f"{-float(margin):g}. Are L and P from the same solve?",
             )
-        else:
-            block = np.block([[-Pm, F.T @ Pm], [Pm @ F, -Pm]])
-            top = float(np.max(np.linalg.eigvalsh((block + block.T) / 2)))
-            if top <= tol * max(1.0, float(np.max(np.abs(Pm)))):
-                result.add(True, "P certifies the LMI: [[-P, F'P], [PF, -P]] <= 0.")
-            else:
-                result.add(
-                    False,
-                    f"P does not certify this L: the LMI block has the eigenvalue {top:.3g} > 0. "
-                    "Is L = np.linalg.solve(P.value, Y.value) from the same solve?",
-                )
     return result
 
 
-@_never_raises("Case study: moving the movable pole", "case_study.pole")
+def _P_definite(result: CheckResult, Pm: np.ndarray, tol: float) -> bool:
+    sym = float(np.max(np.abs(Pm - Pm.T)))
+    low = float(np.min(np.linalg.eigvalsh((Pm + Pm.T) / 2)))
+    if sym > tol * max(1.0, float(np.max(np.abs(Pm)))) or low <= 0:
+        result.add(
+            False,
+            f"P is not symmetric positive definite (smallest eigenvalue {low:.3g}, "
+            f"asymmetry {sym:.2g}): declare it symmetric and ask for P >> 0.01 I in the LMI.",
+        )
+        return False
+    return True
+
+
+def _L_from_solve(
+    result: CheckResult, L: np.ndarray, Pm: np.ndarray, Ym: np.ndarray | None, tol: float
+) -> bool | None:
+    """✓/✗: ``L = P^{-1} Y`` with the solver's values; None when ``Y`` was not given."""
+    if Ym is None:
+        result.add(
+            False,
+            "Y is not given, so L cannot be traced to the solve: pass the solver's value of Y "
+            "too (the gain is L = P^-1 Y).",
+        )
+        return None
+    ref = np.linalg.solve(Pm, Ym)
+    if close(L, ref, tol):
+        result.add(True, "L = P^-1 Y with the solver's P and Y.")
+        return True
+    if close(L, Ym, tol):
+        hint = " Your L is Y itself: Y = PL, so P must be divided out."
+    elif close(L, Pm @ Ym, tol):
+        hint = " Your L is P Y: Y = PL, so L is P^-1 Y, not P Y."
+    else:
+        hint = " Are L, P and Y from the same solve?"
+    result.add(False, f"L is not P^-1 Y with the solver's P and Y.{hint}")
+    return False
+
+
+@never_raises("Case study: moving the movable pole", "case_study.pole")
 def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6) -> CheckResult:
     """Check a gain that moves the one movable pole to ``pole`` with ``LD = 0``.
 
@@ -267,56 +337,51 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
     True
     """
     result = CheckResult("Case study: moving the movable pole")
-    plant = _get_plant(result, plant, "dt_case_study")
+    plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
         return result
     n, p = plant.n, plant.p
-    L = _read_matrix(result, "L", L, n, p, f"n x p = {n} x {p}")
+    L = read_matrix(result, "L", L, n, p, f"n x p = {n} x {p}")
     if L is None:
         return result
     pole = float(pole)
     decoupled = _LD(result, L, plant, tol)
     eig = np.sort_complex(np.linalg.eigvals(_error_matrix(plant, L)))
-    has = np.abs(eig - pole) <= tol * max(1.0, abs(pole))
-    fixed = np.abs(eig - 0.5) <= 1e-6
-    if has.any() and (fixed & ~has).sum() >= 2:
+    fixed = np.asarray(check_existence(plant).fixed_modes, complex)
+    if same_poles(eig, np.concatenate([[pole], fixed]), tol):
         result.add(
             True,
             f"F = A1 - LC has the poles {format_poles(eig)}: the movable pole is at "
-            f"{pole:g}, the two fixed poles stay at 0.5.",
+            f"{pole:g}, the fixed ones {format_poles(fixed)} stay.",
         )
-    elif has.any() and not decoupled:
+    elif np.any(np.abs(eig - pole) <= tol * max(1.0, abs(pole))) and not decoupled:
         result.add(
             False,
-            f"F has the poles {format_poles(eig)}: {pole:g} is there, but the poles at 0.5 moved "
+            f"F has the poles {format_poles(eig)}: {pole:g} is there, but the fixed poles moved "
             "too, which only a gain with LD != 0 can do (see above).",
         )
     else:
         result.add(
             False,
             f"F = A1 - LC has the poles {format_poles(eig)}, but the exercise asks to move the "
-            f"movable pole to {pole:g} (the two at 0.5 stay): "
-            f"ut.design_pmo(plant, poles=[{pole:g}]), or L = l N with the l that puts it there.",
+            f"movable pole to {pole:g} (the fixed ones {format_poles(fixed)} stay): with "
+            "L = l N, which l puts the one observable mode of (A1, NC) there?",
         )
     return result
 
 
 def _read_resp(result: CheckResult, response: Any):
-    from .responses import _read_response
-
-    return _read_response(result, response)
+    return read_response(result, response)
 
 
 def _staircase(timepts: np.ndarray, amplitude: float, hold: int, seed: int) -> np.ndarray:
-    from ..signals import piecewise_constant
-
     rng = np.random.default_rng(seed)
     switch = np.arange(0, timepts[-1] + 1, hold)
     levels = rng.uniform(-amplitude, amplitude, switch.size)
     return np.asarray(piecewise_constant(switch, levels)(timepts), float).ravel()
 
 
-@_never_raises("Case study: the simulation with u2 and v", "case_study.simulation")
+@never_raises("Case study: the simulation with u2 and v", "case_study.simulation")
 def case_study_simulation(
     response: Any,
     *,
@@ -324,6 +389,8 @@ def case_study_simulation(
     v: tuple[float, int, int] | None = None,
     initial_state: Any = None,
     decay: float = 0.01,
+    plant: Any = None,
+    observer: Any = None,
 ) -> CheckResult:
     """Check a run with both unknown signals: the error ignores ``u2`` and ``v`` and decays.
 
@@ -340,6 +407,11 @@ def case_study_simulation(
         The asked ``x[0]``.
     decay : float, optional
         The largest final error relative to the initial one.
+    plant : Plant, optional
+        The plant of the lab's set-up cell: the run must be of it.
+    observer : PMO, optional
+        Your observer (built from your LMI gain): the run must simulate it,
+        started from ``z[0] = 0``.
 
     Returns
     -------
@@ -354,17 +426,23 @@ def case_study_simulation(
     >>> checks.case_study_simulation(CS.simulate(pmo)).passed
     True
     """
-    from ..simulation import simulate
-
     result = CheckResult("Case study: the simulation with u2 and v")
     resp = _read_resp(result, response)
-    if resp is None:
+    if resp is None or not check_plant_of(result, resp, plant):
         return result
+    _observer_as_asked(result, resp, observer)
+    _signals_as_asked(result, resp, u2, v, initial_state)
+    _ignores_and_decays(result, resp, decay)
+    return result
+
+
+def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_state: Any) -> None:
+    """✓/✗ on u2 (the plant's d), the staircase v and x[0], as the exercise asks."""
     t = np.asarray(resp.time, float)
     d = np.asarray(resp.inputs.d, float)
     vv = np.asarray(resp.inputs.v, float)
     if not np.any(d):
-        result.add(False, "u2 is zero during the whole run: pass d=u2 to ut.simulate.")
+        result.add(False, "u2 is zero during the whole run: it acts as the plant's d.")
     elif u2 is not None:
         want = float(u2[0]) * np.sin(float(u2[1]) * t)
         if np.allclose(d[0], want, rtol=0, atol=1e-9 * max(1.0, abs(float(u2[0])))):
@@ -378,7 +456,7 @@ def case_study_simulation(
     else:
         result.add(True, "u2 acts during the run.")
     if vv.size == 0 or not np.any(vv):
-        result.add(False, "v is zero during the whole run: pass v=v to ut.simulate.")
+        result.add(False, "v is zero during the whole run: the staircase v acts on y.")
     elif v is not None:
         want = _staircase(t, float(v[0]), int(v[1]), int(v[2]))
         if np.allclose(vv[0], want, rtol=0, atol=1e-12):
@@ -394,13 +472,19 @@ def case_study_simulation(
     if initial_state is not None:
         want_x0 = np.asarray(initial_state, float).ravel()
         if want_x0.shape == resp.states[:, 0].shape and np.allclose(resp.states[:, 0], want_x0):
-            result.add(True, f"x[0] = {_numbers(want_x0)}, as asked.")
+            result.add(True, f"x[0] = {numbers(want_x0)}, as asked.")
         else:
             result.add(
                 False,
-                f"the plant starts from x[0] = {_numbers(resp.states[:, 0])}, but the exercise "
-                f"asks for {_numbers(want_x0)}.",
+                f"the plant starts from x[0] = {numbers(resp.states[:, 0])}, but the exercise "
+                f"asks for {numbers(want_x0)}"
+                + (" (initial_state left out?)." if not np.any(resp.states[:, 0]) else "."),
             )
+
+
+def _ignores_and_decays(result: CheckResult, resp: Any, decay: float) -> None:
+    """✓/✗: the error is the same without u2 and v, and decays."""
+    t = np.asarray(resp.time, float)
     quiet = simulate(
         resp.plant,
         resp.observer,
@@ -415,7 +499,7 @@ def case_study_simulation(
         result.add(
             True,
             f"the error ignores u2 and v: run again without them, it is the same"
-            f"{_up_to(diff, 'largest difference')}.",
+            f"{up_to(diff, 'largest difference')}.",
         )
     else:
         result.add(
@@ -441,11 +525,37 @@ def case_study_simulation(
             f"the error has not decayed: {e1:.3g} at the end against {e0:.3g} at k = 0; run more "
             "steps.",
         )
-    return result
 
 
-@_never_raises("Case study: the residual and D v", "case_study.residual")
-def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
+def _observer_as_asked(result: CheckResult, resp: Any, observer: Any) -> None:
+    """✓/✗: the run simulates the student's PMO, started from z[0] = 0."""
+    family = str(getattr(resp.observer, "family", ""))
+    if family != "PMO":
+        result.add(
+            False,
+            f"the run simulates a {family or type(resp.observer).__name__}, but the exercise "
+            "asks for the PMO built from your LMI gain.",
+        )
+    elif observer is not None:
+        theirs = getattr(observer, "L", None)
+        if theirs is None or not close(np.asarray(resp.observer.L), np.asarray(theirs), 1e-9):
+            result.add(
+                False,
+                "the run simulates another PMO than the one built from your LMI gain L.",
+            )
+        else:
+            result.add(True, "the run simulates your PMO.")
+    z0 = np.asarray(resp.observer_states[:, 0], float)
+    if float(np.max(np.abs(z0))) > 1e-9 * max(1.0, float(np.max(np.abs(resp.states)))):
+        result.add(
+            False,
+            f"the observer starts from z[0] = {numbers(z0)}, but the exercise asks for "
+            "z[0] = 0 (ut.simulate's default).",
+        )
+
+
+@never_raises("Case study: the residual and D v", "case_study.residual")
+def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -> CheckResult:
     """Check ``D v`` (what the residual settles on) and ``N r`` (the part ``v`` cannot reach).
 
     Parameters
@@ -456,6 +566,8 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
         The residual seen through a row ``N`` with ``N D = 0``.
     response : UIOResponse
         The run.
+    plant : Plant, optional
+        The plant of the lab's set-up cell.
 
     Returns
     -------
@@ -477,21 +589,23 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
     for name in missing:
         result.add(False, f"{name} is missing: compute it from the run (see the exercise).")
     resp = _read_resp(result, response)
-    if resp is None or missing:
+    if resp is None or missing or not check_plant_of(result, resp, plant):
         return result
     plant = resp.plant
     N = resp.time.size
     p = plant.p
-    Dv_m = _read_matrix(result, "Dv", Dv, p, N, f"p x N = {p} x {N}: one column per step")
-    Nr_m = _read_matrix(result, "Nr", Nr, 1, N, f"1 x N = 1 x {N}")
+    Dv_m = read_matrix(result, "Dv", Dv, p, N, f"p x N = {p} x {N}: one column per step")
+    Nr_m = read_matrix(result, "Nr", Nr, 1, N, f"1 x N = 1 x {N}")
     if Dv_m is None or Nr_m is None:
         return result
     v = np.asarray(resp.inputs.v, float)
     ref = plant.D @ v
-    if _close(Dv_m, ref, 1e-9):
+    if close(Dv_m, ref, 1e-9):
         result.add(True, "Dv is D times the run's v.")
     else:
-        result.add(False, "Dv is not D @ resp.inputs.v (the disturbance of this run times D).")
+        result.add(
+            False, "Dv is not D times the v of this run (its inputs.v, one column per step)."
+        )
     r = np.asarray(resp.residual, float)
     late = resp.time >= resp.time[0] + 0.5 * (resp.time[-1] - resp.time[0])
     gap = float(np.max(np.abs(r - ref)[:, late]))
@@ -499,8 +613,6 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
         None,
         f"over the second half of the run, max |r - Dv| = {gap:.2g}: r = Ce + Dv settles on Dv.",
     )
-    from ..linalg import left_null
-
     Nd = left_null(plant.D)
     want = Nd @ r
     r_scale = max(1.0, float(np.max(np.abs(r))))
@@ -522,7 +634,138 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any) -> CheckResult:
         result.add(
             False,
             f"Nr is not the residual seen through a row N with N D = 0 (its entries reach "
-            f"{got_big:.3g}, N r reaches {want_big:.2g}): take N = ut.linalg.left_null(D) and "
-            "Nr = N @ resp.residual.",
+            f"{got_big:.3g}): N is a row with N D = 0, applied to the run's residual.",
         )
+    return result
+
+
+def _panel_text(ax: Any) -> str:
+    texts = [ax.get_ylabel(), ax.get_title()]
+    legend = ax.get_legend()
+    if legend is not None:
+        texts += [t.get_text() for t in legend.get_texts()]
+    texts += [ln.get_label() for ln in ax.get_lines() if not ln.get_label().startswith("_")]
+    return " ".join(t for t in texts if t)
+
+
+@never_raises("Case study: the plot of the residual and D v", "case_study.plot")
+def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResult:
+    """Check the figure of the residual ``r`` with ``D v``, and of ``N r``, against the step ``k``.
+
+    The checks: every residual component ``r_i`` and every ``(Dv)_i`` of the run
+    is drawn in one panel; ``N r`` (for the row ``N`` with ``N D = 0``, any
+    scale) in another; the curves against the run's steps, with an x-label that
+    says steps; the panels labelled (``r``, ``Dv``, ``N r``).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    response : UIOResponse
+        The run that was plotted.
+    plant : Plant, optional
+        The plant of the lab's set-up cell.
+
+    Returns
+    -------
+    CheckResult
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from matplotlib.figure import Figure
+    >>> from uio_teach import checks
+    >>> from uio_teach.experiments import CASE_STUDY as CS
+    >>> plant = CS.plant()
+    >>> run = CS.simulate(ut.design_pmo(plant, method="lmi"))
+    >>> fig = Figure()
+    >>> ax_r, ax_n = fig.subplots(2, 1, sharex=True)
+    >>> _ = ax_r.plot(run.time, run.residual.T, label=["r1", "r2"])
+    >>> _ = ax_r.plot(run.time, (plant.D @ run.inputs.v).T, label=["(Dv)1", "(Dv)2"])
+    >>> _ = ax_r.set_ylabel("residual r and Dv")
+    >>> N = ut.linalg.left_null(plant.D)
+    >>> _ = ax_n.plot(run.time, (N @ run.residual).T); _ = ax_n.set_ylabel("N r")
+    >>> _ = ax_n.set_xlabel("step k")
+    >>> checks.case_study_plot(fig, run).passed
+    True
+    """
+    result = CheckResult("Case study: the plot of the residual and D v")
+    resp = _read_resp(result, response)
+    fig = read_figure(result, fig)
+    if resp is None or fig is None or not check_plant_of(result, resp, plant):
+        return result
+    axes = [ax for ax in fig.axes if ax.has_data()]
+    if not axes:
+        result.add(False, "the figure has no curves: did you draw into another figure?")
+        return result
+    t = np.asarray(resp.time, float)
+    names = [f"axes {i + 1}" for i in range(len(axes))]
+    units = xlabels(result, axes, names)
+    if not curves_against_time(result, axes, t, units):
+        return result
+    N = t.size
+    r = np.asarray(resp.residual, float)
+    Dv = resp.plant.D @ np.asarray(resp.inputs.v, float)
+    Nr = (left_null(resp.plant.D) @ r).ravel()
+    scale = max(1.0, float(np.max(np.abs(r))))
+
+    def rows_in(ax: Any, M: np.ndarray) -> set[int]:
+        ys = [np.asarray(ln.get_ydata(), float) for ln in ax.get_lines()]
+        ys = [y for y in ys if y.shape == (N,)]
+        return {
+            i
+            for i in range(M.shape[0])
+            for y in ys
+            if np.allclose(y, M[i], rtol=0, atol=1e-9 * scale)
+        }
+
+    def shows_Nr(ax: Any) -> bool:
+        tiny = float(np.max(np.abs(Nr))) <= 1e-9 * scale
+        for ln in ax.get_lines():
+            y = np.asarray(ln.get_ydata(), float)
+            if y.shape != (N,):
+                continue
+            if tiny:
+                if float(np.max(np.abs(y))) <= 1e-8 * scale:
+                    return True
+                continue
+            k = float(np.dot(Nr, y) / np.dot(Nr, Nr))
+            if abs(k) > 1e-9 and np.linalg.norm(y - k * Nr) <= 1e-6 * np.linalg.norm(y):
+                return True
+        return False
+
+    p = r.shape[0]
+    both = [ax for ax in axes if len(rows_in(ax, r)) == p and len(rows_in(ax, Dv)) == p]
+    if both:
+        result.add(True, "one panel shows every component of the residual r with D v.")
+    elif any(len(rows_in(ax, r)) == p for ax in axes):
+        result.add(
+            False,
+            "the residual is drawn, but not next to D v (every component) in the same panel: "
+            "the exercise compares the two.",
+        )
+    elif any(rows_in(ax, resp.outputs) for ax in axes):
+        result.add(False, "a panel shows the outputs y, not the residual r = y - C x̂.")
+    else:
+        result.add(False, "no panel shows the residual r of the run (every component).")
+    n_axes = [ax for ax in axes if shows_Nr(ax)]
+    if n_axes:
+        result.add(True, "another panel shows N r, the residual seen through N with N D = 0.")
+    else:
+        result.add(
+            False,
+            "no panel shows N r, the residual seen through the row N with N D = 0 (the "
+            "combination v does not reach).",
+        )
+    for ax in both[:1]:
+        text = _panel_text(ax)
+        if not (re.search(r"\bresidual|\br\b|\br_?\d", text) and re.search(r"D\s*v", text)):
+            result.add(
+                False,
+                "the panel of r and D v does not say which curve is which: label it (y-label "
+                "or legend naming r and Dv).",
+            )
+    for ax in n_axes[:1]:
+        if not re.search(r"N\s*r|N\s*\\?cdot\s*r", _panel_text(ax)):
+            result.add(False, "the panel of N r is not labelled as N r.")
     return result

@@ -18,19 +18,20 @@ from typing import Any
 
 import numpy as np
 
-from .. import experiments
 from .._display import format_matrix_line, format_poles
-from ._common import (
+from ..linalg import pinv, sort_poles
+from .common import (
     CheckResult,
-    _close,
-    _get_plant,
-    _looks_two_decimals,
-    _maxdiff,
-    _never_raises,
-    _numbers,
-    _read_matrix,
-    _stability,
-    _up_to,
+    as_poles,
+    close,
+    get_plant,
+    looks_two_decimals,
+    maxdiff,
+    never_raises,
+    read_matrix,
+    same_poles,
+    stability,
+    up_to,
 )
 
 __all__ = ["pa9_design"]
@@ -39,7 +40,7 @@ __all__ = ["pa9_design"]
 _OMITTED: Any = type("_Omitted", (), {"__repr__": lambda self: "<omitted>"})()
 
 
-@_never_raises("Practical Assignment 9: the observer design", "pa9.design")
+@never_raises("Practical Assignment 9: the observer design", "pa9.design")
 def pa9_design(
     H: Any,
     T: Any,
@@ -117,135 +118,162 @@ def pa9_design(
     ['K2 is -FH: the sign is flipped. The condition (A - K1C - HCA)H - K2 = 0 of eq. (7) gives K2 = FH.']
     """  # noqa: E501
     result = CheckResult("Practical Assignment 9: the observer design")
-    plant = _get_plant(result, plant)
+    plant = get_plant(result, plant)
     if plant is None:
         return result
     n, p = plant.n, plant.p
-    A, C, E = plant.A, plant.C, plant.E
     what_np = f"n x p = {n} x {p}: one row per state, one column per output"
     what_nn = f"n x n = {n} x {n}"
-    H = _read_matrix(result, "H", H, n, p, what_np)
-    T = _read_matrix(result, "T", T, n, n, what_nn)
-    K1 = _read_matrix(result, "K1", K1, n, p, what_np)
+    H = read_matrix(result, "H", H, n, p, what_np)
+    T = read_matrix(result, "T", T, n, n, what_nn)
+    K1 = read_matrix(result, "K1", K1, n, p, what_np)
     F_given = F is not _OMITTED
     K2_given = K2 is not _OMITTED
-    F = _read_matrix(result, "F", F, n, n, what_nn) if F_given else None
-    K2 = _read_matrix(result, "K2", K2, n, p, what_np) if K2_given else None
-    wanted = _read_poles(result, poles, n, plant.is_discrete) if poles is not None else None
+    F = read_matrix(result, "F", F, n, n, what_nn) if F_given else None
+    K2 = read_matrix(result, "K2", K2, n, p, what_np) if K2_given else None
+    wanted = _read_poles(result, poles, n) if poles is not None else None
     if poles is not None and wanted is None:
         return result
     if H is None or T is None or K1 is None or (F_given and F is None) or (K2_given and K2 is None):
         result.add(None, "Fix the shapes first; the design equations are checked afterwards.")
         return result
-
-    from ..linalg import pinv
-
-    eye = np.eye(n)
-    H_ref = E @ pinv(C @ E)
-
-    # (I - HC) E = 0 ---------------------------------------------------------------------------
-    R = (eye - H @ C) @ E
-    big = float(np.max(np.abs(R))) if R.size else 0.0
-    if big <= tol * max(1.0, float(np.max(np.abs(E))) if E.size else 1.0):
-        result.add(
-            True,
-            f"(I - HC)E = 0{_up_to(big, 'largest entry')}: H cancels the disturbance.",
-        )
-    else:
-        if _looks_two_decimals(H, H_ref):
-            hint = (
-                " Your H has the 2 decimals printed in the assignment; those numbers are "
-                "chopped, not exact, so the disturbance is not fully cancelled. Keep full "
-                "precision: H = E @ np.linalg.pinv(C @ E)."
-            )
-        elif _close(H, -H_ref, 1e-6):
-            hint = " Your H is -E(CE)^+: drop the minus sign."
-        else:
-            hint = (
-                " H must solve HCE = E; the assignment's choice is H = E (CE)^+, in NumPy "
-                "H = E @ np.linalg.pinv(C @ E) (pinv, because CE is not square)."
-            )
-        result.add(
-            False,
-            f"H does not satisfy (I - HC)E = 0: (I - HC)E = {format_matrix_line(R)} "
-            f"(largest entry {big:.3g}), "
-            f"so the disturbance d still drives the error.{hint}",
-        )
-
-    # T = I - HC -------------------------------------------------------------------------------
-    T_ref = eye - H @ C
-    T_ok = _close(T, T_ref, tol)
-    if T_ok:
-        result.add(True, "T = I - HC.")
-    else:
-        diff, idx = _maxdiff(T, T_ref)
-        where = f"T[{idx[0]}, {idx[1]}] is {T[idx]:.4g} but (I - HC)[{idx[0]}, {idx[1]}] is "
-        where += f"{T_ref[idx]:.4g}"
-        if _close(T, -T_ref, tol):
-            hint = " Your T is HC - I: the sign is flipped."
-        elif _close(T, H @ C, tol):
-            hint = " Your T is HC; it must be I - HC."
-        elif _looks_two_decimals(T, T_ref) or _looks_two_decimals(T, eye - H_ref @ C):
-            hint = " Your T has only 2 decimals; compute it as T = np.eye(n) - H @ C."
-        else:
-            hint = " Compute it from your H: T = np.eye(n) - H @ C."
-        result.add(False, f"T is not I - HC: {where} (difference {diff:.3g}).{hint}")
-
-    # F = TA - K1C -----------------------------------------------------------------------------
-    F_ref = T_ref @ A - K1 @ C
+    _cancels(result, plant, H, tol)
+    T_ok = _T_is_I_minus_HC(result, plant, H, T, tol)
+    T_ref = np.eye(n) - H @ plant.C
+    F_ref = T_ref @ plant.A - K1 @ plant.C
     if F_given:
-        if _close(F, F_ref, tol):
-            result.add(True, "F = TA - K1C.")
-        else:
-            diff, idx = _maxdiff(F, F_ref)
-            if not T_ok and _close(F, T @ A - K1 @ C, tol):
-                hint = " It is TA - K1C with your T, but your T is wrong (see above): fix T first."
-            elif _close(F, A - K1 @ C, tol):
-                hint = " Your F is A - K1C: the T is missing, F = TA - K1C."
-            elif _close(F, T_ref @ A + K1 @ C, tol):
-                hint = " Your F is TA + K1C: the sign of K1C is flipped."
-            else:
-                hint = " Compute it as F = T @ A - K1 @ C."
-            result.add(
-                False,
-                f"F is not TA - K1C: F[{idx[0]}, {idx[1]}] is {F[idx]:.4g} but "
-                f"(TA - K1C)[{idx[0]}, {idx[1]}] is {F_ref[idx]:.4g} "
-                f"(difference {diff:.3g}).{hint}",
-            )
+        _F_is_TA_minus_K1C(result, plant, T, T_ok, K1, F, F_ref, tol)
     else:
         result.add(None, "F not given: F = TA - K1C is computed from your H and K1.")
-
-    # K2 = FH ----------------------------------------------------------------------------------
     if K2_given:
-        K2_ref = F_ref @ H
-        if _close(K2, K2_ref, tol):
-            result.add(True, "K2 = FH.")
-        elif _close(K2, -K2_ref, tol):
-            result.add(
-                False,
-                "K2 is -FH: the sign is flipped. The condition (A - K1C - HCA)H - K2 = 0 of "
-                "eq. (7) gives K2 = FH.",
-            )
-        elif F_given and _close(K2, F @ H, tol):
-            result.add(False, "K2 = FH with your F, but your F is wrong (see above): fix F first.")
-        else:
-            diff, idx = _maxdiff(K2, K2_ref)
-            hint = (
-                " Your K2 is K1 - FH; K2 alone is FH."
-                if _close(K2, K1 - K2_ref, tol)
-                else " Compute it as K2 = F @ H."
-            )
-            result.add(
-                False,
-                f"K2 is not FH: K2[{idx[0]}, {idx[1]}] is {K2[idx]:.4g} but (FH)[{idx[0]}, "
-                f"{idx[1]}] is {K2_ref[idx]:.4g} (difference {diff:.3g}).{hint}",
-            )
+        _K2_is_FH(result, H, K1, F if F_given else None, K2, F_ref, tol)
+    eig = _stable(result, plant, F if F_given else F_ref, F_given)
+    if wanted is not None:
+        which = "F" if F_given else "F = TA - K1C"
+        _poles_asked(result, eig, wanted, which, plant.A - K1 @ plant.C, F_ref, F_given)
+    return result
 
-    # stability of F ---------------------------------------------------------------------------
-    F_used = F if F_given else F_ref
+
+def _cancels(result: CheckResult, plant: Any, H: np.ndarray, tol: float) -> None:
+    """Step 1: ``(I - HC)E = 0``, the disturbance cancelled."""
+    C, E = plant.C, plant.E
+    H_ref = E @ pinv(C @ E)
+    R = (np.eye(plant.n) - H @ C) @ E
+    big = float(np.max(np.abs(R))) if R.size else 0.0
+    if big <= tol * max(1.0, float(np.max(np.abs(E))) if E.size else 1.0):
+        result.add(True, f"(I - HC)E = 0{up_to(big, 'largest entry')}: H cancels the disturbance.")
+        return
+    if looks_two_decimals(H, H_ref):
+        hint = (
+            " Your H has the 2 decimals printed in the assignment; those numbers are chopped, "
+            "not exact, so the disturbance is not fully cancelled. Compute H at full precision "
+            "from E and C instead of typing it."
+        )
+    elif close(H, -H_ref, 1e-6):
+        hint = " Your H is -E(CE)^+: check the sign."
+    else:
+        hint = (
+            " H must solve HCE = E. CE is not square, so it has no inverse: which generalized "
+            "inverse gives a solution (see the toolbox chapter)?"
+        )
+    result.add(
+        False,
+        f"H does not satisfy (I - HC)E = 0: (I - HC)E = {format_matrix_line(R)} "
+        f"(largest entry {big:.3g}), so the disturbance d still drives the error.{hint}",
+    )
+
+
+def _differs(name: str, ref: str, X: np.ndarray, Y: np.ndarray) -> str:
+    """Where ``X`` and ``Y`` differ most, without giving the expected value away."""
+    diff, idx = maxdiff(X, Y)
+    size = "slightly (rounding?)" if diff <= 0.01 * max(1.0, float(np.max(np.abs(Y)))) else "a lot"
+    return f"{name} is not {ref}: they differ most in entry [{idx[0]}, {idx[1]}], {size}"
+
+
+def _T_is_I_minus_HC(
+    result: CheckResult, plant: Any, H: np.ndarray, T: np.ndarray, tol: float
+) -> bool:
+    """Step 2: ``T = I - HC`` with the student's own ``H``."""
+    eye = np.eye(plant.n)
+    C = plant.C
+    T_ref = eye - H @ C
+    if close(T, T_ref, tol):
+        result.add(True, "T = I - HC.")
+        return True
+    if close(T, -T_ref, tol):
+        hint = " Your T is HC - I: the sign is flipped."
+    elif close(T, H @ C, tol):
+        hint = " Your T is HC; it must be I - HC."
+    elif looks_two_decimals(T, T_ref) or looks_two_decimals(
+        T, eye - plant.E @ pinv(C @ plant.E) @ C
+    ):
+        hint = " Your T has only 2 decimals; compute it from your H instead of typing it."
+    else:
+        hint = " Compute it from your own H, with the identity of size n."
+    result.add(False, f"{_differs('T', 'I - HC', T, T_ref)}.{hint}")
+    return False
+
+
+def _F_is_TA_minus_K1C(
+    result: CheckResult,
+    plant: Any,
+    T: np.ndarray,
+    T_ok: bool,
+    K1: np.ndarray,
+    F: np.ndarray,
+    F_ref: np.ndarray,
+    tol: float,
+) -> None:
+    """Step 3: ``F = TA - K1C``."""
+    A, C = plant.A, plant.C
+    if close(F, F_ref, tol):
+        result.add(True, "F = TA - K1C.")
+        return
+    if not T_ok and close(F, T @ A - K1 @ C, tol):
+        hint = " It is TA - K1C with your T, but your T is wrong (see above): fix T first."
+    elif close(F, A - K1 @ C, tol):
+        hint = " Your F is A - K1C: the T is missing, F = TA - K1C."
+    elif close(F, F_ref + 2 * K1 @ C, tol):
+        hint = " Your F is TA + K1C: the sign of K1C is flipped."
+    else:
+        hint = " Compute it from your T, A, K1 and C, in the order of eq. (8)."
+    result.add(False, f"{_differs('F', 'TA - K1C', F, F_ref)}.{hint}")
+
+
+def _K2_is_FH(
+    result: CheckResult,
+    H: np.ndarray,
+    K1: np.ndarray,
+    F: np.ndarray | None,
+    K2: np.ndarray,
+    F_ref: np.ndarray,
+    tol: float,
+) -> None:
+    """Step 4: ``K2 = FH``."""
+    K2_ref = F_ref @ H
+    if close(K2, K2_ref, tol):
+        result.add(True, "K2 = FH.")
+    elif close(K2, -K2_ref, tol):
+        result.add(
+            False,
+            "K2 is -FH: the sign is flipped. The condition (A - K1C - HCA)H - K2 = 0 of "
+            "eq. (7) gives K2 = FH.",
+        )
+    elif F is not None and close(K2, F @ H, tol):
+        result.add(False, "K2 = FH with your F, but your F is wrong (see above): fix F first.")
+    else:
+        hint = (
+            " Your K2 is K1 - FH; K2 alone is FH."
+            if close(K2, K1 - K2_ref, tol)
+            else " Which product of eq. (8) gives K2?"
+        )
+        result.add(False, f"{_differs('K2', 'FH', K2, K2_ref)}.{hint}")
+
+
+def _stable(result: CheckResult, plant: Any, F_used: np.ndarray, F_given: bool) -> np.ndarray:
+    """Step 5: ``F`` stable; returns its eigenvalues."""
     which = "F" if F_given else "F = TA - K1C"
-    stable, eig, bad = _stability(F_used, plant.is_discrete)
-    asked = wanted if wanted is not None else experiments.PA9.poles
+    stable, eig, bad = stability(F_used, plant.is_discrete)
     region = "inside the unit circle" if plant.is_discrete else "in the open left half-plane"
     law = "e[k+1] = F e[k]" if plant.is_discrete else "e' = F e"
     if stable:
@@ -260,20 +288,16 @@ def pa9_design(
             f"{which} is not stable: the eigenvalue{'s' if len(bad) > 1 else ''} "
             f"{format_poles(bad)} "
             f"{'are' if len(bad) > 1 else 'is'} not {region}, so the error {law} does not "
-            "decay. Choose K1 so that TA - K1C has the poles you want, e.g. "
-            f"K1 = ct.place((T @ A).T, C.T, {_numbers(asked)}).T.",
+            "decay. Choose K1 so that TA - K1C has the poles of the exercise (pole placement "
+            "for the pair (TA, C), by duality).",
         )
-    if wanted is not None:
-        _poles_asked(result, eig, wanted, which, A - K1 @ C, T_ref @ A - K1 @ C, F_given)
-    return result
+    return eig
 
 
-def _read_poles(result: CheckResult, poles: Any, n: int, discrete: bool) -> np.ndarray | None:
+def _read_poles(result: CheckResult, poles: Any, n: int) -> np.ndarray | None:
     """The poles an exercise asks for, as a sorted complex array (a ✗ if they are unusable)."""
-    from ..linalg import sort_poles
-
     try:
-        arr = np.array([complex(p) for p in np.ravel(np.asarray(poles, dtype=object))])
+        arr = as_poles(poles)
     except (TypeError, ValueError):
         result.add(False, f"poles must be a list of {n} numbers, got {poles!r}.")
         return None
@@ -281,24 +305,6 @@ def _read_poles(result: CheckResult, poles: Any, n: int, discrete: bool) -> np.n
         result.add(False, f"poles must be a list of {n} finite numbers, got {poles!r}.")
         return None
     return sort_poles(arr)
-
-
-def _same_poles(got: np.ndarray, wanted: np.ndarray) -> bool:
-    from ..linalg import sort_poles
-
-    got = sort_poles(np.asarray(got, complex))
-    if got.size != wanted.size:
-        return False
-    used = [False] * got.size
-    for w in wanted:
-        k = next(
-            (i for i, g in enumerate(got) if not used[i] and abs(g - w) <= 1e-6 * max(1.0, abs(w))),
-            None,
-        )
-        if k is None:
-            return False
-        used[k] = True
-    return True
 
 
 def _poles_asked(
@@ -311,25 +317,22 @@ def _poles_asked(
     F_given: bool,
 ) -> None:
     """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for, else a ✗ with the cause."""
-    if _same_poles(eig, wanted):
+    if same_poles(eig, wanted):
         result.add(True, f"{which} has the poles asked for, {format_poles(wanted)}.")
         return
-    if _same_poles(np.linalg.eigvals(F_without_T), wanted):
+    if same_poles(np.linalg.eigvals(F_without_T), wanted):
         hint = (
             " Your K1 places the poles of A - K1C, not of TA - K1C: place them for the pair "
-            "(TA, C), K1 = ct.place((T @ A).T, C.T, poles).T."
+            "(TA, C)."
         )
     elif (
         F_given
-        and not _same_poles(np.linalg.eigvals(F_ref), eig)
-        and _same_poles(np.linalg.eigvals(F_ref), wanted)
+        and not same_poles(np.linalg.eigvals(F_ref), eig)
+        and same_poles(np.linalg.eigvals(F_ref), wanted)
     ):
         hint = " TA - K1C has them, so your F is not TA - K1C (see above)."
     else:
-        hint = (
-            " Place them with K1 = ct.place((T @ A).T, C.T, poles).T, with the poles of the "
-            "exercise."
-        )
+        hint = " Place them for the pair (TA, C) with the poles of PARAMS (duality)."
     result.add(
         False,
         f"{which} has the poles {format_poles(eig)}, but the exercise asks for "

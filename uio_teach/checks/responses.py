@@ -20,30 +20,25 @@ from typing import Any
 
 import numpy as np
 
-from .. import experiments
 from .._display import format_complex, format_poles
-from ._common import (
+from ..signals import piecewise_constant
+from ..simulation import simulate
+from .common import (
     CheckResult,
-    _never_raises,
-    _numbers,
-    _plural,
-    _stability,
-    _up_to,
+    as_poles,
+    check_plant_of,
+    close,
+    never_raises,
+    numbers,
+    plural,
+    read_response,
+    same_observer,
+    same_poles,
+    stability,
+    up_to,
 )
 
 __all__ = ["pa9_simulation", "pa9_piecewise"]
-
-
-def _read_response(result: CheckResult, response: Any, name: str = "response"):
-    needed = ("time", "states", "error", "residual", "inputs", "plant", "observer")
-    if response is None or not all(hasattr(response, a) for a in needed):
-        got = "None" if response is None else type(response).__name__
-        result.add(
-            False,
-            f"{name} must be the result of ut.simulate(plant, observer, timepts, ...), got {got}.",
-        )
-        return None
-    return response
 
 
 def _disturbance(result: CheckResult, resp) -> np.ndarray | None:
@@ -52,12 +47,10 @@ def _disturbance(result: CheckResult, resp) -> np.ndarray | None:
         return None
     d = np.asarray(resp.inputs.d, float)
     if not np.any(d):
-        pa9 = experiments.PA9
         result.add(
             False,
             "d is zero during the whole simulation, so the test says nothing about the "
-            "disturbance: pass one, e.g. ut.simulate(..., "
-            f"d=ut.signals.sinusoid({pa9.sine_amplitude:g}, {pa9.sine_frequency:g})).",
+            "disturbance: pass the disturbance of the exercise to ut.simulate (its d argument).",
         )
         return None
     return d
@@ -80,15 +73,13 @@ def _initial_error(result: CheckResult, resp) -> float:
         result.add(
             False,
             "the error is zero at t = 0, so nothing can be seen decaying: start the plant from "
-            f"a nonzero state, e.g. initial_state={_numbers(experiments.PA9.initial_state)}.",
+            "the nonzero initial state of PARAMS.",
         )
     return e0
 
 
 def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
     """Re-simulate with ``d = 0``; add a ✓/✗ on whether the error is unchanged."""
-    from ..simulation import simulate
-
     quiet = simulate(
         resp.plant,
         resp.observer,
@@ -104,7 +95,7 @@ def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
         result.add(
             True,
             f"the error does not depend on d: simulated again with d = 0, it is the same"
-            f"{_up_to(diff, 'largest difference')}.",
+            f"{up_to(diff, 'largest difference')}.",
         )
         return quiet.error
     if not resp.observer.decouples:
@@ -141,12 +132,12 @@ def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool 
         )
         return
     poles = resp.observer.poles()
-    stable, _, bad = _stability(resp.observer.error_matrix, resp.plant.is_discrete)
+    stable, _, bad = stability(resp.observer.error_matrix, resp.plant.is_discrete)
     if not stable:
         result.add(
             False,
             f"the error does not decay: the observer's error dynamics are unstable (pole(s) "
-            f"{format_poles(bad)}). Choose K1 so that F = TA - K1C is stable.",
+            f"{format_poles(bad)}). Its K1 must make F = TA - K1C stable (requirement 1).",
         )
         return
     if not decoupled:
@@ -177,7 +168,7 @@ def _jumps(d: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.any(np.abs(np.diff(d, axis=1)) > 1e-9 * scale, axis=0))
 
 
-@_never_raises("Practical Assignment 9: the test with a sinusoidal disturbance", "pa9.simulation")
+@never_raises("Practical Assignment 9: the test with a sinusoidal disturbance", "pa9.simulation")
 def pa9_simulation(
     response: Any,
     *,
@@ -186,6 +177,9 @@ def pa9_simulation(
     amplitude: float | None = None,
     frequency: float | None = None,
     initial_state: Any = None,
+    H: Any = None,
+    K1: Any = None,
+    plant: Any = None,
 ) -> CheckResult:
     """Check a simulation with a sinusoidal disturbance: does the error ignore ``d`` and decay?
 
@@ -207,6 +201,11 @@ def pa9_simulation(
         The sinusoid ``d(t) = amplitude sin(frequency t)`` the exercise asks for.
     initial_state : array_like, optional
         The plant's initial state the exercise asks for.
+    H, K1 : array_like, optional
+        Your design of requirement 1: the simulated observer must be built from
+        them (any valid ``H`` of yours, not only ``E (CE)^+``).
+    plant : Plant, optional
+        The plant of the lab's set-up cell: the run must be of this plant.
 
     Returns
     -------
@@ -226,7 +225,7 @@ def pa9_simulation(
     False
     """
     result = CheckResult("Practical Assignment 9: the test with a sinusoidal disturbance")
-    resp = _read_response(result, response)
+    resp = read_response(result, response)
     if resp is None:
         return result
     d = _disturbance(result, resp)
@@ -238,8 +237,8 @@ def pa9_simulation(
         if changing < 0.5:
             result.add(
                 False,
-                "d is piecewise constant, not a sinusoid: use d=ut.signals.sinusoid(amplitude, "
-                "frequency) here (the piecewise-constant test is checked by pa9_piecewise).",
+                "d is piecewise constant, not a sinusoid: this test takes the sinusoid of "
+                'PARAMS["sine"] (the piecewise-constant test is checked by pa9_piecewise).',
             )
         elif crossings < 2:
             result.add(
@@ -256,7 +255,9 @@ def pa9_simulation(
             _asked_signal(
                 result, d[0], want, f"d(t) = {float(amplitude):g} sin({float(frequency):g} t)"
             )
-    _asked_setup(result, resp, poles, initial_state)
+    if not check_plant_of(result, resp, plant):
+        return result
+    _asked_setup(result, resp, poles, initial_state, H, K1)
     if not _noise_free(result, resp):
         return result
     e0 = _initial_error(result, resp)
@@ -265,7 +266,7 @@ def pa9_simulation(
     return result
 
 
-@_never_raises(
+@never_raises(
     "Practical Assignment 9: the test with a piecewise-constant disturbance", "pa9.piecewise"
 )
 def pa9_piecewise(
@@ -278,6 +279,9 @@ def pa9_piecewise(
     values: Any = None,
     poles: Any = None,
     initial_state: Any = None,
+    H: Any = None,
+    K1: Any = None,
+    plant: Any = None,
 ) -> CheckResult:
     """Check a simulation with a piecewise-constant disturbance, and compare with the sinusoid.
 
@@ -304,6 +308,11 @@ def pa9_piecewise(
         The observer poles the exercise asks for.
     initial_state : array_like, optional
         The plant's initial state the exercise asks for.
+    H, K1 : array_like, optional
+        Your design of requirement 1: the simulated observer must be built from
+        them (any valid ``H`` of yours, not only ``E (CE)^+``).
+    plant : Plant, optional
+        The plant of the lab's set-up cell: the run must be of this plant.
 
     Returns
     -------
@@ -323,7 +332,7 @@ def pa9_piecewise(
     'd changes at 100% of the time steps'
     """
     result = CheckResult("Practical Assignment 9: the test with a piecewise-constant disturbance")
-    resp = _read_response(result, response)
+    resp = read_response(result, response)
     if resp is None:
         return result
     d = _disturbance(result, resp)
@@ -333,14 +342,15 @@ def pa9_piecewise(
         if jumps.size == 0:
             result.add(
                 False,
-                "d is constant: a piecewise-constant test needs at least one jump, e.g. "
-                "d=ut.signals.piecewise_constant([0, 4, 7], [1.0, -2.0, 0.5]).",
+                "d is constant: a piecewise-constant test needs jumps; take the times and "
+                'values of PARAMS["piecewise"].',
             )
         elif frac > max_jumps:
             result.add(
                 False,
                 f"d changes at {frac:.0%} of the time steps, so it is not piecewise constant "
-                "(is it still the sinusoid?): use d=ut.signals.piecewise_constant(times, values).",
+                "(is it still the sinusoid?): take the piecewise-constant d of "
+                'PARAMS["piecewise"].',
             )
         else:
             at = ", ".join(f"{resp.time[k + 1]:.3g}" for k in jumps[:6])
@@ -348,21 +358,20 @@ def pa9_piecewise(
             unit = "" if resp.plant.dt is True else " s"
             result.add(
                 True,
-                f"d is piecewise constant: {_plural(jumps.size, 'jump')} (at t = "
-                f"{at}{more}{unit}).",
+                f"d is piecewise constant: {plural(jumps.size, 'jump')} (at t = {at}{more}{unit}).",
             )
         if times is not None and values is not None and resp.plant.q == 1:
-            from ..signals import piecewise_constant
-
             want = np.asarray(piecewise_constant(times, values)(resp.time), float).ravel()
             _asked_signal(
                 result,
                 d[0],
                 want,
-                f"the piecewise-constant d with times {_numbers(times)} and values "
-                f"{_numbers(values)}",
+                f"the piecewise-constant d with times {numbers(times)} and values "
+                f"{numbers(values)}",
             )
-    _asked_setup(result, resp, poles, initial_state)
+    if not check_plant_of(result, resp, plant):
+        return result
+    _asked_setup(result, resp, poles, initial_state, H, K1)
     if not _noise_free(result, resp):
         return result
     e0 = _initial_error(result, resp)
@@ -374,7 +383,7 @@ def pa9_piecewise(
             "disturbances give the same error.",
         )
     else:
-        other = _read_response(result, sinusoidal, "sinusoidal")
+        other = read_response(result, sinusoidal, "sinusoidal")
         if other is not None:
             _compare(result, resp, other)
     _decays(result, resp, e0, decay, decoupled)
@@ -393,12 +402,12 @@ def _compare(result: CheckResult, resp, other) -> None:
         result.add(
             False,
             f"the two simulations start the plant from different states, "
-            f"{_numbers(resp.states[:, 0])} here and {_numbers(other.states[:, 0])} in the "
+            f"{numbers(resp.states[:, 0])} here and {numbers(other.states[:, 0])} in the "
             "sinusoidal test, so their errors differ for that reason alone: use the same "
             "initial_state in both.",
         )
         return
-    if not _same_observer(resp.observer, other.observer):
+    if not same_observer(resp.observer, other.observer):
         result.add(
             False,
             f"the two simulations use different observers (a {resp.observer.family} here, "
@@ -419,7 +428,7 @@ def _compare(result: CheckResult, resp, other) -> None:
         result.add(
             True,
             f"the error is the same as with the sinusoidal disturbance"
-            f"{_up_to(diff, 'largest difference')}: the observer does not see which "
+            f"{up_to(diff, 'largest difference')}: the observer does not see which "
             "disturbance acts.",
         )
     else:
@@ -428,20 +437,6 @@ def _compare(result: CheckResult, resp, other) -> None:
             f"the error differs from the sinusoidal test by up to {diff:.3g}: are both "
             "simulations made with the same decoupling observer?",
         )
-
-
-def _same_observer(a: Any, b: Any) -> bool:
-    if a is b:
-        return True
-    if type(a) is not type(b) or getattr(a, "family", None) != getattr(b, "family", None):
-        return False
-    for name in ("F", "H", "T", "K1", "K2", "L", "M", "error_matrix"):
-        x, y = getattr(a, name, None), getattr(b, name, None)
-        if x is None and y is None:
-            continue
-        if x is None or y is None or np.shape(x) != np.shape(y) or not np.allclose(x, y):
-            return False
-    return True
 
 
 def _asked_signal(result: CheckResult, got: np.ndarray, want: np.ndarray, what: str) -> None:
@@ -456,29 +451,83 @@ def _asked_signal(result: CheckResult, got: np.ndarray, want: np.ndarray, what: 
         )
 
 
-def _asked_setup(result: CheckResult, resp: Any, poles: Any, initial_state: Any) -> None:
-    """✓/✗ on the initial state and the observer poles that the exercise asks for."""
+def _asked_setup(
+    result: CheckResult,
+    resp: Any,
+    poles: Any,
+    initial_state: Any,
+    H: Any = None,
+    K1: Any = None,
+) -> None:
+    """✓/✗ on the initial state, the observer (the student's own design) and its poles."""
     if initial_state is not None:
         want = np.asarray(initial_state, float).ravel()
         got = resp.states[:, 0]
         if want.shape == got.shape and np.allclose(got, want, rtol=0, atol=1e-9):
-            result.add(True, f"the plant starts from x(0) = {_numbers(want)}, as asked.")
+            result.add(True, f"the plant starts from x(0) = {numbers(want)}, as asked.")
+        elif not np.any(got):
+            result.add(
+                False,
+                "the plant starts from x(0) = 0, but the exercise asks for the initial state "
+                "of PARAMS: was initial_state left out of ut.simulate?",
+            )
         else:
             result.add(
                 False,
-                f"the plant starts from x(0) = {_numbers(got)}, but the exercise asks for "
-                f'{_numbers(want)}: pass initial_state=PARAMS["initial_state"].',
+                f"the plant starts from x(0) = {numbers(got)}, but the exercise asks for "
+                f'{numbers(want)}: take it from PARAMS["initial_state"].',
             )
-    if poles is not None:
-        from .design import _same_poles
+    mine = _own_design(result, resp.observer, H, K1)
+    if poles is None:
+        return
+    got_poles = resp.observer.poles()
+    want_poles = as_poles(poles)
+    if same_poles(got_poles, want_poles):
+        result.add(True, f"the observer has the poles asked for, {format_poles(want_poles)}.")
+    elif mine is False:
+        result.add(
+            False,
+            f"the simulated observer has the poles {format_poles(got_poles)}, not the "
+            f"{format_poles(want_poles)} of the exercise, because it is not your design "
+            "(see above).",
+        )
+    else:
+        result.add(
+            False,
+            f"the observer has the poles {format_poles(got_poles)}, but the exercise asks "
+            f"for {format_poles(want_poles)}: its K1 does not place them (see requirement 1).",
+        )
 
-        got_poles = resp.observer.poles()
-        want_poles = np.array([complex(p) for p in np.ravel(np.asarray(poles, dtype=object))])
-        if _same_poles(got_poles, want_poles):
-            result.add(True, f"the observer has the poles asked for, {format_poles(want_poles)}.")
-        else:
-            result.add(
-                False,
-                f"the observer has the poles {format_poles(got_poles)}, but the exercise asks "
-                f"for {format_poles(want_poles)}: simulate the observer of requirement 1.",
-            )
+
+def _own_design(result: CheckResult, observer: Any, H: Any, K1: Any) -> bool | None:
+    """✓/✗: the simulated observer is built from the student's own ``H`` and ``K1``.
+
+    Returns None when neither is given, else whether both agree.
+    """
+    given = [(name, value) for name, value in (("H", H), ("K1", K1)) if value is not None]
+    if not given:
+        return None
+    differ = []
+    for name, value in given:
+        theirs = getattr(observer, name, None)
+        try:
+            mine = np.asarray(value, float)
+        except (TypeError, ValueError):
+            mine = None
+        if theirs is None or mine is None or not close(mine, np.asarray(theirs, float), 1e-8):
+            differ.append(name)
+    if not differ:
+        result.add(True, "the simulated observer is your design of requirement 1.")
+        return True
+    hint = (
+        " ut.design_uio(plant, K1=K1) builds it with H = E(CE)^+; an observer with your own "
+        "H and K1 is ut.UIO(plant, H, K1)."
+        if "H" in differ and getattr(observer, "family", "") == "UIO"
+        else " Build the observer from the H and K1 of requirement 1."
+    )
+    result.add(
+        False,
+        f"the simulated observer is not your design of requirement 1: its "
+        f"{' and '.join(differ)} differ{'s' if len(differ) == 1 else ''} from yours.{hint}",
+    )
+    return False

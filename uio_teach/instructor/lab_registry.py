@@ -54,7 +54,7 @@ class Lab:
     --------
     >>> from uio_teach.instructor.lab_registry import LABS
     >>> LABS["pa9"].check_ids
-    ('pa9.design', 'pa9.simulation', 'pa9.plot', 'pa9.piecewise')
+    ('pa9.design', 'pa9.simulation', 'pa9.plot', 'pa9.piecewise', 'pa9.piecewise_plot')
     """
 
     id: str
@@ -69,7 +69,7 @@ def _registry() -> dict[str, Lab]:
             "pa9",
             "lab_pa9.md",
             PA9Params,
-            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise"),
+            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise", "pa9.piecewise_plot"),
         ),
         "case_study": Lab(
             "case_study",
@@ -81,6 +81,7 @@ def _registry() -> dict[str, Lab]:
                 "case_study.pole",
                 "case_study.simulation",
                 "case_study.residual",
+                "case_study.plot",
             ),
         ),
         "missile": Lab(
@@ -91,6 +92,7 @@ def _registry() -> dict[str, Lab]:
                 "missile.pmo",
                 "missile.ginverse",
                 "missile.reconstruction",
+                "missile.plot",
                 "missile.catch_times",
                 "missile.noise",
             ),
