@@ -271,7 +271,7 @@ def _prose_claims() -> list[tuple[str, str]]:
         # case study
         (
             "case_study.md",
-            f"$u_2[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
+            f"$d[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
         ),
         (
             "case_study.md",
@@ -304,7 +304,7 @@ def _prose_claims() -> list[tuple[str, str]]:
         ),
         ("missile.md", f"the error ${_num(x0_missile[0])}\\,e^{{-l_1 t}}$"),
         # fault detection: the PA9 experiment again
-        ("fault_detection.md", f"the UIO with poles $\\{{{poles_pa9}\\}}$"),
+        ("fault_detection.md", f"the experiment's poles $\\{{{poles_pa9}\\}}$"),
         ("fault_detection.md", f"over the same {_num(PA9.duration)} s"),
         ("fault_detection.md", f"the disturbance $d(t) = {sin_pa9}$"),
     ]
