@@ -66,6 +66,11 @@ __all__ = [
 UNIT = "model units"
 """The unit of states, inputs and disturbances: the course's models give no physical units."""
 
+FIGURE_WIDTH = 9.0
+"""Width (inches) of a new figure: drawn at 100 dpi, the book shows it at 688 of its 911 px."""
+FONT_SIZE = 10
+"""Font size (points) of legends and notes: about 10.5 px at the book's column width."""
+
 _ROUNDING = 1e-9
 """Relative size below which a panel's values are called zero to rounding."""
 _MIN_SPAN = 1e-3
@@ -186,7 +191,7 @@ def _zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
             0.9,
             f"zero to rounding (largest {peak:.0e})" if peak > 0 else "zero",
             transform=ax.transAxes,
-            fontsize="small",
+            fontsize=FONT_SIZE,
             va="top",
         )
         return True
@@ -284,7 +289,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ylabel : str
         The label of its vertical axis.
     legend : bool, optional
-        Show the legend (upper right, small).
+        Show the legend (upper right, 10 points).
 
     Examples
     --------
@@ -298,7 +303,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
     if legend:
-        ax.legend(loc="upper right", fontsize="small")
+        ax.legend(loc="upper right", fontsize=FONT_SIZE)
 
 
 def plot_channels(
@@ -438,7 +443,7 @@ def _figure_and_axes(
     if fig is None:
         import matplotlib.pyplot as plt
 
-        fig = plt.figure(figsize=(10, height), layout="constrained")
+        fig = plt.figure(figsize=(FIGURE_WIDTH, height), layout="constrained")
     else:
         fig.clear()
     by_name = fig.subplot_mosaic(layout)
@@ -595,8 +600,8 @@ def plot_input_estimate(
 
 
 # The bank's figure: the members' colours (black is the alarm level), the smallest font size.
-_MEMBER_COLORS = ("C0", "C1", "C2", "C4", "C5", "C6", "C8", "C9")
-BANK_FONT_SIZE = 11
+_MEMBER_COLORS = ("C0", "C1", "C2", "C4", "C9", "C6", "C8", "C5")
+BANK_FONT_SIZE = FONT_SIZE + 1
 """Font size (points) of every text of :func:`plot_bank_alarms`: about 9 px or more when the
 figure is shown at the width of the book's column."""
 
@@ -628,7 +633,7 @@ def plot_bank_alarms(
     banks : sequence of UIOBank
         The banks whose members are drawn.
     thresholds : sequence of sequences of Threshold or None
-        One threshold per member, as :meth:`UIOBank.thresholds` returns them; a member
+        One threshold per member, as :meth:`uio_teach.UIOBank.thresholds` returns them; a member
         without one (it does not exist) is not drawn.
     fault_time : float, optional
         When the faults start (a dotted vertical line).
@@ -674,7 +679,7 @@ def plot_bank_alarms(
     if fig is None:
         import matplotlib.pyplot as plt  # deferred: a pyplot figure shows in a notebook
 
-        fig = plt.figure(figsize=(9.0, 1.0 + 2.4 * rows), layout="constrained")
+        fig = plt.figure(figsize=(FIGURE_WIDTH, 1.0 + 2.4 * rows), layout="constrained")
     else:
         fig.clear()
     axes = np.atleast_1d(fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False))
