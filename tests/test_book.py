@@ -5,7 +5,10 @@ The book is built once per test run into the repository's ``_build/html`` with t
 in headless Chromium (Debian's ``/usr/bin/chromium``, driven by Playwright), blocks every request
 that leaves the local server, and checks that the mathematics is typeset, every image loaded, no
 output cell shows an error and the console stays clean. A screenshot of each page is saved in
-``_build/screenshots/``.
+``_build/screenshots/``. At 1280 px every display equation, every visible code line and every
+printed output fits its column. The browser tests wait on events and page state (the load event,
+fonts, images, MathJax), never on a fixed duration, and assert nothing about how long anything
+took.
 """
 
 from __future__ import annotations
