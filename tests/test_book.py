@@ -5,7 +5,10 @@ The book is built once per test run into the repository's ``_build/html`` with t
 in headless Chromium (Debian's ``/usr/bin/chromium``, driven by Playwright), blocks every request
 that leaves the local server, and checks that the mathematics is typeset, every image loaded, no
 output cell shows an error and the console stays clean. A screenshot of each page is saved in
-``_build/screenshots/``.
+``_build/screenshots/``. At 1280 px every display equation, every visible code line and every
+printed output fits its column. The browser tests wait on events and page state (the load event,
+fonts, images, MathJax), never on a fixed duration, and assert nothing about how long anything
+took.
 """
 
 from __future__ import annotations
@@ -39,6 +42,11 @@ CHROMIUM_ARGS = [
     "--no-first-run",
 ]
 BUILD_TIMEOUT = 1800  # seconds, for a clean build that executes every chapter
+# Playwright's own limit for one navigation, wait or screenshot (its default is 30 s). The
+# browser tests wait on events and page state (load, fonts, images, MathJax); this limit is only
+# a safety net against a hung browser, generous enough for a machine whose cores are all busy.
+# No assertion depends on how long anything took.
+BROWSER_TIMEOUT_MS = 20 * 60 * 1000
 
 pytestmark = [pytest.mark.book, pytest.mark.timeout(BUILD_TIMEOUT)]
 
@@ -211,6 +219,41 @@ async () => {
 }
 """
 
+_WAIT_FOR_FONTS_JS = """
+async () => { await document.fonts.ready; return document.fonts.status; }
+"""
+
+
+def _new_context(browser, width: int):
+    """A browser context of the given viewport width, with the safety-net timeouts."""
+    context = browser.new_context(viewport={"width": width, "height": 900})
+    context.set_default_timeout(BROWSER_TIMEOUT_MS)
+    context.set_default_navigation_timeout(BROWSER_TIMEOUT_MS)
+    return context
+
+
+def _open_local(browser, book_server: str, page: str, width: int):
+    """Open a page of the book (requests to other hosts aborted) once it is fully rendered.
+
+    Waits on events and page state only: the load event, then the web fonts, every image and
+    MathJax's typesetting. Returns the context (close it) and the tab.
+    """
+    context = _new_context(browser, width)
+    tab = context.new_page()
+    host = urlsplit(book_server).hostname
+    tab.route(
+        "**/*",
+        lambda route: (
+            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
+        ),
+    )
+    tab.goto(f"{book_server}/{page}.html", wait_until="load")
+    tab.evaluate(_WAIT_FOR_FONTS_JS)
+    tab.evaluate(_WAIT_FOR_IMAGES_JS)
+    tab.evaluate(_WAIT_FOR_MATHJAX_JS)
+    return context, tab
+
+
 _ERROR_OUTPUTS = ".output.error, .output.traceback, .output.stderr"
 _EXCEPTION_LINE = re.compile(
     r"Traceback \(most recent call last\)|^[A-Z]\w*(Error|Exception): ", re.M
@@ -232,7 +275,7 @@ def test_page_in_browser(page: str, book_server: str, browser) -> None:
     console_errors: list[str] = []
     failed: list[str] = []
 
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
+    context = _new_context(browser, 1280)
     tab = context.new_page()
 
     def route(route) -> None:
@@ -258,6 +301,7 @@ def test_page_in_browser(page: str, book_server: str, browser) -> None:
 
         broken_images = tab.evaluate(_WAIT_FOR_IMAGES_JS)
         typeset = tab.evaluate(_WAIT_FOR_MATHJAX_JS)
+        tab.evaluate(_WAIT_FOR_FONTS_JS)
         has_math = tab.locator("main .math").count() > 0
         rendered_math = tab.locator("mjx-container").count()
         prose = tab.evaluate(_VISIBLE_PROSE_JS)
@@ -310,18 +354,8 @@ _DISPLAY_EQUATIONS_JS = """
 
 
 def _display_equations(browser, book_server: str, page: str, width: int) -> list[dict]:
-    context = browser.new_context(viewport={"width": width, "height": 900})
-    tab = context.new_page()
-    host = urlsplit(book_server).hostname
-    tab.route(
-        "**/*",
-        lambda route: (
-            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
-        ),
-    )
+    context, tab = _open_local(browser, book_server, page, width)
     try:
-        tab.goto(f"{book_server}/{page}.html", wait_until="load")
-        tab.evaluate(_WAIT_FOR_MATHJAX_JS)
         return tab.evaluate(_DISPLAY_EQUATIONS_JS)
     finally:
         context.close()
@@ -380,22 +414,57 @@ _WIDE_CODE_JS = """
 @pytest.mark.browser
 @pytest.mark.parametrize("page", PAGES)
 def test_visible_code_lines_fit_at_1280px(page: str, book_server: str, browser) -> None:
-    context = browser.new_context(viewport={"width": 1280, "height": 900})
-    tab = context.new_page()
-    host = urlsplit(book_server).hostname
-    tab.route(
-        "**/*",
-        lambda route: (
-            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
-        ),
-    )
+    context, tab = _open_local(browser, book_server, page, 1280)
     try:
-        tab.goto(f"{book_server}/{page}.html", wait_until="load")
         wide = tab.evaluate(_WIDE_CODE_JS)
     finally:
         context.close()
     assert not wide, f"{page}: code lines wider than their column at 1280 px:\n" + "\n".join(
         f"code cell {w['cell']}: {w['width']} px in {w['box']} px: {w['text']!r}" for w in wide
+    )
+
+
+# --- every printed output visible at 1280 px ---------------------------------------------------
+
+# Every output of a code cell, with the solution dropdowns opened (a reader opens them): the text
+# blocks (pre), the output boxes and their tables, whose content is wider than their box
+# (scrollWidth > clientWidth: the end of a line is cut off or needs sideways scrolling), and the
+# output boxes wider than the cell that holds them. Figures are scaled to the column by the theme.
+_WIDE_OUTPUTS_JS = """
+() => {
+  document.querySelectorAll("main details").forEach((d) => { d.open = true; });
+  const wide = [];
+  document.querySelectorAll("main div.cell_output").forEach((out, i) => {
+    const cell = out.closest("div.cell") || out;
+    const blocks = [out, ...out.querySelectorAll("pre, div.output, table")];
+    blocks.forEach((el) => {
+      if (!el.checkVisibility()) return;
+      const overflow = el.scrollWidth - el.clientWidth;
+      const outside = el.getBoundingClientRect().right - cell.getBoundingClientRect().right;
+      if (overflow > 1 || outside > 1) {
+        const lines = (el.textContent || "").split("\\n");
+        const longest = lines.reduce((a, l) => (l.length > a.length ? l : a), "");
+        wide.push({output: i + 1, tag: el.tagName.toLowerCase(), width: el.scrollWidth,
+                   box: el.clientWidth, text: longest.trim().slice(0, 72)});
+      }
+    });
+  });
+  return wide;
+}
+"""
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_printed_outputs_fit_at_1280px(page: str, book_server: str, browser) -> None:
+    context, tab = _open_local(browser, book_server, page, 1280)
+    try:
+        wide = tab.evaluate(_WIDE_OUTPUTS_JS)
+    finally:
+        context.close()
+    assert not wide, f"{page}: outputs wider than their column at 1280 px:\n" + "\n".join(
+        f"output {w['output']} ({w['tag']}): {w['width']} px in {w['box']} px: {w['text']!r}"
+        for w in wide
     )
 
 

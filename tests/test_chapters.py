@@ -271,7 +271,7 @@ def _prose_claims() -> list[tuple[str, str]]:
         # case study
         (
             "case_study.md",
-            f"$u_2[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
+            f"$d[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
         ),
         (
             "case_study.md",
@@ -304,7 +304,7 @@ def _prose_claims() -> list[tuple[str, str]]:
         ),
         ("missile.md", f"the error ${_num(x0_missile[0])}\\,e^{{-l_1 t}}$"),
         # fault detection: the PA9 experiment again
-        ("fault_detection.md", f"the UIO with poles $\\{{{poles_pa9}\\}}$"),
+        ("fault_detection.md", f"the experiment's poles $\\{{{poles_pa9}\\}}$"),
         ("fault_detection.md", f"over the same {_num(PA9.duration)} s"),
         ("fault_detection.md", f"the disturbance $d(t) = {sin_pa9}$"),
     ]
@@ -326,3 +326,35 @@ def test_prose_states_the_experiments_numbers() -> None:
     assert not missing, "text that no longer states the experiment's value:\n" + "\n".join(missing)
     for name in ("pa9.md", "fault_detection.md"):
         assert "$u = [1,\\ 0.5 \\sin t]^\\top$" in texts[name], name
+
+
+# --- one notation ---------------------------------------------------------------------------------
+
+# The observer's own state is z in every chapter (the missile paper's q is named only as the
+# paper's); r is the residual alone (the number of measurement disturbances is n_v, `plant.nv`).
+_OTHER_OBSERVER_STATE = re.compile(r"\\dot q\b|\bq\(0\)|\bq\[0\]|\bq_\{?\d|plant\.r\b")
+COURSE_CHAPTERS = [path for path in CHAPTERS if not path.name.startswith("lab_")]
+
+
+@pytest.mark.parametrize("chapter", COURSE_CHAPTERS, ids=[path.name for path in COURSE_CHAPTERS])
+def test_one_notation_for_the_observer_state_and_the_residual(chapter: Path) -> None:
+    lines = chapter.read_text(encoding="utf-8").splitlines()
+    found = [
+        f"line {k}: {line.strip()[:80]}"
+        for k, line in enumerate(lines, 1)
+        if _OTHER_OBSERVER_STATE.search(line)
+    ]
+    assert not found, f"{chapter.name}: the observer state is z, r the residual:\n" + "\n".join(
+        found
+    )
+
+
+def test_the_notation_table_names_z_d_nv_and_the_residual() -> None:
+    text = (BOOK / "introduction.md").read_text(encoding="utf-8")
+    table = text[text.index("(sec-introduction-notation)=") :]
+    rows = {
+        line.split("|")[1].strip(): line for line in table.splitlines() if line.startswith("| $")
+    }
+    assert "$z$" in rows and "observer" in rows["$z$"]
+    assert "$d$" in rows and "$u_2$" in rows["$d$"] and "$v_1, v_2$" in rows["$d$"]
+    assert "$n_v$" in rows["$v$"] and "$r = y - C\\hat x$" in rows

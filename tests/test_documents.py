@@ -5,6 +5,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach.examples import DT_CASE_STUDY_PUBLISHED, MISSILE_PUBLISHED, PA9_PUBLISHED
+from uio_teach.experiments import MISSILE
 
 
 def printed(x, decimals):
@@ -242,3 +243,34 @@ def test_missile_actuator_reading():
     wn = np.sqrt(-A[3, 2])
     assert wn == pytest.approx(180)
     assert -A[3, 3] / (2 * wn) == pytest.approx(0.6)
+
+
+def test_case_study_rounded_gain_is_accepted_and_projected_onto_LD_zero():
+    """The printed L (4 decimals) misses L D = 0 by ~4e-5: design_pmo warns and projects it."""
+    plant = ut.examples.dt_case_study()
+    off = np.abs(DT_CASE_STUDY_PUBLISHED.L @ plant.D).max()
+    assert 1e-5 < off < 1e-4
+    with pytest.warns(UserWarning, match="L D"):
+        pmo = ut.design_pmo(plant, L=DT_CASE_STUDY_PUBLISHED.L)
+    np.testing.assert_allclose(pmo.L @ plant.D, 0, atol=1e-15)
+    assert np.abs(pmo.L - DT_CASE_STUDY_PUBLISHED.L).max() < 4e-5
+    np.testing.assert_allclose(np.sort(pmo.poles().real), [0, 0.5, 0.5], atol=1e-4)
+
+
+@pytest.mark.parametrize(
+    ("poles", "x34"),
+    [([-60, -50], (0.084, 0.098)), ([-100, -120], (0.042, 0.060)), ([-300, -250], (0.039, 0.045))],
+)
+def test_missile_catch_times_of_x3_x4_depend_on_the_start_and_the_x1_pole(poles, x34):
+    """Table II: from xhat(0) = 0 the x1 error leaks into x3, x4 through A1's first column, so
+    their catch times follow the x1 pole; from z(0) = 0 only the fixed modes are excited."""
+    plant = MISSILE.plant()
+    pmo = ut.design_pmo(plant, poles=poles, Mv=MISSILE_PUBLISHED.Mv)
+    np.testing.assert_allclose(pmo.A1[2:, 0], [34.4, 154.8], atol=1e-9)
+    t = MISSILE.timepts
+    from_zero_estimate = MISSILE.simulate(pmo)  # xhat(0) = 0
+    from_zero_state = MISSILE.simulate(pmo, observer_state=None)  # z(0) = 0
+    catch = ut.catch_time(t, from_zero_estimate.states, from_zero_estimate.estimates, tol=0.02)
+    np.testing.assert_allclose(catch[2:], x34, atol=0.0015)
+    catch0 = ut.catch_time(t, from_zero_state.states, from_zero_state.estimates, tol=0.02)
+    np.testing.assert_allclose(catch0[2:], [0.051, 0.058], atol=0.0015)

@@ -112,3 +112,41 @@ def test_the_course_figures_follow_the_same_conventions():
     assert ax_r.lines[1].get_color() == ax_e.lines[2].get_color()  # r2 = e3
     fig = figures.FIGURES["case_response"].draw(runs)
     assert {ax.get_xlabel() for ax in fig.axes} - {""} == {"step k"}
+
+
+def test_bank_figure_draws_every_member_over_its_threshold_with_legible_text():
+    """One panel per run, one legend, each curve J / threshold, no text under 9 px on the page."""
+    pa9 = ut.examples.pa9()
+    plant = ut.Plant(pa9.A, np.eye(3), B=pa9.B, E=pa9.E)
+    detector = ut.design_uio(plant, poles=[-1, -2, -3])
+    t = np.linspace(0, 6, 601)
+    banks = [ut.design_uio_bank(plant, kind, poles=[-2, -3, -4]) for kind in ("actuator", "sensor")]
+    healthy = [ut.simulate_fault(plant, detector, t, noise=0.01, seed=k) for k in range(30)]
+    ths = [bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5) for bank in banks]
+    fault = ut.sensor_fault(plant, 0, ut.signals.step(0.3, 3.0))
+    runs = {"sensor 1": ut.simulate_fault(plant, detector, t, fault, noise=0.01, seed=99)}
+    runs["no fault"] = healthy[0]
+    runs["again"] = healthy[1]
+    fig = plotting.plot_bank_alarms(t, runs, banks, ths, fault_time=3.0, fig=plotting.new_figure())
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(visible) == 3 and len(fig.legends) == 1
+    assert all(ax.get_legend() is None for ax in visible)
+    members = [m for bank in banks for m in bank.members]
+    legend = [text.get_text() for text in fig.legends[0].get_texts()]
+    assert legend == [f"blind to {m.fault}" for m in members] + ["alarm level (J = threshold)"]
+    # the curves are J / threshold of each member, in the order of the legend
+    ax = visible[0]
+    curves = [line for line in ax.get_lines() if line.get_label().startswith("blind to")]
+    residuals = [r for bank in banks for r in bank.residuals(runs["sensor 1"])]
+    for line, r, th in zip(curves, residuals, [th for g in ths for th in g], strict=True):
+        expected = ut.residual_rms(t, r, th.window) / th.value
+        np.testing.assert_allclose(line.get_ydata(), expected)
+    assert ax.get_title() == "fault: sensor 1" and visible[1].get_title() == "no fault"
+    # legible: the book shows the 9-inch figure (911 px at 100 dpi) in its 688 px column
+    fig.set_size_inches(9, fig.get_size_inches()[1])
+    scale = 688 / 911
+    texts = [t_ for ax in visible for t_ in (ax.title, ax.xaxis.label, ax.yaxis.label)]
+    texts += [lab for ax in visible for lab in ax.get_xticklabels() + ax.get_yticklabels()]
+    texts += list(fig.legends[0].get_texts())
+    sizes_px = [text.get_fontsize() * 100 / 72 * scale for text in texts if text.get_text()]
+    assert min(sizes_px) >= 9, min(sizes_px)

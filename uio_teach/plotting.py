@@ -8,6 +8,8 @@ Drawing code only; the numbers come from :func:`uio_teach.simulate` and
   accepts an existing figure or axes;
 * panels: :func:`plot_error`, :func:`plot_residual` and :func:`plot_channels` draw
   one line per channel into an axes; :func:`finish_panel` labels and grids it;
+* the bank of UIOs: :func:`plot_bank_alarms` (each member's windowed residual over its
+  threshold, one panel per run, one legend for all panels);
 * names: :func:`symbol` (``$e_{1}$``, ``$\\hat{x}_{2}$``), :func:`axis_label` (the error
   ``e = x - xhat``, the residual ``r = y - C xhat``, an input and its estimate) and
   :func:`time_label`; :func:`new_figure` makes a figure without pyplot.
@@ -39,12 +41,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from .detection import Threshold
+    from .isolation import UIOBank
     from .reconstruction import InputEstimate
     from .simulation import UIOResponse
 
 __all__ = [
     "plot_response",
     "plot_input_estimate",
+    "plot_bank_alarms",
     "plot_error",
     "plot_residual",
     "plot_channels",
@@ -60,6 +65,11 @@ __all__ = [
 
 UNIT = "model units"
 """The unit of states, inputs and disturbances: the course's models give no physical units."""
+
+FIGURE_WIDTH = 9.0
+"""Width (inches) of a new figure: drawn at 100 dpi, the book shows it at 688 of its 911 px."""
+FONT_SIZE = 10
+"""Font size (points) of legends and notes: about 10.5 px at the book's column width."""
 
 _ROUNDING = 1e-9
 """Relative size below which a panel's values are called zero to rounding."""
@@ -181,7 +191,7 @@ def zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
             0.9,
             f"zero to rounding (largest {peak:.0e})" if peak > 0 else "zero",
             transform=ax.transAxes,
-            fontsize="small",
+            fontsize=FONT_SIZE,
             va="top",
         )
         return True
@@ -279,7 +289,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ylabel : str
         The label of its vertical axis.
     legend : bool, optional
-        Show the legend (upper right, small).
+        Show the legend (upper right, 10 points).
 
     Examples
     --------
@@ -293,7 +303,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
     if legend:
-        ax.legend(loc="upper right", fontsize="small")
+        ax.legend(loc="upper right", fontsize=FONT_SIZE)
 
 
 def plot_channels(
@@ -433,7 +443,7 @@ def _figure_and_axes(
     if fig is None:
         import matplotlib.pyplot as plt
 
-        fig = plt.figure(figsize=(10, height), layout="constrained")
+        fig = plt.figure(figsize=(FIGURE_WIDTH, height), layout="constrained")
     else:
         fig.clear()
     by_name = fig.subplot_mosaic(layout)
@@ -586,4 +596,143 @@ def plot_input_estimate(
         title = f"unknown input reconstruction ({estimate.method}"
         title += f", tau = {estimate.tau:g})" if estimate.tau is not None else ")"
     fig.suptitle(title)
+    return fig
+
+
+# The bank's figure: the members' colours (black is the alarm level), the smallest font size.
+_MEMBER_COLORS = ("C0", "C1", "C2", "C4", "C9", "C6", "C8", "C5")
+BANK_FONT_SIZE = FONT_SIZE + 1
+"""Font size (points) of every text of :func:`plot_bank_alarms`: about 9 px or more when the
+figure is shown at the width of the book's column."""
+
+
+def plot_bank_alarms(
+    timepts: Any,
+    runs: Any,
+    banks: Sequence[UIOBank],
+    thresholds: Sequence[Sequence[Threshold | None]],
+    *,
+    fault_time: float | None = None,
+    columns: int = 2,
+    fig: Figure | None = None,
+) -> Figure:
+    """Draw each bank member's evaluation function over its threshold, one panel per run.
+
+    Every panel shows one run (a fault, or none) and all the members of all the banks:
+    ``J / threshold`` on a logarithmic axis, so a curve above 1 (the black dashed line)
+    is an alarm. The members keep one colour in every panel; the members of the second
+    bank are dashed. One legend, above the panels, names them all; the grey band is the
+    start before monitoring begins.
+
+    Parameters
+    ----------
+    timepts : array_like, shape (N,)
+        The time grid of the runs.
+    runs : mapping of str to UIOResponse
+        The runs to show, by name (e.g. ``"actuator 1"``, ``"no fault"``).
+    banks : sequence of UIOBank
+        The banks whose members are drawn.
+    thresholds : sequence of sequences of Threshold or None
+        One threshold per member, as :meth:`uio_teach.UIOBank.thresholds` returns them; a member
+        without one (it does not exist) is not drawn.
+    fault_time : float, optional
+        When the faults start (a dotted vertical line).
+    columns : int, optional
+        Panels per row.
+    fig : matplotlib.figure.Figure, optional
+        Draw into this figure (it is cleared); by default a new pyplot figure, 9 inches
+        wide, so that a notebook shows it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> from uio_teach.plotting import plot_bank_alarms
+    >>> plant = ut.Plant(ut.examples.pa9().A, np.eye(3), B=ut.examples.pa9().B,
+    ...                  E=ut.examples.pa9().E)
+    >>> bank = ut.design_uio_bank(plant, "sensor", poles=[-2, -3, -4])
+    >>> t = np.linspace(0, 4, 401)
+    >>> detector = ut.design_uio(plant, poles=[-1, -2, -3])
+    >>> healthy = [ut.simulate_fault(plant, detector, t, noise=0.01, seed=k)
+    ...            for k in range(20)]
+    >>> ths = bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5)
+    >>> fig = plot_bank_alarms(t, {"no fault": healthy[0]}, [bank], [ths])
+    >>> len(fig.axes), len(fig.legends)
+    (1, 1)
+    """
+    from .detection import residual_rms  # the evaluation function J of eq. (fd-rms)
+
+    t = np.asarray(timepts, dtype=float)
+    names = list(runs)
+    if not names:
+        raise ValueError("runs is empty: give at least one run to draw")
+    if len(banks) != len(thresholds):
+        raise ValueError(
+            f"give one list of thresholds per bank: {len(banks)} banks, {len(thresholds)} lists"
+        )
+    columns = max(1, min(int(columns), len(names)))
+    rows = -(-len(names) // columns)
+    if fig is None:
+        import matplotlib.pyplot as plt  # deferred: a pyplot figure shows in a notebook
+
+        fig = plt.figure(figsize=(FIGURE_WIDTH, 1.0 + 2.4 * rows), layout="constrained")
+    else:
+        fig.clear()
+    axes = np.atleast_1d(fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False))
+    size = BANK_FONT_SIZE
+    handles: dict[str, Any] = {}
+    for k, name in enumerate(names):
+        ax = axes.flat[k]
+        colour = 0
+        for b, (bank, ths) in enumerate(zip(banks, thresholds, strict=True)):
+            for member, residual, th in zip(
+                bank.members, bank.residuals(runs[name]), ths, strict=True
+            ):
+                if residual is None or th is None:
+                    colour += 1
+                    continue
+                J = residual_rms(t, residual, th.window)
+                label = f"blind to {member.fault}"
+                (line,) = ax.plot(
+                    t,
+                    J / th.value,
+                    lw=1.4,
+                    ls="-" if b == 0 else "--",
+                    color=_MEMBER_COLORS[colour % len(_MEMBER_COLORS)],
+                    label=label,
+                )
+                handles.setdefault(label, line)
+                colour += 1
+                start = th.start
+        level = ax.axhline(1, color="k", lw=1, ls="--")
+        if handles:
+            ax.axvspan(t[0], start, color="0.88", lw=0)
+        if fault_time is not None:
+            ax.axvline(fault_time, color="0.4", ls=":", lw=1.2)
+        ax.set_yscale("log")
+        ax.set_title(name if name == "no fault" else f"fault: {name}", fontsize=size + 1)
+        ax.grid(alpha=0.3, which="both")
+        ax.tick_params(labelsize=size)
+    for ax in axes.flat[len(names) :]:
+        ax.set_visible(False)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("J / threshold", fontsize=size)
+    for k in range(columns):
+        column = [ax for ax in axes[:, k] if ax.get_visible()]
+        column[-1].set_xlabel(time_label(None), fontsize=size)
+        column[-1].xaxis.set_tick_params(labelbottom=True)
+    labels = list(handles) + ["alarm level (J = threshold)"]
+    lines = list(handles.values()) + [level]
+    fig.legend(
+        lines,
+        labels,
+        loc="outside upper center",
+        ncols=3,
+        fontsize=size,
+        frameon=False,
+    )
     return fig
