@@ -225,11 +225,10 @@ def _figure(fig: Any) -> dict[str, Any]:
                 ],
             }
         )
-    suptitle = getattr(fig, "_suptitle", None)  # matplotlib has no public getter before 3.8
     return {
         _TAG: "figure",
         "size": [float(v) for v in fig.get_size_inches()],
-        "suptitle": None if suptitle is None else str(suptitle.get_text()),
+        "suptitle": str(fig.get_suptitle()) or None,
         "legends": [_texts(leg.get_texts()) for leg in getattr(fig, "legends", [])],
         "axes": out_axes,
     }
@@ -462,9 +461,9 @@ def _strings(value: Any, what: str) -> list[str]:
 
 def _from_figure(data: Any) -> Any:
     # deferred on purpose: matplotlib is needed only for answers that are figures
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # deferred: see above
+    from matplotlib.figure import Figure  # deferred: see above
+    from matplotlib.lines import Line2D  # deferred: see above
 
     size = _need(data, "size", list)
     fig = Figure(figsize=tuple(float(v) for v in size[:2]) if len(size) >= 2 else None)
