@@ -77,6 +77,7 @@ __all__ = [
     "Limits",
     "grade",
     "read_answer_key",
+    "write_gradebook",
     "group_from_name",
     "clean_leftovers",
     "feedback_folder",
@@ -403,6 +404,52 @@ def _grade_one(
 
 
 # the run ----------------------------------------------------------------------------------
+
+
+def write_gradebook(
+    submissions: Sequence[Submission], out: str | os.PathLike[str]
+) -> tuple[Path, Path]:
+    """Write a whole gradebook at once: the CSV and one feedback text per submission.
+
+    :func:`grade` writes its rows one by one as it goes; this writes graded
+    submissions in one call (a fresh gradebook, as a run without ``resume``).
+
+    Parameters
+    ----------
+    submissions : sequence of Submission
+        The grades, in the order of the rows.
+    out : str or path-like
+        The CSV; the feedback goes to ``<stem>_feedback/`` beside it.
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        The CSV and the feedback folder.
+
+    Raises
+    ------
+    uio_teach.instructor.output.OutputError
+        ``out`` is a folder, or its feedback folder is not one of an earlier grading.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.grade import Submission, write_gradebook
+    >>> s = Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",))
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
+    ...     print(csv_path.read_text(encoding="utf-8").splitlines()[1])
+    ...     print(sorted(p.name for p in folder.iterdir()))
+    a.ipynb,pa9,g01,ok,✗,0,1
+    ['a.txt', 'manifest.json']
+    """
+    columns: list[str] = []
+    for sub in submissions:
+        columns += [c for c in sub.verdicts() if c not in columns]
+    with Gradebook(out, [s.file for s in submissions], columns) as book:
+        for sub in submissions:
+            book.add(sub)
+    return book.out, book.folder
 
 
 def _positive(name: str, value: Any) -> None:

@@ -100,6 +100,14 @@ class Submission:
         Time spent grading it.
     feedback_file : pathlib.Path or None
         Its feedback text, once written.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.gradebook import Submission
+    >>> s = Submission("pa9_g01.ipynb", "pa9", "g01", "unreadable",
+    ...                errors=["not a notebook"], expected=("pa9.design",))
+    >>> s.row(["pa9.design"])
+    ['pa9_g01.ipynb', 'pa9', 'g01', 'unreadable', '✗', 0, 1]
     """
 
     file: str

@@ -79,6 +79,12 @@ class Limits:
         Largest file a process may write (MiB).
     cpu_seconds : int
         CPU time of each process (a safety net under the wall-clock limit).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.sandbox import Limits
+    >>> Limits(memory_mb=2048).memory_mb, Limits().processes
+    (2048, 1024)
     """
 
     memory_mb: int = 4096
@@ -188,7 +194,9 @@ class Sandbox:
         -------
         list of str
         """
-        args = [_bwrap() or BWRAP, "--unshare-all", "--die-with-parent", "--new-session"]
+        args = [_bwrap() or BWRAP, "--unshare-user-try", "--unshare-ipc", "--unshare-pid"]
+        args += ["--unshare-net", "--unshare-uts", "--unshare-cgroup-try"]
+        args += ["--die-with-parent", "--new-session"]
         args += ["--ro-bind", "/usr", "/usr"]
         for name in ("bin", "lib", "lib32", "lib64", "sbin"):
             path = Path("/") / name
