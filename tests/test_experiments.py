@@ -138,3 +138,59 @@ def test_scenarios_read_the_experiments():
     d, _ = disturbance_signals(missile, missile.defaults)
     t = missile.timepts
     np.testing.assert_allclose(np.vstack([f(t) for f in d]), MISSILE.v(t), atol=1e-9)
+
+
+# the plant of a lab, from its PARAMS ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "lab, course",
+    [
+        ("pa9", ut.examples.pa9),
+        ("case_study", ut.examples.dt_case_study),
+        ("missile", ut.examples.missile_autopilot),
+    ],
+)
+def test_plant_from_params_is_the_course_plant_by_default(lab, course):
+    from uio_teach.experiments import plant_from_params
+
+    assert plant_from_params(lab) == course()
+    assert plant_from_params(lab, {"poles": [-1.0]}) == course()
+    assert plant_from_params(lab, {"plant": {}}) == course()
+
+
+def test_plant_from_params_puts_the_given_matrices_in_place():
+    from uio_teach.experiments import plant_from_params
+
+    course = ut.examples.dt_case_study()
+    A = [[0.4, 0.1, 0.0], [0.0, 0.5, 0.0], [0.0, 0.2, 0.3]]
+    plant = plant_from_params("case_study", {"plant": {"A": A, "D": [[2.0], [0.5]]}})
+    np.testing.assert_array_equal(plant.A, A)
+    np.testing.assert_array_equal(plant.D, [[2.0], [0.5]])
+    np.testing.assert_array_equal(plant.C, course.C)
+    np.testing.assert_array_equal(plant.E, course.E)
+    assert plant.dt == course.dt and plant.name == course.name
+
+
+@pytest.mark.parametrize(
+    "lab, params, match",
+    [
+        ("pa10", None, r"unknown lab 'pa10': expected one of pa9, case_study, missile"),
+        ("pa9", [1, 2], r"must be a mapping"),
+        ("pa9", {"plant": [[1.0]]}, r'PARAMS\["plant"\] of the pa9 lab must map matrix names'),
+        ("pa9", {"plant": {"F": [[1.0]]}}, r"unknown matrix 'F'; expected some of A, B, C, D, E"),
+        (
+            "pa9",
+            {"plant": {"E": [[1.0, 0.0]]}},
+            r'\["E"\] of the pa9 lab has shape \(1, 2\), '
+            r"expected \(3, 1\)",
+        ),
+        ("missile", {"plant": {"C": [[1, 0, 0, float("inf")], [0, 1, 0, 0]]}}, r"non-finite"),
+        ("missile", {"plant": {"A": "A"}}, r'PARAMS\["plant"\]\["A"\] must be a real numeric'),
+    ],
+)
+def test_plant_from_params_refuses_bad_input_clearly(lab, params, match):
+    from uio_teach.experiments import plant_from_params
+
+    with pytest.raises(ValueError, match=match):
+        plant_from_params(lab, params)

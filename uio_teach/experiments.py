@@ -34,14 +34,16 @@ True
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from types import MappingProxyType
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from . import examples, signals
+from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
 
@@ -53,7 +55,219 @@ __all__ = [
     "PA9",
     "CASE_STUDY",
     "MISSILE",
+    "EXPERIMENTS",
+    "Param",
+    "param",
+    "experiment_params",
+    "LAB_PLANTS",
+    "plant_from_params",
+    "pole_text",
 ]
+
+PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
+"""The kinds of value a :class:`Param` declares."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """What the course knows about one field of an experiment: the one declaration of it.
+
+    The term config (:mod:`uio_teach.instructor.config`), the lab parameters
+    (:mod:`uio_teach.instructor.lab_params`) and the explorers
+    (:mod:`uio_teach.explorers.scenarios`) read their keys, types, bounds,
+    help texts and ranges from these declarations, attached to the fields of
+    the experiment dataclasses with :func:`param`; adding a field to an
+    experiment adds it to all three.
+
+    Parameters
+    ----------
+    kind : {"int", "float", "floats", "poles", "str", "style", "matrices"}
+        The value's type: an integer, a number, a list of numbers, observer
+        poles (complex ones as strings such as ``"-1+2j"``), a string, a
+        matplotlib style, or plant matrices (``{"A": [[...]], ...}``).
+    doc : str
+        One line on what the value is (the config's comment).
+    unit : str
+        Its unit (``"s"``, ``"rad/s"``, ...; empty: none).
+    key : str, optional
+        Its dotted name inside the experiment's table of the term config and
+        in the lab's ``PARAMS`` (``"sine.amplitude"``); default: the field's name.
+    config : bool or str
+        ``True``: a key ``<section>.<key>`` of the term config; a string: that
+        key instead (``"seed"``, shared by the experiments); ``False``: not in
+        the config.
+    lab : bool
+        An entry of the lab's ``PARAMS``.
+    minimum, maximum : float, optional
+        Inclusive bounds (for ``"floats"`` without ``minimum`` and for a
+        ``"float"`` without ``minimum`` or ``positive``, ``maximum`` bounds the
+        magnitude).
+    positive : bool
+        Strictly positive.
+    length : int, optional
+        The exact length of a list.
+    discrete : bool
+        Poles of a discrete-time observer (inside the unit circle).
+    optional : bool
+        May be absent (the value ``None``).
+    omit_default : bool
+        Left out of ``PARAMS`` while it has its default value.
+    range : (float, float), optional
+        The range a student explores (the explorers' sliders).
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import PA9, experiment_params
+    >>> spec = dict(experiment_params(PA9))["sine_frequency"]
+    >>> spec.key, spec.unit, spec.config_key("pa9")
+    ('sine.frequency', 'rad/s', 'pa9.sine.frequency')
+    """
+
+    kind: str
+    doc: str
+    unit: str = ""
+    key: str | None = None
+    config: bool | str = True
+    lab: bool = True
+    minimum: float | None = None
+    maximum: float | None = None
+    positive: bool = False
+    length: int | None = None
+    discrete: bool = False
+    optional: bool = False
+    omit_default: bool = False
+    range: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in PARAM_KINDS:
+            raise ValueError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
+
+    def config_key(self, section: str, name: str = "") -> str | None:
+        """The key of the term config (``None``: not in the config).
+
+        Parameters
+        ----------
+        section : str
+            The experiment's table (``"pa9"``, ``"case_study"``, ``"missile"``).
+        name : str
+            The field's name (used when :attr:`key` is not given).
+
+        Returns
+        -------
+        str or None
+        """
+        if self.config is False:
+            return None
+        if isinstance(self.config, str):
+            return self.config
+        return f"{section}.{self.key or name}"
+
+    @property
+    def help(self) -> str:
+        """The one-line help: :attr:`doc`, and the unit in brackets."""
+        return f"{self.doc} [{self.unit}]" if self.unit else self.doc
+
+
+def param(default: Any, kind: str, doc: str, **options: Any) -> Any:
+    """An experiment field declared with its :class:`Param` (a ``dataclasses.field``).
+
+    Parameters
+    ----------
+    default : object
+        The course's value (immutable: a tuple for a list).
+    kind, doc : str
+        See :class:`Param`.
+    **options
+        The other arguments of :class:`Param`, and ``init``/``repr`` of
+        :func:`dataclasses.field`.
+
+    Returns
+    -------
+    dataclasses.Field
+
+    Examples
+    --------
+    >>> import dataclasses
+    >>> from uio_teach.experiments import PA9Experiment, param
+    >>> @dataclasses.dataclass(frozen=True)
+    ... class Heavier(PA9Experiment):
+    ...     gain: float = param(2.0, "float", "a gain of the known input", positive=True)
+    >>> Heavier(name="pa9", timepts=[0.0, 1.0]).gain
+    2.0
+    """
+    init = options.pop("init", True)
+    shown = options.pop("repr", True)
+    kwargs: dict[str, Any] = {
+        "init": init,
+        "repr": shown,
+        "metadata": {PARAM: Param(kind, doc, **options)},
+    }
+    if init:
+        kwargs["default"] = default
+    return field(**kwargs)
+
+
+PARAM = "uio_teach.param"
+"""The key of a field's :class:`Param` in its ``metadata``."""
+
+
+def experiment_params(experiment: Any) -> tuple[tuple[str, Param], ...]:
+    """The declared fields of an experiment (or experiment class), in order, with their Param.
+
+    Parameters
+    ----------
+    experiment : Experiment or type
+        An experiment, or its class.
+
+    Returns
+    -------
+    tuple of (str, Param)
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import MISSILE, experiment_params
+    >>> [name for name, spec in experiment_params(MISSILE) if spec.lab]
+    ['poles', 'duration', 'samples', 'style', 'matrices', 'noise_sigma', 'noise_seed', 'tol']
+    """
+    return tuple((f.name, f.metadata[PARAM]) for f in fields(experiment) if PARAM in f.metadata)
+
+
+MAX_SEED = 2**32 - 1
+"""The largest seed (numpy's legacy seeds and most tools take 32 bits)."""
+MAX_SAMPLES = 200_000
+"""The most time points of a continuous-time run (3 states: a few MB per signal)."""
+MAX_STEPS = 100_000
+"""The most steps of the discrete-time case study."""
+MAX_DURATION = 10_000.0
+"""The longest simulated time, in s."""
+MAX_VALUE = 1e6
+"""The largest magnitude of an amplitude, a level, a noise level or an initial state entry."""
+
+SEED_DOC = "seed of every random number: PA9's measurement noise, the case study's v"
+STYLE_DOC = "matplotlib style: a name of matplotlib.style.available or a .mplstyle file"
+
+
+def pole_text(p: complex) -> float | str:
+    """A pole as JSON and TOML keep it: a float if real, else a string such as ``"-1+2j"``.
+
+    Parameters
+    ----------
+    p : complex
+
+    Returns
+    -------
+    float or str
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import pole_text
+    >>> pole_text(-2), pole_text(complex(-1, 2))
+    (-2.0, '-1+2j')
+    """
+    z = complex(p)
+    if z.imag == 0:
+        return float(z.real) + 0.0
+    return f"{z.real:g}{z.imag:+g}j"
 
 
 def _frozen(values: Any) -> np.ndarray:
@@ -62,9 +276,24 @@ def _frozen(values: Any) -> np.ndarray:
     return arr
 
 
+def _matrices(value: Any) -> tuple[tuple[str, tuple[tuple[float, ...], ...]], ...]:
+    """Plant matrices as a hashable, sorted tuple of ``(name, rows)`` (from a mapping or pairs)."""
+    items = value.items() if isinstance(value, Mapping) else (value or ())
+    out = []
+    for name, matrix in items:
+        rows = np.atleast_2d(np.asarray(matrix, dtype=float))
+        out.append((str(name), tuple(tuple(float(x) + 0.0 for x in row) for row in rows)))
+    return tuple(sorted(out))
+
+
 @dataclass(frozen=True)
 class Experiment:
     """A worked experiment: the plant and everything a simulation of it needs but the observer.
+
+    The fields declared with :func:`param` are the experiment's numbers that
+    an instructor may change: each carries its :class:`Param` (type, unit,
+    help, bounds), from which the term config, the lab parameters and the
+    explorers are derived (:func:`experiment_params`).
 
     Attributes
     ----------
@@ -77,9 +306,18 @@ class Experiment:
     poles : tuple of complex, or None
         The observer poles of the experiment (``None``: the gain comes from the LMI).
     noise : float or None
-        Standard deviation of the measurement noise on every output (``None``: none).
+        Standard deviation of the measurement noise on every output (``None`` or 0: none).
     seed : int or None
         Seed of the noise and of any random signal of the experiment.
+    duration : float
+        The last time point (seconds, or steps), from ``timepts``.
+    samples : int
+        The number of time points, from ``timepts``.
+    style : str
+        The matplotlib style of its plots.
+    matrices : tuple
+        The plant's own matrices as ``(name, rows)`` pairs (empty: the course's
+        plant); :meth:`plant` puts them in place.
 
     Examples
     --------
@@ -88,12 +326,31 @@ class Experiment:
     ('missile', 0.5, 10001)
     """
 
+    lab: ClassVar[str] = ""
+    tables: ClassVar[Mapping[str, str]] = MappingProxyType({})
+
     name: str
     timepts: np.ndarray = field(repr=False)
     initial_state: np.ndarray
     poles: tuple[complex, ...] | None
     noise: float | None = None
     seed: int | None = None
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, config=False, lab=False
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, config=False, lab=False, repr=False
+    )
+    style: str = param("default", "style", STYLE_DOC, config="style", omit_default=True, repr=False)
+    matrices: tuple = param(
+        (),
+        "matrices",
+        "the plant's own matrices, e.g. {'E': [[1], [0], [2]]} (none: the course's)",
+        key="plant",
+        config=False,
+        omit_default=True,
+        repr=False,
+    )
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "timepts", _frozen(self.timepts))
@@ -101,10 +358,13 @@ class Experiment:
         if self.poles is not None:
             poles = tuple(complex(p) if complex(p).imag else complex(p).real for p in self.poles)
             object.__setattr__(self, "poles", poles)
+        object.__setattr__(self, "duration", float(self.timepts[-1]))
+        object.__setattr__(self, "samples", int(self.timepts.size))
+        object.__setattr__(self, "matrices", _matrices(self.matrices))
 
     # the plant and the time grid ----------------------------------------------------------------
     def plant(self) -> Plant:
-        """A new copy of the experiment's plant (from :mod:`uio_teach.examples`).
+        """A new copy of the experiment's plant: the course's, with :attr:`matrices` in place.
 
         Returns
         -------
@@ -115,13 +375,10 @@ class Experiment:
         >>> from uio_teach.experiments import PA9
         >>> PA9.plant().name
         'PA9'
+        >>> PA9.with_values(matrices={"E": [[1], [0], [0]]}).plant().E.ravel().tolist()
+        [1.0, 0.0, 0.0]
         """
-        raise NotImplementedError  # pragma: no cover - every experiment names its plant
-
-    @property
-    def duration(self) -> float:
-        """The last time point (seconds, or steps)."""
-        return float(self.timepts[-1])
+        return plant_from_params(self.lab, {"plant": dict(self.matrices)})
 
     def grid(self, samples: int | None = None, duration: float | None = None) -> np.ndarray:
         """The time grid, or one from the same start with another length or resolution.
@@ -149,6 +406,30 @@ class Experiment:
         stop = self.duration if duration is None else float(duration)
         count = self.timepts.size if samples is None else int(samples)
         return np.linspace(start, stop, count)
+
+    def with_values(self, **values: Any) -> Experiment:
+        """A copy with other values of its fields; ``duration`` and ``samples`` remake the grid.
+
+        Parameters
+        ----------
+        **values
+            Field names and their new values.
+
+        Returns
+        -------
+        Experiment
+
+        Examples
+        --------
+        >>> from uio_teach.experiments import PA9
+        >>> run = PA9.with_values(duration=5.0, samples=11, sine_amplitude=2.0)
+        >>> run.timepts[-1], run.timepts.size, run.sine_amplitude, PA9.duration
+        (np.float64(5.0), 11, 2.0, 10.0)
+        """
+        samples, duration = values.pop("samples", None), values.pop("duration", None)
+        if samples is not None or duration is not None:
+            values.setdefault("timepts", self.grid(samples=samples, duration=duration))
+        return replace(self, **values)
 
     # the run ------------------------------------------------------------------------------------
     @property
@@ -268,25 +549,71 @@ class PA9Experiment(Experiment):
     [1 step(t - 0); 0.5 sin(1 t)]
     """
 
-    sine_amplitude: float = 1.0
-    sine_frequency: float = 2.0
-    switch_times: tuple[float, ...] = (0.0, 2.0, 5.0, 7.5)
-    switch_values: tuple[float, ...] = (1.0, -1.5, 2.0, 0.0)
+    lab: ClassVar[str] = "pa9"
+    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {
+            "": "Practical Assignment 9: the decoupling observer and its lab",
+            "sine": "the sinusoidal disturbance",
+            "piecewise": "the piecewise-constant disturbance (0 before the first switching time)",
+        }
+    )
 
-    def plant(self) -> Plant:
-        """The PA9 plant, :func:`uio_teach.examples.pa9`.
-
-        Returns
-        -------
-        Plant
-
-        Examples
-        --------
-        >>> from uio_teach.experiments import PA9
-        >>> PA9.plant().n
-        3
-        """
-        return examples.pa9()
+    initial_state: np.ndarray = param(
+        (1.0, -1.0, 0.5), "floats", "plant state x(0)", length=3, maximum=MAX_VALUE
+    )
+    poles: tuple[complex, ...] | None = param(
+        (-1.0, -2.0, -3.0), "poles", "UIO poles (also the Luenberger poles)"
+    )
+    noise: float | None = param(
+        0.0,
+        "float",
+        "standard deviation of the measurement noise (0: none)",
+        minimum=0.0,
+        maximum=MAX_VALUE,
+        omit_default=True,
+        range=(0.0, 0.2),
+    )
+    seed: int | None = param(
+        4, "int", SEED_DOC, config="seed", minimum=0, maximum=MAX_SEED, omit_default=True
+    )
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
+    )
+    sine_amplitude: float = param(
+        1.0,
+        "float",
+        "d(t) = amplitude sin(frequency t)",
+        key="sine.amplitude",
+        maximum=MAX_VALUE,
+        range=(0.0, 5.0),
+    )
+    sine_frequency: float = param(
+        2.0,
+        "float",
+        "angular frequency, below the time grid's Nyquist frequency",
+        unit="rad/s",
+        key="sine.frequency",
+        positive=True,
+        range=(0.1, 10.0),
+    )
+    switch_times: tuple[float, ...] = param(
+        (0.0, 2.0, 5.0, 7.5),
+        "floats",
+        "switching times, increasing, within the duration",
+        unit="s",
+        key="piecewise.times",
+        minimum=0.0,
+    )
+    switch_values: tuple[float, ...] = param(
+        (1.0, -1.5, 2.0, 0.0),
+        "floats",
+        "the level held from each switching time",
+        key="piecewise.values",
+        maximum=MAX_VALUE,
+    )
 
     @property
     def inputs(self) -> Callable:
@@ -332,25 +659,102 @@ class CaseStudyExperiment(Experiment):
     (np.float64(40.0), None, 2 sin(0.6 t))
     """
 
-    u2_amplitude: float = 2.0
-    u2_frequency: float = 0.6
-    v_amplitude: float = 1.0
-    v_hold: int = 5
+    lab: ClassVar[str] = "case_study"
+    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {
+            "": "the discrete-time case study (projection-operator observer)",
+            "u2": "the unknown state input",
+            "v": "the measurement disturbance",
+        }
+    )
 
-    def plant(self) -> Plant:
-        """The case-study plant, :func:`uio_teach.examples.dt_case_study`.
+    initial_state: np.ndarray = param(
+        (1.0, -2.0, 3.0), "floats", "plant state x[0]", length=3, maximum=MAX_VALUE
+    )
+    poles: tuple[complex, ...] | None = param(
+        None,
+        "poles",
+        "the one movable pole, e.g. [0.2]; absent: the LMI gain of the case study",
+        discrete=True,
+        optional=True,
+        lab=False,
+    )
+    seed: int | None = param(
+        4, "int", SEED_DOC, config="seed", key="v.seed", minimum=0, maximum=MAX_SEED
+    )
+    duration: float = param(
+        None,
+        "int",
+        "number of steps k = 0 ... steps",
+        key="steps",
+        init=False,
+        minimum=2,
+        maximum=MAX_STEPS,
+    )
+    pole: float = param(
+        0.3,
+        "float",
+        "where the lab's exercise moves the one movable pole (inside the unit circle)",
+        config=False,
+        minimum=-1.0,
+        maximum=1.0,
+    )
+    u2_amplitude: float = param(
+        2.0,
+        "float",
+        "u2[k] = amplitude sin(frequency k)",
+        key="u2.amplitude",
+        maximum=MAX_VALUE,
+        range=(0.0, 5.0),
+    )
+    u2_frequency: float = param(
+        0.6,
+        "float",
+        "angular frequency, at most pi",
+        unit="rad per step",
+        key="u2.frequency",
+        positive=True,
+        maximum=math.pi,
+        range=(0.05, 3.0),
+    )
+    v_amplitude: float = param(
+        1.0,
+        "float",
+        "v: a random staircase, levels uniform in [-amplitude, amplitude]",
+        key="v.amplitude",
+        minimum=0.0,
+        maximum=MAX_VALUE,
+    )
+    v_hold: int = param(
+        5, "int", "steps each level of v is held", key="v.hold", minimum=1, maximum=MAX_STEPS
+    )
+
+    def grid(self, samples: int | None = None, duration: float | None = None) -> np.ndarray:
+        """The steps ``k = 0 ... duration`` (``samples``, if given, must be ``duration + 1``).
+
+        Parameters
+        ----------
+        samples : int, optional
+            Number of steps plus one.
+        duration : int, optional
+            The last step (default: :attr:`duration`).
 
         Returns
         -------
-        Plant
+        numpy.ndarray
 
         Examples
         --------
         >>> from uio_teach.experiments import CASE_STUDY
-        >>> CASE_STUDY.plant().is_discrete
-        True
+        >>> CASE_STUDY.grid(duration=3).tolist()
+        [0.0, 1.0, 2.0, 3.0]
         """
-        return examples.dt_case_study()
+        if duration is None and samples is None:
+            return self.timepts
+        last = int(duration) if duration is not None else int(samples) - 1
+        if samples is not None and int(samples) != last + 1:
+            raise ValueError(f"samples must be the steps plus one ({last + 1}), got {samples}")
+        return np.arange(last + 1, dtype=float)
 
     @property
     def u2(self) -> signals.Signal:
@@ -412,22 +816,47 @@ class MissileExperiment(Experiment):
     ((-100.0, -120.0), [10 exp(-2 t) cos(10 t); 50 exp(-5 t) sin(100 t)])
     """
 
+    lab: ClassVar[str] = "missile"
+    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {
+            "": "the missile autopilot of De, Banerjee and Das (2014)",
+            "noise": "the measurement noise of the lab's last exercise",
+        }
+    )
+
+    initial_state: np.ndarray = field(default=tuple(examples.MISSILE_PUBLISHED.x0))
+    poles: tuple[complex, ...] | None = param(
+        (-100.0, -120.0),
+        "poles",
+        "PMO poles (the paper's are not given; see chapter 5)",
+        key="pmo_poles",
+    )
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
+    )
     v_parameters: tuple[tuple[float, float, float, str], ...] = examples.MISSILE_INPUTS
-
-    def plant(self) -> Plant:
-        """The missile plant, :func:`uio_teach.examples.missile_autopilot`.
-
-        Returns
-        -------
-        Plant
-
-        Examples
-        --------
-        >>> from uio_teach.experiments import MISSILE
-        >>> MISSILE.plant().q
-        2
-        """
-        return examples.missile_autopilot()
+    noise_sigma: float = param(
+        0.01,
+        "float",
+        "standard deviation of the measurement noise",
+        key="noise.sigma",
+        positive=True,
+        maximum=MAX_VALUE,
+    )
+    noise_seed: int = param(
+        7, "int", "seed of that noise", key="noise.seed", minimum=0, maximum=MAX_SEED
+    )
+    tol: float = param(
+        0.02,
+        "float",
+        "the band of the catch times, relative to each signal's peak",
+        config=False,
+        positive=True,
+        maximum=1.0,
+    )
 
     @property
     def v(self) -> Callable:
@@ -465,36 +894,144 @@ class MissileExperiment(Experiment):
         return -observer.M @ C @ self.initial_state
 
 
-PA9 = PA9Experiment(
-    name="pa9",
-    timepts=np.linspace(0.0, 10.0, 2001),
-    initial_state=[1.0, -1.0, 0.5],
-    poles=(-1.0, -2.0, -3.0),
-)
+PA9 = PA9Experiment(name="pa9", timepts=np.linspace(0.0, 10.0, 2001))
 """The run of Practical Assignment 9.
 
 10 s on 2001 points, ``x(0) = [1, -1, 0.5]``, poles -1, -2, -3.
 """
 
-CASE_STUDY = CaseStudyExperiment(
-    name="case-study",
-    timepts=np.arange(41.0),
-    initial_state=[1.0, -2.0, 3.0],
-    poles=None,
-    seed=4,
-)
+CASE_STUDY = CaseStudyExperiment(name="case-study", timepts=np.arange(41.0))
 """The run of the case study.
 
 Steps ``k = 0 ... 40``, ``x[0] = [1, -2, 3]``, the LMI gain, seed 4.
 """
 
-MISSILE = MissileExperiment(
-    name="missile",
-    timepts=np.linspace(0.0, 0.5, 10_001),
-    initial_state=examples.MISSILE_PUBLISHED.x0,
-    poles=(-100.0, -120.0),
-)
+MISSILE = MissileExperiment(name="missile", timepts=np.linspace(0.0, 0.5, 10_001))
 """The run of the missile autopilot.
 
 0.5 s on 10001 points, the paper's ``x0``, PMO poles -100, -120.
 """
+
+
+class _Experiments(Mapping):
+    """The course's experiments by lab, read from this module's names when asked."""
+
+    _names = {"pa9": "PA9", "case_study": "CASE_STUDY", "missile": "MISSILE"}
+
+    def __getitem__(self, lab: str) -> Experiment:
+        return globals()[self._names[lab]]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __repr__(self) -> str:
+        return f"EXPERIMENTS({', '.join(self._names)})"
+
+
+EXPERIMENTS: Mapping[str, Experiment] = _Experiments()
+"""The course's experiments by lab (and table of the term config): ``PA9``, ``CASE_STUDY``,
+``MISSILE`` (a view: replacing one of them in this module replaces it here)."""
+
+
+LAB_PLANTS: Mapping[str, Callable[[], Plant]] = MappingProxyType(
+    {
+        "pa9": examples.pa9,
+        "case_study": examples.dt_case_study,
+        "missile": examples.missile_autopilot,
+    }
+)
+"""The course's plant of each lab (``"pa9"``, ``"case_study"``, ``"missile"``), as a factory."""
+
+_PLANT_MATRICES = ("A", "B", "C", "D", "E")
+
+
+def plant_from_params(lab: str, params: Mapping[str, Any] | None = None) -> Plant:
+    """The plant of a lab: the course's, with the matrices of ``params["plant"]`` in their place.
+
+    A lab notebook's ``PARAMS`` may carry a group's own plant as
+    ``PARAMS["plant"] = {"A": [[...]], "E": [[...]], ...}`` (nested lists, as
+    JSON keeps them); a matrix that is not given is the course's. Every given
+    matrix must have the shape of the course's one (the lab's text and checks
+    rely on the sizes n, m, q, p, n_v).
+
+    Parameters
+    ----------
+    lab : {"pa9", "case_study", "missile"}
+        The lab (see :data:`LAB_PLANTS`).
+    params : mapping, optional
+        The lab's ``PARAMS``; only its ``"plant"`` entry is read. ``None``, or
+        no ``"plant"`` entry: the course's plant.
+
+    Returns
+    -------
+    Plant
+        A new plant, with the name, sampling period and sizes of the course's.
+
+    Raises
+    ------
+    ValueError
+        An unknown lab, a ``"plant"`` entry that is not a mapping of the
+        names ``A, B, C, D, E``, or a matrix that is not a finite real matrix
+        of the course's shape (the message names the matrix and the shape
+        expected).
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import plant_from_params
+    >>> plant_from_params("pa9") == plant_from_params("pa9", {"poles": [-1, -2, -3]})
+    True
+    >>> plant = plant_from_params("pa9", {"plant": {"E": [[1], [0], [2]]}})
+    >>> plant.E.ravel().tolist(), plant.A[1].tolist()
+    ([1.0, 0.0, 2.0], [-2.0, -3.0, 0.0])
+    >>> plant_from_params("pa9", {"plant": {"E": [[1, 0]]}})
+    Traceback (most recent call last):
+    ...
+    ValueError: PARAMS["plant"]["E"] of the pa9 lab has shape (1, 2), expected (3, 1) ...
+    """
+    if not isinstance(lab, str) or lab not in LAB_PLANTS:
+        raise ValueError(f"unknown lab {lab!r}: expected one of {', '.join(LAB_PLANTS)}")
+    course = LAB_PLANTS[lab]()
+    if params is None:
+        return course
+    if not isinstance(params, Mapping):
+        raise ValueError(f"params of the {lab} lab must be a mapping (PARAMS), got {params!r}")
+    given = params.get("plant")
+    if given is None:
+        return course
+    if not isinstance(given, Mapping):
+        raise ValueError(
+            f'PARAMS["plant"] of the {lab} lab must map matrix names ({", ".join(_PLANT_MATRICES)})'
+            f" to nested lists, got {type(given).__name__}"
+        )
+    unknown = sorted(str(k) for k in given if k not in _PLANT_MATRICES)
+    if unknown:
+        raise ValueError(
+            f'PARAMS["plant"] of the {lab} lab: unknown matrix {", ".join(map(repr, unknown))};'
+            f" expected some of {', '.join(_PLANT_MATRICES)}"
+        )
+    matrices = {name: getattr(course, name) for name in _PLANT_MATRICES}
+    for name, value in given.items():
+        label = f'PARAMS["plant"]["{name}"]'
+        expected = matrices[name].shape
+        try:
+            arr = as_matrix(label, value)
+        except ValueError as err:
+            raise ValueError(f"{err} (the {lab} lab)") from None
+        if arr.shape != expected:
+            raise ValueError(
+                f"{label} of the {lab} lab has shape {arr.shape}, expected {expected}"
+                f" (the shape of the course's {name})"
+            )
+        matrices[name] = arr
+    return Plant(
+        matrices["A"],
+        matrices["C"],
+        B=matrices["B"],
+        E=matrices["E"],
+        D=matrices["D"],
+        dt=course.dt,
+        name=course.name,
+    )

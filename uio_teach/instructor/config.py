@@ -26,8 +26,23 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
+
 from .._display import format_poles
-from ..experiments import CASE_STUDY, MISSILE, PA9
+from ..existence import check_existence
+from ..experiments import (
+    EXPERIMENTS,
+    MAX_DURATION,
+    MAX_SAMPLES,
+    MAX_SEED,
+    MAX_STEPS,
+    MAX_VALUE,
+    Experiment,
+    Param,
+    experiment_params,
+    pole_text,
+)
+from ..observers import design_pmo, design_uio
 
 __all__ = [
     "ConfigError",
@@ -35,8 +50,17 @@ __all__ = [
     "load_config",
     "default_config_toml",
     "check_dpi",
+    "config_schema",
+    "config_tables",
+    "ConfigKey",
+    "design_observer",
+    "OBSERVER_KEYS",
     "DPI_RANGE",
+    "MAX_DURATION",
     "MAX_SAMPLES",
+    "MAX_SEED",
+    "MAX_STEPS",
+    "MAX_VALUE",
 ]
 
 
@@ -70,156 +94,161 @@ class ConfigError(ValueError):
         super().__init__("\n".join(self.problems))
 
 
-MAX_SEED = 2**32 - 1
-"""The largest seed (numpy's legacy seeds and most tools take 32 bits)."""
-MAX_SAMPLES = 200_000
-"""The most time points of a continuous-time run (3 states: a few MB per signal)."""
-MAX_STEPS = 100_000
-"""The most steps of the discrete-time case study."""
-MAX_DURATION = 10_000.0
-"""The longest simulated time, in s."""
-MAX_VALUE = 1e6
-"""The largest magnitude of an amplitude, a level, a noise level or an initial state entry."""
-MAX_POLE = 1e5
-"""The largest magnitude of a continuous-time pole (faster ones need a finer grid than allowed)."""
 DPI_RANGE = (20, 1200)
 """The resolutions ``uio-teach figures --dpi`` accepts (both ends included)."""
+MAX_POLE = 1e5
+"""The largest magnitude of a continuous-time pole (faster ones need a finer grid than allowed)."""
 
 
 @dataclass(frozen=True)
-class _Option:
-    kind: str  # "int", "float", "floats", "poles", "str"
+class ConfigKey:
+    """One key of the term config, derived from the ``Param`` of an experiment's field.
+
+    Attributes
+    ----------
+    key : str
+        The dotted key (``"pa9.sine.amplitude"``).
+    kind : str
+        ``"int"``, ``"float"``, ``"floats"``, ``"poles"`` or ``"str"``.
+    default : object
+        The course's value, as TOML writes it (``None``: absent by default).
+    help : str
+        The comment of ``--print-config``.
+    minimum, maximum, positive, length, optional, discrete
+        The bounds of :class:`~uio_teach.experiments.Param`.
+    """
+
+    key: str
+    kind: str
     default: Any
     help: str
-    minimum: float | None = None  # inclusive lower bound (numbers)
-    maximum: float | None = None  # inclusive upper bound (numbers; |x| for "floats"/"float")
-    positive: bool = False  # strictly positive (numbers)
-    length: int | None = None  # exact length (lists)
-    optional: bool = False  # may be absent (default None)
+    minimum: float | None = None
+    maximum: float | None = None
+    positive: bool = False
+    length: int | None = None
+    optional: bool = False
+    discrete: bool = False
 
 
-_SCHEMA: dict[str, _Option] = {
-    "seed": _Option(
-        "int",
-        CASE_STUDY.seed,
-        "seed of every random number: PA9's measurement noise, the case study's v",
-        minimum=0,
-        maximum=MAX_SEED,
-    ),
-    "style": _Option(
-        "str",
-        "default",
-        "matplotlib style: a name of matplotlib.style.available or a .mplstyle file",
-    ),
-    "pa9.poles": _Option("poles", list(PA9.poles), "UIO poles (also the Luenberger poles)"),
-    "pa9.duration": _Option(
-        "float", PA9.duration, "simulated time in s", positive=True, maximum=MAX_DURATION
-    ),
-    "pa9.samples": _Option(
-        "int", PA9.timepts.size, "number of time points", minimum=2, maximum=MAX_SAMPLES
-    ),
-    "pa9.initial_state": _Option(
-        "floats", PA9.initial_state.tolist(), "plant state x(0)", length=3, maximum=MAX_VALUE
-    ),
-    "pa9.noise": _Option(
-        "float",
-        0.0,
-        "standard deviation of the measurement noise (0: none)",
-        minimum=0.0,
-        maximum=MAX_VALUE,
-    ),
-    "pa9.sine.amplitude": _Option(
-        "float", PA9.sine_amplitude, "d(t) = amplitude sin(frequency t)", maximum=MAX_VALUE
-    ),
-    "pa9.sine.frequency": _Option(
-        "float",
-        PA9.sine_frequency,
-        "angular frequency in rad/s, below the time grid's Nyquist frequency",
-        positive=True,
-    ),
-    "pa9.piecewise.times": _Option(
-        "floats",
-        list(PA9.switch_times),
-        "switching times in s, increasing, within the duration",
-        minimum=0.0,
-    ),
-    "pa9.piecewise.values": _Option(
-        "floats",
-        list(PA9.switch_values),
-        "the level held from each switching time",
-        maximum=MAX_VALUE,
-    ),
-    "case_study.poles": _Option(
-        "poles",
-        None,
-        "the one movable pole, e.g. [0.2]; absent: the LMI gain of the case study",
-        optional=True,
-    ),
-    "case_study.steps": _Option(
-        "int",
-        int(CASE_STUDY.duration),
-        "number of steps k = 0 ... steps",
-        minimum=2,
-        maximum=MAX_STEPS,
-    ),
-    "case_study.initial_state": _Option(
-        "floats",
-        CASE_STUDY.initial_state.tolist(),
-        "plant state x[0]",
-        length=3,
-        maximum=MAX_VALUE,
-    ),
-    "case_study.u2.amplitude": _Option(
-        "float",
-        CASE_STUDY.u2_amplitude,
-        "u2[k] = amplitude sin(frequency k)",
-        maximum=MAX_VALUE,
-    ),
-    "case_study.u2.frequency": _Option(
-        "float",
-        CASE_STUDY.u2_frequency,
-        "angular frequency in rad per step, at most pi",
-        positive=True,
-        maximum=math.pi,
-    ),
-    "case_study.v.amplitude": _Option(
-        "float",
-        CASE_STUDY.v_amplitude,
-        "v: a random staircase, levels uniform in [-amplitude, amplitude]",
-        minimum=0,
-        maximum=MAX_VALUE,
-    ),
-    "case_study.v.hold": _Option(
-        "int", CASE_STUDY.v_hold, "steps each level of v is held", minimum=1, maximum=MAX_STEPS
-    ),
-    "missile.pmo_poles": _Option(
-        "poles", list(MISSILE.poles), "PMO poles (the paper's are not given; see chapter 5)"
-    ),
-    "missile.duration": _Option(
-        "float", 0.3, "simulated time in s", positive=True, maximum=MAX_DURATION
-    ),
-    "missile.samples": _Option(
-        "int", 6001, "number of time points", minimum=2, maximum=MAX_SAMPLES
-    ),
-}
+def _toml_default(spec: Param, value: Any) -> Any:
+    if value is None:
+        return None
+    if spec.kind == "poles":
+        return [pole_text(p) for p in value]
+    if spec.kind == "floats":
+        return [float(v) + 0.0 for v in np.asarray(value, dtype=float).ravel()]
+    if spec.kind == "int":
+        return int(value)
+    if spec.kind == "float":
+        return float(value) + 0.0
+    return value
 
-_DISCRETE_POLES = {"case_study.poles"}
-_SECTION_HELP = {
-    "pa9": "Practical Assignment 9: the decoupling observer and its lab",
-    "pa9.sine": "the sinusoidal disturbance",
-    "pa9.piecewise": "the piecewise-constant disturbance (0 before the first switching time)",
-    "case_study": "the discrete-time case study (projection-operator observer)",
-    "case_study.u2": "the unknown state input",
-    "case_study.v": "the measurement disturbance",
-    "missile": "the missile autopilot of De, Banerjee and Das (2014)",
-}
+
+def config_schema(
+    experiments: Mapping[str, Experiment] | None = None,
+) -> dict[str, ConfigKey]:
+    """Every key of the term config, derived from the declared fields of the experiments.
+
+    A field whose :class:`~uio_teach.experiments.Param` has ``config`` set
+    becomes a key: its type, bounds and help come from the declaration, its
+    default is the experiment's value. A key shared by several experiments
+    (``seed``, ``style``) is declared alike in each. Global keys come first,
+    then each experiment's table, its own keys before its subtables.
+
+    Parameters
+    ----------
+    experiments : mapping, optional
+        Table name to experiment (default: :data:`uio_teach.experiments.EXPERIMENTS`).
+
+    Returns
+    -------
+    dict
+        Dotted key to :class:`ConfigKey`, in the order of ``--print-config``.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import config_schema
+    >>> schema = config_schema()
+    >>> schema["pa9.sine.frequency"].help, schema["pa9.sine.frequency"].default
+    ("angular frequency, below the time grid's Nyquist frequency [rad/s]", 2.0)
+    >>> list(schema)[:2]
+    ['seed', 'style']
+    """
+    experiments = EXPERIMENTS if experiments is None else experiments
+    found: dict[str, ConfigKey] = {}
+    for section, experiment in experiments.items():
+        for name, spec in experiment_params(experiment):
+            key = spec.config_key(section, name)
+            if key is None:
+                continue
+            entry = ConfigKey(
+                key=key,
+                kind="str" if spec.kind == "style" else spec.kind,
+                default=_toml_default(spec, getattr(experiment, name)),
+                help=spec.help,
+                minimum=spec.minimum,
+                maximum=spec.maximum,
+                positive=spec.positive,
+                length=spec.length,
+                optional=spec.optional,
+                discrete=spec.discrete,
+            )
+            if key in found and found[key] != entry:
+                raise ValueError(
+                    f"the config key {key!r} is declared twice, differently: "
+                    f"{found[key]} and {entry}"
+                )
+            found[key] = entry
+    tables = config_tables(experiments)
+
+    def order(key: str) -> tuple[int, int, int]:
+        table = key.rpartition(".")[0]
+        if not table:
+            return (0, 0, 0)
+        names = list(tables)
+        section = table.split(".")[0]
+        return (1, names.index(section), 0 if table == section else names.index(table))
+
+    keys = sorted(found, key=lambda k: order(k) + (list(found).index(k),))
+    return {k: found[k] for k in keys}
+
+
+def config_tables(experiments: Mapping[str, Experiment] | None = None) -> dict[str, str]:
+    """The tables of the term config and their comments (from the experiments' ``tables``).
+
+    Parameters
+    ----------
+    experiments : mapping, optional
+        Table name to experiment (default: :data:`uio_teach.experiments.EXPERIMENTS`).
+
+    Returns
+    -------
+    dict
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import config_tables
+    >>> config_tables()["pa9.sine"]
+    'the sinusoidal disturbance'
+    """
+    experiments = EXPERIMENTS if experiments is None else experiments
+    out: dict[str, str] = {}
+    for section, experiment in experiments.items():
+        docs = dict(experiment.tables)
+        out[section] = docs.get("", section)
+        for name, spec in experiment_params(experiment):
+            key = spec.config_key(section, name)
+            table = key.rpartition(".")[0] if key else ""
+            if table.startswith(section + "."):
+                out.setdefault(table, docs.get(table[len(section) + 1 :], table))
+    return out
 
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> Iterable[tuple[str, Any]]:
     for key, value in table.items():
         name = f"{prefix}{key}"
         if isinstance(value, dict):
-            if name in _SECTION_HELP:
+            if name in config_tables():
                 yield from _flatten(value, name + ".")
             else:
                 yield name, value
@@ -247,7 +276,7 @@ def _number(key: str, value: Any, what: str = "a number") -> float:
     return float(value)
 
 
-def _bounds(key: str, opt: _Option, x: float) -> None:
+def _bounds(key: str, opt: ConfigKey, x: float) -> None:
     if opt.positive and x <= 0:
         raise ConfigError(f"{key}: must be > 0, got {x:g}")
     if opt.minimum is not None and x < opt.minimum:
@@ -277,7 +306,7 @@ def _pole(key: str, value: Any) -> complex:
     return complex(_number(key, value, "a number or a string such as '-1+2j'"))
 
 
-def _check_value(key: str, opt: _Option, value: Any) -> Any:
+def _check_value(key: str, opt: ConfigKey, value: Any) -> Any:
     if opt.kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{key}: expected an integer, got {_describe(value)}")
@@ -304,7 +333,7 @@ def _check_value(key: str, opt: _Option, value: Any) -> Any:
         return tuple(xs)
     # poles
     poles = tuple(_pole(f"{key}[{i}]", v) for i, v in enumerate(value))
-    discrete = key in _DISCRETE_POLES
+    discrete = opt.discrete
     for z in poles:
         if not discrete and abs(z) > MAX_POLE:
             raise ConfigError(
@@ -358,7 +387,7 @@ class FigureConfig(Mapping[str, Any]):
 
     def __init__(self, values: Mapping[str, Any] | None = None, source: str = "defaults") -> None:
         merged = {}
-        for key, opt in _SCHEMA.items():
+        for key, opt in config_schema().items():
             merged[key] = _check_value(key, opt, opt.default) if opt.default is not None else None
         merged.update(values or {})
         self._values = MappingProxyType(merged)
@@ -411,13 +440,14 @@ class FigureConfig(Mapping[str, Any]):
         """
         problems: list[str] = []
         values: dict[str, Any] = {}
+        schema, tables = config_schema(), config_tables()
         for key, value in _flatten(data):
             try:
-                if key in _SECTION_HELP:
+                if key in tables:
                     raise ConfigError(f"{key}: expected a table [{key}], got {_describe(value)}")
-                if key not in _SCHEMA:
+                if key not in schema:
                     raise ConfigError(_unknown_key(key, isinstance(value, dict)))
-                values[key] = _check_value(key, _SCHEMA[key], value)
+                values[key] = _check_value(key, schema[key], value)
             except ConfigError as err:
                 problems += err.problems
         if "style" in values:
@@ -463,6 +493,7 @@ class FigureConfig(Mapping[str, Any]):
                     f"(case_study.steps = {self['case_study.steps']})"
                 )
         style = self["style"]
+        # matplotlib is heavy and only needed here: imported when a config is checked
         import matplotlib.style
 
         if "style" not in skip and style not in matplotlib.style.available and style != "default":
@@ -481,11 +512,11 @@ class FigureConfig(Mapping[str, Any]):
     def _check_designs(self, skip: set[str] = frozenset()) -> list[str]:
         """Design every observer once, so that bad poles are reported before any work."""
         problems = []
-        for key in ("pa9.poles", "case_study.poles", "missile.pmo_poles"):
+        for key in OBSERVER_KEYS:
             if key in skip:
                 continue
             try:
-                _design(self, key)
+                design_observer(self, key)
             except ConfigError as err:
                 problems += [f"{key}: {p}" for p in err.problems]
             except ValueError as err:
@@ -511,7 +542,7 @@ class FigureConfig(Mapping[str, Any]):
     def _defaults() -> dict[str, Any]:
         return {
             k: (None if o.default is None else _check_value(k, o, o.default))
-            for k, o in _SCHEMA.items()
+            for k, o in config_schema().items()
         }
 
 
@@ -564,10 +595,10 @@ def check_dpi(dpi: object) -> int:
 def _unknown_key(key: str, table: bool = False) -> str:
     see = "`uio-teach figures --print-config` lists every key"
     if table:
-        close = difflib.get_close_matches(key, list(_SECTION_HELP), 1, 0.5)
+        close = difflib.get_close_matches(key, list(config_tables()), 1, 0.5)
         hint = f" (did you mean [{close[0]}]?)" if close else ""
         return f"unknown table [{key}]{hint}; {see}"
-    close = difflib.get_close_matches(key, list(_SCHEMA) + list(_SECTION_HELP), 1, 0.6)
+    close = difflib.get_close_matches(key, list(config_schema()) + list(config_tables()), 1, 0.6)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     return f"unknown key {key!r}{hint}; {see}"
 
@@ -650,11 +681,12 @@ def default_config_toml() -> str:
         "",
     ]
     section = ""
-    for key, opt in _SCHEMA.items():
+    tables = config_tables()
+    for key, opt in config_schema().items():
         table, _, name = key.rpartition(".")
         if table != section:
             section = table
-            lines += ["", f"[{table}]  # {_SECTION_HELP[table]}"]
+            lines += ["", f"[{table}]  # {tables[table]}"]
         if opt.default is None:
             lines.append(f"# {name} = [0.2]  # {opt.help}")
         else:
@@ -662,26 +694,54 @@ def default_config_toml() -> str:
     return "\n".join(lines) + "\n"
 
 
-def _design(cfg: Mapping[str, Any], key: str):
-    """The observer that ``key`` configures (validated poles in, observer out)."""
-    import uio_teach as ut
+OBSERVER_KEYS = {
+    "pa9.poles": "pa9",
+    "case_study.poles": "case_study",
+    "missile.pmo_poles": "missile",
+}
+"""The keys that set an observer's poles, and the experiment each belongs to."""
 
+
+def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
+    """The observer that a poles key of the config sets (validated poles in, observer out).
+
+    Parameters
+    ----------
+    cfg : mapping
+        A validated configuration (:class:`FigureConfig`).
+    key : str
+        One of :data:`OBSERVER_KEYS`: ``"pa9.poles"`` (the UIO),
+        ``"case_study.poles"`` (the PMO; absent: the LMI gain) or
+        ``"missile.pmo_poles"`` (the PMO).
+
+    Returns
+    -------
+    Observer
+
+    Raises
+    ------
+    ConfigError
+        Not as many poles as the observer has movable ones.
+    ValueError
+        Poles the observer cannot have (from the design).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import FigureConfig, design_observer
+    >>> design_observer(FigureConfig(), "missile.pmo_poles").L.shape
+    (4, 2)
+    """
+    if key not in OBSERVER_KEYS:
+        raise KeyError(f"{key!r} sets no observer; expected one of {', '.join(OBSERVER_KEYS)}")
     poles = cfg[key]
+    plant = EXPERIMENTS[OBSERVER_KEYS[key]].plant()
     if key == "pa9.poles":
-        plant = ut.examples.pa9()
-        _expect_count(key, poles, ut.check_existence(plant).movable)
-        return ut.design_uio(plant, poles=list(poles))
-    if key == "case_study.poles":
-        plant = ut.examples.dt_case_study()
-        if poles is None:
-            return ut.design_pmo(plant, method="lmi")
-        _expect_count(key, poles, ut.check_existence(plant).movable)
-        return ut.design_pmo(plant, poles=list(poles))
-    if key == "missile.pmo_poles":
-        plant = ut.examples.missile_autopilot()
-        _expect_count(key, poles, ut.check_existence(plant).movable)
-        return ut.design_pmo(plant, poles=list(poles))
-    raise KeyError(key)  # pragma: no cover
+        _expect_count(key, poles, check_existence(plant).movable)
+        return design_uio(plant, poles=list(poles))
+    if poles is None:
+        return design_pmo(plant, method="lmi")
+    _expect_count(key, poles, check_existence(plant).movable)
+    return design_pmo(plant, poles=list(poles))
 
 
 def _expect_count(key: str, poles: Sequence[complex], movable: int) -> None:

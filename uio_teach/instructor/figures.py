@@ -59,9 +59,9 @@ from ..plotting import (
 from .config import (
     ConfigError,
     FigureConfig,
-    _design,
     check_dpi,
     default_config_toml,
+    design_observer,
     load_config,
 )
 from .output import (
@@ -127,7 +127,7 @@ class _Runs:
             seed=c["seed"],
         )
         plant = run.plant()
-        uio = _design(c, "pa9.poles")
+        uio = design_observer(c, "pa9.poles")
         luen = ut.design_luenberger(plant, poles=list(c["pa9.poles"]))
         d_sine, d_steps = run.d_sine, run.d_piecewise
         return {
@@ -155,7 +155,7 @@ class _Runs:
             v_hold=c["case_study.v.hold"],
             seed=c["seed"],
         )
-        pmo = _design(c, "case_study.poles")
+        pmo = design_observer(c, "case_study.poles")
         return {
             "plant": run.plant(),
             "pmo": pmo,
@@ -178,7 +178,7 @@ class _Runs:
         out: dict[str, Any] = {"plant": plant, "time": t}
         ginverse = ut.design_ginverse(plant)
         out["free"] = run.simulate(ginverse, d=None, observer_state=None)
-        pmo = _design(c, "missile.pmo_poles")
+        pmo = design_observer(c, "missile.pmo_poles")
         # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
         # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
         # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles

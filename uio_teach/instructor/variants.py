@@ -28,6 +28,12 @@ ANSWER_KEY = "answer_key.csv"
 def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[Any]:
     """``groups`` distinct parameter sets of ``lab``, each a fair exercise, from ``seed``.
 
+    Each variant is drawn by the lab's parameter class (``draw``) and kept
+    only if it is a fair exercise (``problems()`` is empty: for the plant,
+    the package's existence check and designs succeed) and shares nothing of
+    its ``distinct()`` (poles, plant matrices that decide the answers) with
+    a variant already kept, so that no two groups have the same answers.
+
     Parameters
     ----------
     lab : Lab
@@ -58,15 +64,19 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
     index = list(LABS).index(lab.id) if lab.id in LABS else 0
     rng = np.random.default_rng([int(seed), index])
     out: list[Any] = []
-    seen: set[str] = set()
+    # the course's own numbers (the book's solutions) are no group's
+    seen: dict[str, set[Any]] = {k: {v} for k, v in lab.params().distinct().items()}
     for _ in range(1000 * max(1, groups)):
         if len(out) == groups:
             break
         variant = lab.params.draw(rng, base)
-        key = repr(variant.to_params())
-        if key in seen or variant.problems():
+        keys = {"params": repr(variant.to_params()), **variant.distinct()}
+        if any(value in seen.get(name, ()) for name, value in keys.items()):
             continue
-        seen.add(key)
+        if variant.problems():
+            continue
+        for name, value in keys.items():
+            seen.setdefault(name, set()).add(value)
         out.append(variant)
     if len(out) < groups:
         raise LabUsageError(f"cannot draw {groups} distinct variants of the {lab.id} lab")
