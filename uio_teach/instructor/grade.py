@@ -35,6 +35,7 @@ Examples
 
 from __future__ import annotations
 
+import ast
 import csv
 import json
 import os
@@ -278,7 +279,15 @@ def _defaults(lab: str) -> dict[str, Any]:
 
 
 def _assigns(source: str, name: str) -> bool:
-    return re.search(rf"(^|[\s,(\[]){re.escape(name)}\s*(=(?!=)|,|\))", source, re.M) is not None
+    """Whether the code ``source`` assigns ``name`` (at any depth; ``=``, ``for``, ``with``...)."""
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return re.search(rf"^\s*{re.escape(name)}\s*=(?!=)", source, re.M) is not None
+    return any(
+        isinstance(node, ast.Name) and node.id == name and isinstance(node.ctx, ast.Store)
+        for node in ast.walk(tree)
+    )
 
 
 def _missing(name: str, position: int | None, outcome: RunOutcome) -> Missing:
@@ -286,7 +295,9 @@ def _missing(name: str, position: int | None, outcome: RunOutcome) -> Missing:
     before = [e for e in outcome.errors if position is None or e.position < position]
     if not before:
         return Missing(name)
-    culprit = next((e for e in reversed(before) if _assigns(e.source, name)), before[-1])
+    culprit = next((e for e in reversed(before) if _assigns(e.source, name)), None)
+    if culprit is None:  # a check cell's error follows from an earlier one
+        culprit = ([e for e in before if not e.is_check] or before)[-1]
     return Missing(name, culprit.cell, culprit.ename, culprit.evalue)
 
 

@@ -87,6 +87,8 @@ class CellError:
         The exception's class and message (one line).
     source : str
         The cell's code.
+    is_check : bool
+        Whether it is a check cell (its error then follows from an earlier one).
     """
 
     cell: int
@@ -94,6 +96,7 @@ class CellError:
     ename: str
     evalue: str
     source: str
+    is_check: bool = False
 
 
 @dataclass
@@ -248,6 +251,7 @@ def _errors(executed: Any) -> list[CellError]:
                         _one_line(output.get("ename", ""), 60),
                         _one_line(output.get("evalue", "")),
                         str(cell.get("source", "")),
+                        "check" in _tags(cell),
                     )
                 )
                 break
