@@ -455,3 +455,13 @@ def test_without_a_sandbox_grading_is_refused_unless_asked(tmp_path, monkeypatch
     assert len(err.strip().splitlines()) == 1 and not out.exists()
     with pytest.raises(grade.SandboxRefused):
         grade.grade([nb], out)
+
+
+def test_no_sandbox_grades_the_same_and_says_so_loudly(tmp_path, capsys):
+    nb = small(tmp_path / "pa9_g01.ipynb", "g01")
+    out = tmp_path / "grades.csv"
+    assert cli.main(["grade", str(nb), "--out", str(out), "--no-sandbox", "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "WARNING: --no-sandbox" in err and "your permissions" in err
+    (row,) = rows(out)
+    assert row["status"] == "ok" and row["pa9.design"] == grade.PASS and row["total"] == "1"
