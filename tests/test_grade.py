@@ -29,10 +29,10 @@ from uio_teach.instructor import cli, grade
 from uio_teach.instructor.labs import LABS
 from uio_teach.instructor.sandbox import sandbox_problem
 
-pytestmark = [
-    pytest.mark.filterwarnings("ignore::DeprecationWarning"),
-    pytest.mark.skipif(sandbox_problem() is not None, reason=f"no sandbox: {sandbox_problem()}"),
-]
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+needs_sandbox = pytest.mark.skipif(
+    sandbox_problem() is not None, reason=f"no sandbox here: {sandbox_problem()}"
+)
 CHECKS = ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise")
 
 
@@ -308,6 +308,7 @@ def marks(row: dict[str, str]) -> list[str]:
     return [row[c] for c in CHECKS]
 
 
+@needs_sandbox
 def test_the_solution_passes_whatever_it_does_after_its_checks(graded):
     row = graded["rows"]["solution"]
     assert marks(row) == [grade.PASS] * 4 and row["total"] == row["out_of"] == "4"
@@ -315,17 +316,20 @@ def test_the_solution_passes_whatever_it_does_after_its_checks(graded):
     assert row["status"] == "ok", graded["text"]["solution"]
 
 
+@needs_sandbox
 def test_the_untouched_student_notebook_fails_every_check(graded):
     row = graded["rows"]["student"]
     assert marks(row) == [grade.FAIL] * 4 and row["total"] == "0"
     assert "is missing" in graded["text"]["student"]
 
 
+@needs_sandbox
 def test_patching_the_checks_in_the_kernel_changes_nothing(graded):
     assert marks(graded["rows"]["patched"]) == [grade.FAIL] * 4
     assert graded["rows"]["patched"]["total"] == "0"
 
 
+@needs_sandbox
 def test_another_groups_parameters_do_not_pass_this_groups_key(graded):
     assert graded["g1"]["poles"] != graded["g2"]["poles"]
     row = graded["rows"]["params"]
@@ -333,6 +337,7 @@ def test_another_groups_parameters_do_not_pass_this_groups_key(graded):
     assert graded["results"]["params"].params == graded["g2"]
 
 
+@needs_sandbox
 def test_nothing_outside_the_copy_is_reachable(graded):
     text = graded["text"]["probe"]
     line = next(x for x in text.splitlines() if x.startswith("  - code cell") and "PROBE" in x)
@@ -344,6 +349,7 @@ def test_nothing_outside_the_copy_is_reachable(graded):
     assert graded["rows"]["probe"]["pa9.design"] == grade.PASS  # it ran, in its sandbox
 
 
+@needs_sandbox
 def test_a_sandbox_that_kills_itself_loses_no_other_row(graded):
     row = graded["rows"]["suicide"]
     assert row["status"] == "error" and row["pa9.design"] == grade.PASS
@@ -351,6 +357,7 @@ def test_a_sandbox_that_kills_itself_loses_no_other_row(graded):
     assert len(graded["rows"]) == len(graded["subs"])
 
 
+@needs_sandbox
 def test_a_cell_that_never_ends_is_stopped_and_graded_on_what_ran(graded):
     row = graded["rows"]["stubborn"]
     assert row["status"] == "timeout"
@@ -359,6 +366,7 @@ def test_a_cell_that_never_ends_is_stopped_and_graded_on_what_ran(graded):
     assert "time limit" in text and "fig is missing" in text
 
 
+@needs_sandbox
 def test_memory_processes_and_files_are_limited_for_good(graded):
     row = graded["rows"]["limits"]
     assert row["status"] == "error" and row["pa9.design"] == grade.PASS
@@ -374,6 +382,7 @@ def test_memory_processes_and_files_are_limited_for_good(graded):
     ]  # and the notebook could not raise them again
 
 
+@needs_sandbox
 def test_a_cell_that_raises_is_named_with_a_hint_not_a_traceback(graded):
     text = graded["text"]["raises"]
     assert graded["rows"]["raises"]["pa9.design"] == grade.FAIL
@@ -382,6 +391,7 @@ def test_a_cell_that_raises_is_named_with_a_hint_not_a_traceback(graded):
     assert "Traceback" not in text and 'File "' not in text
 
 
+@needs_sandbox
 def test_every_submission_has_its_row_and_no_temporary_folder_is_left(graded):
     assert [r["file"] for r in graded["rows"].values()] == [str(p) for p in graded["subs"].values()]
     assert graded["rows"]["garbage"]["status"] == "unreadable"
@@ -393,6 +403,7 @@ def test_every_submission_has_its_row_and_no_temporary_folder_is_left(graded):
     assert len(names) == len(graded["subs"]) + 1 and "manifest.json" in names
 
 
+@needs_sandbox
 def test_a_grader_killed_mid_run_resumes_without_losing_a_row(tmp_path, monkeypatch):
     temp = tmp_path / "tmp"
     temp.mkdir()
