@@ -13,10 +13,12 @@ STAMP  := $(VENV)/.installed
 export PATH := $(abspath $(BIN)):$(PATH)
 
 .DEFAULT_GOAL := help
-.PHONY: help venv book test lint clean
+.PHONY: help venv book book-instructor test lint clean
 
 help:
 	@echo "make book   build the HTML book into _build/html (warnings are errors)"
+	@echo "make book-instructor  the instructor edition (lab solutions, tutors' notes)"
+	@echo "            into _build/instructor/_build/html"
 	@echo "make test   lint, then run every test (package, chapters, book build, browser)"
 	@echo "make venv   create or update $(VENV) from requirements.txt"
 	@echo "make lint   ruff check and ruff format --check"
@@ -33,6 +35,13 @@ venv: $(STAMP)
 book: $(STAMP)
 	$(BIN)/jupyter-book build . -W -n --keep-going
 	@echo "The book is in $(CURDIR)/_build/html/index.html"
+
+# The instructor edition: the same pages with the lab solutions and the tutors' notes
+# (_ext/editions.py); its own output folder and execution cache.
+book-instructor: $(STAMP)
+	UIO_TEACH_EDITION=instructor $(BIN)/jupyter-book build . -W -n --keep-going \
+		--path-output _build/instructor
+	@echo "The instructor edition is in $(CURDIR)/_build/instructor/_build/html/index.html"
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

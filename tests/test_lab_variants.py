@@ -216,7 +216,7 @@ def test_the_same_seed_gives_byte_identical_files(variants, tmp_path):
     assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "5", "-q"]) == 0
     files = sorted(p.relative_to(variants) for p in variants.rglob("*") if p.is_file())
     again = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
-    assert files == again and len(files) == 3 * 3 * 2 + 1
+    assert files == again and len(files) == 3 * 3 * 2 + 2  # and the key, the manifest
     for name in files:
         assert (variants / name).read_bytes() == (tmp_path / name).read_bytes(), name
 

@@ -159,7 +159,7 @@ def residual_colors(C: np.ndarray) -> list[str]:
     return colours
 
 
-def _zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
+def zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
     """Keep rounding noise on zero: a half-range of at least ``_MIN_SPAN * scale``.
 
     ``scale`` is the size of the signals ``values`` derive from (the states for
@@ -366,7 +366,7 @@ def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     """
     plot_channels(ax, response.time, response.error, "e", discrete=response.plant.is_discrete)
     finish_panel(ax, axis_label("error"), legend)
-    _zero_to_rounding(ax, response.error, _size(response.states))
+    zero_to_rounding(ax, response.error, _size(response.states))
 
 
 def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
@@ -405,7 +405,7 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
         colors=residual_colors(response.plant.C),
     )
     finish_panel(ax, axis_label("residual"), legend)
-    _zero_to_rounding(ax, response.residual, _size(response.outputs))
+    zero_to_rounding(ax, response.residual, _size(response.outputs))
 
 
 def _size(values: np.ndarray) -> float:

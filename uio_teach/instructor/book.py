@@ -23,23 +23,51 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["BookIndex", "default_book_dir", "PACKAGED_COURSE"]
+__all__ = [
+    "BookIndex",
+    "default_book_dir",
+    "PACKAGED_COURSE",
+    "HEADING",
+    "TARGET",
+    "LABELLED_MATH",
+    "fence_states",
+    "split_front_matter",
+]
 
 PACKAGED_COURSE = Path(__file__).resolve().parents[1] / "_course"
 """Where an installed wheel keeps ``book/*.md``, ``_toc.yml`` and ``references.bib``."""
 
 _DIRECTIVE = re.compile(r"^(?P<fence>`{3,}|:{3,})\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*?)\s*$")
 _OPTION = re.compile(r"^:(?P<key>[\w-]+):[ \t]*(?P<value>.*?)\s*$")
-_HEADING = re.compile(r"^(?P<hashes>#{1,6})[ \t]+(?P<text>.*?)\s*#*\s*$")
-_TARGET = re.compile(r"^\((?P<label>[^)\s]+)\)=\s*$")
-_LABELLED_MATH = re.compile(r"\$\$(?P<body>.+?)\$\$[ \t]*\((?P<label>[\w:.-]+)\)", re.DOTALL)
+HEADING = re.compile(r"^(?P<hashes>#{1,6})[ \t]+(?P<text>.*?)\s*#*\s*$")
+"""A Markdown heading line: groups ``hashes`` (its level) and ``text``."""
+TARGET = re.compile(r"^\((?P<label>[^)\s]+)\)=\s*$")
+"""A MyST target line, ``(label)=``: group ``label``."""
+LABELLED_MATH = re.compile(r"\$\$(?P<body>.+?)\$\$[ \t]*\((?P<label>[\w:.-]+)\)", re.DOTALL)
+"""A labelled display equation, ``$$ ... $$ (label)``: groups ``body`` and ``label``."""
 
 
-def _fence_states(lines: Sequence[str]) -> list[bool]:
+def fence_states(lines: Sequence[str]) -> list[bool]:
     """For each line: True if it is a fence line or inside a code block (no Markdown there).
 
     Directive fences (```` ```{exercise} ````) nest and their bodies are Markdown;
     plain fences (```` ```python ````) and code directives hold code.
+
+    Parameters
+    ----------
+    lines : sequence of str
+        The lines of a page.
+
+    Returns
+    -------
+    list of bool
+        One per line.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.book import fence_states
+    >>> fence_states(["# Title", "```python", "# not a heading", "```", "text"])
+    [False, True, True, True, False]
     """
     stack: list[tuple[str, bool]] = []
     states = []
@@ -60,13 +88,41 @@ def _fence_states(lines: Sequence[str]) -> list[bool]:
     return states
 
 
-def _read_front_matter_free(text: str) -> str:
-    """The text without its YAML front matter."""
-    if text.startswith("---"):
-        end = text.find("\n---", 3)
-        if end >= 0:
-            return text[end + 4 :]
-    return text
+def split_front_matter(text: str) -> tuple[dict, str]:
+    """A page's YAML front matter (between two ``---`` lines) as a dict, and the text after it.
+
+    The one reader of front matter in the course: the book index and the
+    book's extension that links each chapter's notebook both use it.
+
+    Parameters
+    ----------
+    text : str
+        A MyST page.
+
+    Returns
+    -------
+    (dict, str)
+        The front matter (``{}`` if there is none or it is not a mapping) and the rest.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.book import split_front_matter
+    >>> split_front_matter("---\\nkernelspec: {name: python3}\\n---\\n# Title\\n")
+    ({'kernelspec': {'name': 'python3'}}, '\\n# Title\\n')
+    """
+    if not text.startswith("---"):
+        return {}, text
+    end = text.find("\n---", 3)
+    if end < 0:
+        return {}, text
+    # deferred on purpose: PyYAML comes with the optional ``instructor`` extra
+    import yaml
+
+    try:
+        data = yaml.safe_load(text[3:end])
+    except yaml.YAMLError:
+        data = None
+    return (data if isinstance(data, dict) else {}), text[end + 4 :]
 
 
 def _strip_braces(text: str) -> str:
@@ -78,7 +134,7 @@ def _parse_bib(text: str) -> dict[str, dict[str, str]]:
 
     The authors come back as one ``"Last, First and Last, First"`` string.
     """
-    from pybtex.database import parse_string
+    from pybtex.database import parse_string  # deferred: the optional ``instructor`` extra
 
     entries: dict[str, dict[str, str]] = {}
     for key, entry in parse_string(text, "bibtex").entries.items():
@@ -158,11 +214,11 @@ class BookIndex:
         return index
 
     def _scan_page(self, stem: str, text: str) -> None:
-        text = _read_front_matter_free(text)
+        text = split_front_matter(text)[1]
         lines = text.splitlines()
         pending: list[str] = []
         exercise_count = 0
-        verbatim = _fence_states(lines)
+        verbatim = fence_states(lines)
         for i, line in enumerate(lines):
             stripped = line.strip()
             d = _DIRECTIVE.match(stripped)
@@ -176,11 +232,11 @@ class BookIndex:
                         self.exercises[o.group("value")] = (stem, exercise_count)
             if verbatim[i]:
                 continue
-            target = _TARGET.match(stripped)
+            target = TARGET.match(stripped)
             if target:
                 pending.append(target.group("label"))
                 continue
-            heading = _HEADING.match(line)
+            heading = HEADING.match(line)
             if heading:
                 title = heading.group("text")
                 if len(heading.group("hashes")) == 1 and stem not in self.titles:
@@ -190,7 +246,7 @@ class BookIndex:
             if stripped:
                 pending = []
         body = "\n".join(lines)
-        found = [(m.start(), m.group("label")) for m in _LABELLED_MATH.finditer(body)]
+        found = [(m.start(), m.group("label")) for m in LABELLED_MATH.finditer(body)]
         for m in re.finditer(r"^(`{3,}|:{3,})\{math\}.*\n((?::[\w-]+:.*\n)*)", body, re.M):
             label = re.search(r"^:label:\s*(\S+)", m.group(2), re.M)
             if label:
@@ -202,7 +258,7 @@ class BookIndex:
         if not toc.is_file():
             return
         try:
-            import yaml
+            import yaml  # deferred: the optional ``instructor`` extra
 
             data = yaml.safe_load(toc.read_text(encoding="utf-8")) or {}
         except Exception:  # a broken toc only costs the chapter numbers

@@ -24,11 +24,22 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import textwrap
 import time
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TextIO
+from typing import NoReturn, TextIO
+
+import matplotlib
+
+from .. import __version__
+from .config import DPI_RANGE, ConfigError, FigureConfig, check_dpi, load_config
+from .output import FORMATS, MANIFEST, OutputError, check_output_folder
+
+# Each command imports the module that does its work only when it runs (figures draws with
+# matplotlib, grade starts kernels): deferred on purpose, so `uio-teach --help` and a usage
+# error answer at once.
 
 __all__ = ["main", "build_parser"]
 
@@ -80,7 +91,9 @@ All or nothing: the files are written into a temporary folder beside DIR,
 which replaces DIR only when every figure was made. A failed or interrupted
 run leaves DIR as it was; a good run leaves only its own files (with --only,
 just those figures). DIR is replaced only if it is empty or holds an earlier
-output (its manifest.json); any other folder is left alone (exit status 1).
+output (its manifest.json); any other folder is left alone (exit status 1), and
+so is a folder that another run is writing (a lock beside it, .DIR.lock).
+Staging folders left by a killed run (.DIR.new-*) are removed by the next run.
 
 The parameters that change from one term to the next (disturbances, observer
 poles, noise level, seed, matplotlib style) are read from a TOML file given
@@ -130,16 +143,28 @@ is still missing; a question answered in words gets a "Your answer" cell.
 The numbers of each lab (poles, disturbances, switching times, noise, seeds)
 are in its cell tagged `parameters` (`PARAMS = {...}`); the code and the checks
 read them from there. --config takes them from the term config (the keys of
-`uio-teach figures --print-config`: pa9.*, case_study.*, seed,
-missile.pmo_poles). --groups N --seed S draws numbers of its own for every
-group, each a fair exercise (the observer exists, poles distinct and stable,
-disturbances visible), and writes
+`uio-teach figures --print-config`). These keys go into PARAMS but the notebooks
+do not read them:
+{unread}
+
+--groups N --seed S draws numbers of its own for every group, each a fair
+exercise (the observer exists, poles distinct and stable, disturbances
+visible), and writes
 
   DIR/<lab>/student/<lab>_g01.ipynb, DIR/<lab>/solution/<lab>_g01.ipynb, ...
   DIR/answer_key.csv        one row per lab and group: lab, group, params,
                             then the expected matrices and numbers (JSON)
 
-The same seed gives byte-identical files.
+The same seed gives byte-identical files. DIR/manifest.json lists what was
+written (the configuration as used and its hash, the options, the versions,
+each file's SHA-256).
+
+All or nothing, as for figures: the notebooks are written into a temporary
+folder beside DIR, which replaces DIR whole only when every file is written,
+so a rerun (--groups 3, then --groups 2) leaves no notebook of the earlier run
+and a failed or killed run leaves DIR as it was. DIR is replaced only if it is
+empty or holds an earlier output (its manifest.json); any other folder is left
+alone (exit status 1), and so is a folder another run is writing.
 """
 
 _LABS_EPILOG = """\
@@ -150,8 +175,8 @@ examples:
   uio-teach labs --out handout/labs --groups 12 --seed 2026
 
 exit status:
-  0 all notebooks written, 1 a lab could not be read or written, 2 a usage
-  error.
+  0 all notebooks written, 1 a lab could not be read or written (nothing
+  written), 2 a usage or configuration error, one line per problem.
 """
 
 
@@ -191,6 +216,60 @@ exit status:
 """
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line: ``uio-teach labs: error: ...``."""
+
+    def error(self, message: str) -> NoReturn:
+        text = " ".join(str(message).split())
+        _say(f"{self.prog}: error: {text} (see {self.prog} --help)", sys.stderr)
+        raise SystemExit(2)
+
+
+def _say(text: str, stream: TextIO | None = None) -> None:
+    """Print a line; if the reader has gone (``... | head -1``), stop printing, quietly.
+
+    The run itself goes on (a run of ``figures`` or ``labs`` still writes its
+    folder); only its messages are dropped from then on.
+    """
+    stream = stream or sys.stdout
+    try:
+        print(text, file=stream, flush=True)
+    except BrokenPipeError:
+        _drop_stream(stream)
+
+
+def _drop_stream(stream: TextIO) -> None:
+    """Point a stream whose reader has gone at /dev/null, so nothing more fails on it."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, stream.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # a stream without a file descriptor
+        if stream is sys.stdout:
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115 (kept open until the end)
+        elif stream is sys.stderr:
+            sys.stderr = open(os.devnull, "w")  # noqa: SIM115
+
+
+def _load_config(command: str, path: str | None) -> FigureConfig | None:
+    """The term config of ``--config``, or ``None`` after printing one line per problem."""
+    try:
+        return load_config(path)
+    except ConfigError as err:
+        for problem in err.problems:
+            _error(command, problem)
+    except UnicodeDecodeError as err:
+        _error(
+            command,
+            f"{path}: not a text file in UTF-8 (byte 0x{err.object[err.start]:02x} at "
+            f"position {err.start}); a config is a TOML file, see `uio-teach figures "
+            "--print-config`",
+        )
+    except (ValueError, OSError) as err:  # anything else a file can do to the reader
+        _error(command, f"{path}: cannot read it as a config ({' '.join(str(err).split())})")
+    return None
+
+
 class _Formatter(argparse.RawDescriptionHelpFormatter):
     def __init__(self, prog: str) -> None:
         super().__init__(prog, max_help_position=30, width=88)
@@ -217,8 +296,6 @@ def _positive_float(text: str) -> float:
 
 
 def _dpi(text: str) -> int:
-    from .config import DPI_RANGE, ConfigError, check_dpi
-
     try:
         value = int(text)
     except ValueError:
@@ -230,6 +307,17 @@ def _dpi(text: str) -> int:
         return check_dpi(value)
     except ConfigError as err:
         raise argparse.ArgumentTypeError(str(err).removeprefix("dpi: ")) from None
+
+
+def _labs_description() -> str:
+    from .labs import UNREAD_CONFIG_KEYS  # deferred on purpose (see the imports)
+
+    lines = []
+    for entry in UNREAD_CONFIG_KEYS:
+        lines += textwrap.wrap(
+            entry.text(), width=76, initial_indent="  * ", subsequent_indent="    "
+        )
+    return _LABS_DESCRIPTION.replace("{unread}", "\n".join(lines))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -246,11 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
     >>> args.command, args.out, args.format, args.dpi
     ('figures', 'figs', 'svg', 150)
     """
-    from .. import __version__
-    from .config import DPI_RANGE
-    from .output import FORMATS
-
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog=PROG,
         description=_MAIN_DESCRIPTION,
         epilog=_MAIN_EPILOG,
@@ -303,7 +387,7 @@ def build_parser() -> argparse.ArgumentParser:
     labs = commands.add_parser(
         "labs",
         help="write the lab notebooks (student and solution versions)",
-        description=_LABS_DESCRIPTION,
+        description=_labs_description(),
         epilog=_LABS_EPILOG,
         formatter_class=_Formatter,
     )
@@ -399,19 +483,19 @@ def _seed(text: str) -> int:
 
 def _error(command: str, message: str, stream: TextIO | None = None) -> None:
     text = " ".join(str(message).split())
-    print(f"{PROG} {command}: error: {text}", file=stream or sys.stderr)
+    _say(f"{PROG} {command}: error: {text}", stream or sys.stderr)
 
 
 def _figures(args: argparse.Namespace) -> int:
-    from . import figures
+    from . import figures  # deferred on purpose (see the imports)
 
     if args.list:
         width = max(len(name) for name in figures.FIGURES)
         for name, spec in figures.FIGURES.items():
-            print(f"{name:<{width}}  {spec.description}")
+            _say(f"{name:<{width}}  {spec.description}")
         return 0
     if args.print_config:
-        sys.stdout.write(figures.default_config_toml())
+        _say(figures.default_config_toml().rstrip("\n"))
         return 0
     if not args.out:
         _error("figures", "--out DIR is required (or use --list or --print-config)")
@@ -420,22 +504,15 @@ def _figures(args: argparse.Namespace) -> int:
         if name not in figures.FIGURES:
             _error("figures", figures.unknown_figure_message(name))
             return 2
-    try:
-        config = figures.load_config(args.config)
-    except figures.ConfigError as err:
-        for problem in err.problems:
-            _error("figures", problem)
+    config = _load_config("figures", args.config)
+    if config is None:
         return 2
-    from .output import check_output_folder
-
     out = args.out
     try:
         check_output_folder(out)
     except OSError as err:
         _error("figures", str(err))
         return 1
-
-    import matplotlib
 
     matplotlib.use("Agg")  # no display needed, and the same pixels everywhere
 
@@ -447,15 +524,14 @@ def _figures(args: argparse.Namespace) -> int:
         elif not args.quiet:
             files = ", ".join(os.fspath(p) for p in result.paths)
             count = f"[{index:>{len(str(total))}}/{total}]"
-            print(f"{count} {result.name}: {files} ({result.seconds:.1f} s)")
-            sys.stdout.flush()
+            _say(f"{count} {result.name}: {files} ({result.seconds:.1f} s)")
 
     try:
         results = figures.generate(
             out, args.only, fmt=args.format, dpi=args.dpi, config=config, progress=progress
         )
     except OSError as err:
-        _error("figures", str(err) if isinstance(err, figures.OutputError) else f"{out}: {err}")
+        _error("figures", str(err) if isinstance(err, OutputError) else f"{out}: {err}")
         return 1
     elapsed = time.perf_counter() - start
     failed = [r.name for r in results if not r.ok]
@@ -469,31 +545,30 @@ def _figures(args: argparse.Namespace) -> int:
             f"written, {os.fspath(out)} {left}",
         )
         return 1
-    summary = f"{done} of {len(results)} figures ({files} files) and {figures.MANIFEST} "
+    summary = f"{done} of {len(results)} figures ({files} files) and {MANIFEST} "
     summary += f"written to {os.fspath(out)} in {elapsed:.1f} s"
     if not args.quiet:
-        print(summary)
+        _say(summary)
     return 0
 
 
 def _labs(args: argparse.Namespace) -> int:
-    from . import labs
-    from .config import ConfigError, load_config
+    from . import labs  # deferred on purpose (see the imports)
 
     start = time.perf_counter()
     if args.seed is not None and args.groups is None:
         _error("labs", "--seed needs --groups N (the seed of the groups' variants)")
         return 2
-    try:
-        config = load_config(args.config) if args.config else None
-    except ConfigError as err:
-        _error("labs", str(err))
-        return 2
+    config = None
+    if args.config:
+        config = _load_config("labs", args.config)
+        if config is None:
+            return 2
 
     def progress(index: int, total: int, result: labs.LabResult) -> None:
         if not args.quiet:
             group = f" {result.group}" if result.group else ""
-            print(
+            _say(
                 f"[{index}/{total}] {result.source.name}{group}: {os.fspath(result.student)} "
                 f"({result.todo_cells} TODO cells), {os.fspath(result.solution)}"
             )
@@ -528,15 +603,15 @@ def _labs(args: argparse.Namespace) -> int:
         plural = "s" if n != 1 else ""
         what = f"{n} lab{plural}" if args.groups is None else f"{n} lab variant{plural}"
         key = f", and {labs.ANSWER_KEY}" if args.groups is not None else ""
-        print(
+        _say(
             f"{what} written to {os.fspath(args.out)}: {n} student and {n} solution "
-            f"notebook{plural}{key} in {elapsed:.1f} s"
+            f"notebook{plural}{key} and {MANIFEST} in {elapsed:.1f} s"
         )
     return 0
 
 
 def _grade(args: argparse.Namespace) -> int:
-    from . import grade
+    from . import grade  # deferred on purpose (see the imports)
 
     missing = [p for p in args.submissions if not os.path.isfile(p)]
     if missing:
@@ -547,12 +622,11 @@ def _grade(args: argparse.Namespace) -> int:
     def progress(index: int, total: int, sub: grade.Submission) -> None:
         if not args.quiet:
             verdicts = sub.verdicts()
-            print(
+            _say(
                 f"[{index}/{total}] {sub.file}: lab {sub.lab or '?'}, group {sub.group or '?'}, "
                 f"{sub.total} of {len(verdicts)} checks passed, {sub.status} "
                 f"({sub.seconds:.1f} s)"
             )
-            sys.stdout.flush()
 
     if args.no_sandbox:
         _error(
@@ -591,7 +665,7 @@ def _grade(args: argparse.Namespace) -> int:
         elapsed = time.perf_counter() - start
         out = Path(args.out)
         feedback = out.with_name(f"{out.stem}_feedback")
-        print(
+        _say(
             f"{len(results)} submission{'s' if len(results) != 1 else ''} graded in "
             f"{elapsed:.1f} s: {out}, feedback in {feedback}"
         )
@@ -625,6 +699,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exit_:  # --help, --version and usage errors
         code = exit_.code
         return code if isinstance(code, int) else (0 if code is None else 2)
+    except BrokenPipeError:  # `uio-teach --help | head -1`
+        _drop_stream(sys.stdout)
+        return 0
     try:
         if args.command == "figures":
             return _figures(args)

@@ -41,12 +41,14 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
+import matplotlib.style
 import numpy as np
+
+import uio_teach as ut
 
 from .._display import format_poles
 from ..experiments import CASE_STUDY, MISSILE, PA9
 from ..plotting import (
-    _zero_to_rounding,
     finish_panel,
     new_figure,
     plot_error,
@@ -55,6 +57,7 @@ from ..plotting import (
     symbol,
     time_label,
     with_unit,
+    zero_to_rounding,
 )
 from .config import (
     ConfigError,
@@ -111,8 +114,6 @@ class _Runs:
     # PA9 --------------------------------------------------------------------------------------
     @cached_property
     def pa9(self) -> dict[str, Any]:
-        import uio_teach as ut
-
         c = self.cfg
         run = dataclasses.replace(
             PA9,
@@ -166,8 +167,6 @@ class _Runs:
     # missile ----------------------------------------------------------------------------------
     @cached_property
     def missile(self) -> dict[str, Any]:
-        import uio_teach as ut
-
         c = self.cfg
         run = dataclasses.replace(
             MISSILE,
@@ -336,7 +335,7 @@ def _missile_error(runs: _Runs) -> Figure:
         finish_panel(ax, with_unit(rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$"))
         # a measured state is estimated exactly: its error is rounding noise, shown on zero
         scale = float(np.max(np.abs(m["pmo"]["response"].states[i])))
-        _zero_to_rounding(ax, np.array(errors), scale)
+        zero_to_rounding(ax, np.array(errors), scale)
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle("Missile autopilot: estimation error of both observers")
@@ -367,8 +366,6 @@ def _missile_inputs(runs: _Runs) -> Figure:
 
 
 def _table2_rows(runs: _Runs) -> list[tuple[str, float, float, float, float]]:
-    import uio_teach as ut
-
     m = runs.missile
     pub = ut.examples.MISSILE_PUBLISHED
     names = ["x1", "x2", "x3", "x4", "v1", "v2"]
@@ -600,8 +597,6 @@ def generate(
     ...     res[0].ok, res[0].paths[0].name
     (True, 'case_error.png')
     """
-    import matplotlib.style
-
     if fmt not in FORMATS:
         raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
     dpi = check_dpi(dpi)
@@ -626,6 +621,8 @@ def generate(
                     else:
                         fig = spec.draw(runs)
                         made = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
+                for _ in made:
+                    stage.written()
                 paths = tuple(target / path.name for path in made)
                 result = FigureResult(name, paths, time.perf_counter() - start)
             except Exception as exc:  # one figure failing must not stop the others
@@ -639,6 +636,7 @@ def generate(
         if all(r.ok for r in results):
             options = {"figures": wanted, "format": fmt, "dpi": dpi, "config_file": cfg.source}
             write_manifest(folder, command="uio-teach figures", config=cfg, options=options)
+            stage.written()
             stage.commit()
     return results
 

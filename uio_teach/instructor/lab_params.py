@@ -518,9 +518,10 @@ class CaseStudyParams(LabParams):
         (``L D = 0``) and the moved pole's gain differ between groups;
         :meth:`problems` makes sure that ``M`` exists, the two fixed modes are
         stable and the LMI is feasible. The pole lies in [-0.6, 0.3], at least
-        0.1 from the fixed modes; the unknown inputs have amplitudes of at least
-        0.5; ``x[0]`` has integer entries and a nonzero initial error
-        ``(I - MC) x[0]``.
+        0.1 from the fixed modes and from the eigenvalues of ``A1`` (moving it
+        takes a gain; a term's own pole must be 0.05 from them); the unknown
+        inputs have amplitudes of at least 0.5; ``x[0]`` has integer entries
+        and a nonzero initial error ``(I - MC) x[0]``.
         """
         base = base or cls()
         B2 = [[_choice(rng, [1.0, 2.0])], *([_choice(rng, [-1.0, 1.0, 2.0])] for _ in range(2))]
@@ -540,7 +541,7 @@ class CaseStudyParams(LabParams):
             duration=base.duration,
             style=base.style,
             matrices=_lab_value(dict(experiment_params(CASE_STUDY))["matrices"], matrices),
-            pole=_choice(rng, [-0.6, -0.4, -0.2, 0.0, 0.2, 0.3]),
+            pole=_choice(rng, [-0.6, -0.4, -0.3, -0.2, 0.1, 0.2, 0.3]),
             u2_amplitude=_choice(rng, [1.0, 1.5, 2.0, 2.5, 3.0]),
             u2_frequency=_choice(rng, [0.3, 0.4, 0.5, 0.6, 0.7, 0.8]),
             v_amplitude=_choice(rng, [0.5, 1.0, 1.5]),
@@ -584,6 +585,10 @@ class CaseStudyParams(LabParams):
             out.append("the movable pole must differ from the fixed modes")
         if np.max(np.abs(decoupling(plant).M)) > 10:
             out.append("M has entries too large for a fair hand computation")
+        natural = np.linalg.eigvals(decoupling(plant).A1)
+        if np.min(np.abs(natural - self.pole)) < 0.05:
+            # the mode is there already: L = 0 would "move" it, for every group alike
+            out.append("the movable pole must be moved: away from the eigenvalues of A1")
         if not out:
             try:
                 pmo = design_pmo(plant, method="lmi")

@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from .book import _LABELLED_MATH, _TARGET, BookIndex
+from .book import LABELLED_MATH, TARGET, BookIndex
 
 __all__ = ["Converter", "Directive", "tokens", "quote"]
 
@@ -55,6 +55,7 @@ def tokens(text: str) -> list[str | Directive]:
     The block parser of :mod:`jupytext.myst` (markdown-it-py with the MyST plugins, and the
     colon fence of mdit-py-plugins) finds the directives; jupytext reads their options.
     """
+    # deferred on purpose: jupytext comes with the optional ``instructor`` extra
     from jupytext.myst import get_parser, parse_directive_options
     from mdit_py_plugins.colon_fence import colon_fence_plugin
 
@@ -132,8 +133,8 @@ class Converter:
                 number = label
             return f"$${m.group('body').rstrip()} \\tag{{{number}}}$$"
 
-        text = _LABELLED_MATH.sub(tag, text)
-        lines = [ln for ln in text.split("\n") if not _TARGET.match(ln.strip())]
+        text = LABELLED_MATH.sub(tag, text)
+        lines = [ln for ln in text.split("\n") if not TARGET.match(ln.strip())]
         lines = [ln for ln in lines if not re.match(r"^%( |$)", ln)]  # MyST comments
         text = _ROLE.sub(self.role, "\n".join(lines))
         # "eq. {eq}`x`" in the source: the role already says "eq."

@@ -15,6 +15,13 @@ output, and it may hold someone's work. :func:`write_manifest` records what a
 run used and made (the configuration and its hash, the versions, every file
 with its SHA-256).
 
+:class:`StagedFolder` is the one way the instructor's commands write a folder
+(``figures``, ``labs`` and the graders' feedback): it also holds a
+:class:`FolderLock` (one run per folder at a time), removes what killed runs
+left beside the folder (:func:`clean_leftovers`), gives the folder the user's
+usual permissions and swaps it in with one atomic exchange on Linux, so a run
+killed at any point leaves the old set or the new set of files, never a mix.
+
 Examples
 --------
 >>> from uio_teach.instructor.output import FORMATS
@@ -24,15 +31,23 @@ Examples
 
 from __future__ import annotations
 
+import ctypes
+import errno
+import fcntl
+import glob
 import hashlib
 import json
 import os
 import shutil
+import signal
 import sys
 import tempfile
 from collections.abc import Mapping
+from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from .. import __version__
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -42,6 +57,9 @@ __all__ = [
     "MANIFEST",
     "OutputError",
     "StagedFolder",
+    "FolderLock",
+    "clean_leftovers",
+    "KILL_AT_ENV",
     "save_figure",
     "prepare_output_dir",
     "write_manifest",
@@ -102,7 +120,7 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], fmt: str, dpi: int = 
     >>> a == b
     True
     """
-    import matplotlib
+    import matplotlib  # deferred on purpose: the lab notebooks and the grader do not draw
 
     if fmt not in FORMATS:
         raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
@@ -210,10 +228,6 @@ def library_versions() -> dict[str, str]:
     >>> sorted(library_versions())[:3]
     ['control', 'cvxpy', 'matplotlib']
     """
-    from importlib import metadata
-
-    from .. import __version__
-
     versions = {"python": sys.version.split()[0], "uio-teach": __version__}
     for name in _LIBRARIES:
         try:
@@ -245,8 +259,9 @@ def write_manifest(
     The manifest holds the command, the configuration as used (every key,
     defaults included) and the SHA-256 of its canonical JSON, the options
     (format, resolution, figures asked for), the versions of Python, uio-teach
-    and the libraries, and every file of the folder with its size and
-    SHA-256. It has no time stamp, so the same run gives the same manifest.
+    and the libraries, and every file of the folder and its sub-folders with
+    its size and SHA-256 (names relative to ``folder``, with ``/``). It has
+    no time stamp, so the same run gives the same manifest.
 
     Parameters
     ----------
@@ -279,9 +294,13 @@ def write_manifest(
     cfg = _jsonable(dict(config))
     canonical = json.dumps(cfg, sort_keys=True, separators=(",", ":"))
     files = [
-        {"name": p.name, "bytes": p.stat().st_size, "sha256": sha256_file(p)}
-        for p in sorted(folder.iterdir())
-        if p.is_file() and p.name != MANIFEST
+        {
+            "name": p.relative_to(folder).as_posix(),
+            "bytes": p.stat().st_size,
+            "sha256": sha256_file(p),
+        }
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and p != folder / MANIFEST
     ]
     data = {
         "generator": "uio-teach",
@@ -327,14 +346,174 @@ def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
     return data
 
 
-class StagedFolder:
-    """Write a folder all at once: into a temporary folder beside it, swapped in by :meth:`commit`.
+class FolderLock:
+    """Hold the lock of an output folder: one run at a time writes it.
 
-    Use it as a context manager. Inside, write into :attr:`path`; call
-    :meth:`commit` when everything is written. Leaving the block without a
-    commit (a failure, an exception, Ctrl-C) deletes the temporary folder and
-    leaves ``target`` exactly as it was. A commit replaces ``target`` whole,
-    so no file of an earlier run is left next to the new ones.
+    The lock is the file ``.<name>.lock`` beside the folder, locked with
+    :func:`fcntl.flock` and holding the process id of its holder. The kernel
+    releases the lock when its holder ends, however it ends, so the lock file
+    of a killed run is simply taken over by the next one; a lock held by a
+    live process is refused with :class:`OutputError` naming that process.
+
+    Parameters
+    ----------
+    target : str or path-like
+        The output folder (it need not exist).
+
+    Raises
+    ------
+    OutputError
+        Another process holds the lock, or the lock file cannot be made.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.output import FolderLock, OutputError
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     target = pathlib.Path(tmp) / "labs"
+    ...     with FolderLock(target):
+    ...         try:
+    ...             FolderLock(target).acquire()
+    ...         except OutputError as err:
+    ...             print("is writing" in str(err))
+    True
+    """
+
+    def __init__(self, target: str | os.PathLike[str]) -> None:
+        self.target = Path(os.path.abspath(target))
+        self.path = self.target.parent / f".{self.target.name}.lock"
+        self._fd: int | None = None
+
+    def acquire(self) -> FolderLock:
+        """Take the lock (never waits); returns ``self``."""
+        try:
+            self.target.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise OutputError(
+                f"cannot create the output folder {os.fspath(self.target)}: {err.strerror or err}"
+            ) from None
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+            except OSError as err:
+                raise OutputError(
+                    f"cannot write beside the output folder {os.fspath(self.target)}: "
+                    f"{err.strerror or err}"
+                ) from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+                os.close(fd)
+                raise OutputError(
+                    f"another uio-teach run (process {holder}) is writing "
+                    f"{os.fspath(self.target)}; wait until it ends, or choose another folder"
+                ) from None
+            # the holder before us may have removed the file between our open and our lock
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self._fd = fd
+        return self
+
+    def release(self) -> None:
+        """Remove the lock file and let the lock go."""
+        if self._fd is None:
+            return
+        try:
+            os.unlink(self.path)
+        except OSError:
+            pass
+        os.close(self._fd)  # closing releases the flock
+        self._fd = None
+
+    def __enter__(self) -> FolderLock:
+        return self.acquire()
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+
+KILL_AT_ENV = "UIO_TEACH_KILL_AT"
+"""A testing aid: with ``UIO_TEACH_KILL_AT=k`` in its environment, a run kills itself (SIGKILL)
+at its k-th step (a file written into the staging folder, or a point of the swap), so that the
+tests can check what a kill at that moment leaves. Unset, it does nothing."""
+_steps = 0
+
+
+def _step() -> None:
+    """One step of a staged run: a file written, or a point of the swap (see ``KILL_AT_ENV``)."""
+    global _steps
+    _steps += 1
+    wanted = os.environ.get(KILL_AT_ENV)
+    if wanted and wanted.isdigit() and int(wanted) == _steps:
+        os.kill(os.getpid(), signal.SIGKILL)
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths in one atomic step (Linux ``renameat2``); False where it is not available."""
+    if _RENAMEAT2 is None:
+        return False
+    res = _RENAMEAT2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
+    if res == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP):
+        return False
+    raise OSError(err, os.strerror(err), os.fspath(b))
+
+
+def _find_renameat2() -> Any:
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        func = libc.renameat2
+    except (OSError, AttributeError):
+        return None
+    func.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    func.restype = ctypes.c_int
+    return func
+
+
+_AT_FDCWD = -100
+_RENAME_EXCHANGE = 2
+_RENAMEAT2 = _find_renameat2() if sys.platform.startswith("linux") else None
+
+
+class StagedFolder:
+    """Write a folder all at once: into a staging folder beside it, swapped in by :meth:`commit`.
+
+    This is the one way the instructor's commands write a folder (the
+    figures, the lab notebooks, the graders' feedback). Use it as a context
+    manager. Entering it
+
+    1. takes the folder's :class:`FolderLock` (a second run into the same
+       folder is refused, not raced);
+    2. cleans what killed runs left beside the folder (staging folders
+       ``.<name>.new-*`` and ``.<name>.old-*``; an earlier output that a
+       run killed in the middle of a non-atomic swap left aside is put back);
+    3. checks that the folder may be replaced (:func:`check_output_folder`);
+    4. makes the staging folder :attr:`path`, with the user's usual
+       permissions (the umask, not the private mode of a temporary folder).
+
+    Write into :attr:`path` (calling :meth:`written` after each file lets a
+    test stop the run there), then call :meth:`commit`. Leaving the block
+    without a commit (a failure, an exception, Ctrl-C) deletes the staging
+    folder and leaves ``target`` exactly as it was. A commit replaces
+    ``target`` whole, in one atomic exchange of the two folders on Linux, so
+    no file of an earlier run is left next to the new ones and a run killed at
+    any point leaves the old set or the new set, never a mix.
 
     Parameters
     ----------
@@ -348,22 +527,23 @@ class StagedFolder:
     OutputError
         ``target`` is a file; or it is a folder that is not empty and has no
         :data:`MANIFEST` of uio-teach (it does not look like an earlier output:
-        empty it, or choose another folder); or the temporary folder cannot
-        be made beside it.
+        empty it, or choose another folder); or another run is writing it; or
+        the staging folder cannot be made beside it.
 
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.output import StagedFolder
+    >>> from uio_teach.instructor.output import StagedFolder, write_manifest
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     target = pathlib.Path(tmp) / "figures"
     ...     with StagedFolder(target) as stage:
     ...         _ = (stage.path / "a.txt").write_text("new")
+    ...         _ = write_manifest(stage.path, command="demo", config={})
     ...         print(target.exists())
     ...         _ = stage.commit()
     ...     print(sorted(p.name for p in target.iterdir()))
     False
-    ['a.txt']
+    ['a.txt', 'manifest.json']
     """
 
     def __init__(self, target: str | os.PathLike[str], what: str = "output") -> None:
@@ -371,43 +551,115 @@ class StagedFolder:
         self.what = what
         self.committed = False
         self.path: Path | None = None
+        self._lock = FolderLock(self.target)
         check_output_folder(self.target)
 
     def __enter__(self) -> StagedFolder:
-        parent = self.target.absolute().parent
+        self._lock.acquire()
         try:
-            parent.mkdir(parents=True, exist_ok=True)
-            self.path = Path(tempfile.mkdtemp(dir=parent, prefix=f".{self.target.name}.new-"))
-        except OSError as err:
-            reason = err.strerror or str(err)
-            raise OutputError(
-                f"cannot create the output folder {os.fspath(self.target)}: {reason}"
-            ) from None
+            clean_leftovers(self.target)
+            check_output_folder(self.target)
+            parent = self._lock.target.parent
+            try:
+                self.path = Path(tempfile.mkdtemp(dir=parent, prefix=f".{self.target.name}.new-"))
+                os.chmod(self.path, 0o777 & ~_umask())
+            except OSError as err:
+                reason = err.strerror or str(err)
+                raise OutputError(
+                    f"cannot create the output folder {os.fspath(self.target)}: {reason}"
+                ) from None
+        except BaseException:
+            self._lock.release()
+            raise
         return self
+
+    def written(self, path: str | os.PathLike[str] | None = None) -> None:
+        """Note that one more file is in the staging folder (a point where a test may stop)."""
+        _step()
 
     def commit(self) -> Path:
         """Swap the written folder in place of ``target``; returns ``target``."""
         assert self.path is not None, "use StagedFolder in a with block"
         check_output_folder(self.target)  # it may have changed while we were writing
+        _step()
+        target = self._lock.target
+        if target.exists() and _exchange(self.path, target):
+            # self.path now holds the earlier output
+            self.committed = True
+            _step()
+            shutil.rmtree(self.path, ignore_errors=True)
+            return self.target
         old = None
-        if self.target.exists():
-            old = Path(tempfile.mkdtemp(dir=self.path.parent, prefix=f".{self.target.name}.old-"))
+        if target.exists():
+            old = Path(tempfile.mkdtemp(dir=target.parent, prefix=f".{target.name}.old-"))
             os.rmdir(old)
-            os.replace(self.target, old)
+            os.replace(target, old)
+            _step()
         try:
-            os.replace(self.path, self.target)
+            os.replace(self.path, target)
         except OSError:
             if old is not None:
-                os.replace(old, self.target)
+                os.replace(old, target)
             raise
         self.committed = True
+        _step()
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
         return self.target
 
     def __exit__(self, *exc: object) -> None:
-        if not self.committed and self.path is not None:
-            shutil.rmtree(self.path, ignore_errors=True)
+        try:
+            if not self.committed and self.path is not None:
+                shutil.rmtree(self.path, ignore_errors=True)
+        finally:
+            self._lock.release()
+
+
+def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
+    """Remove the staging folders that killed runs left beside ``target``.
+
+    Call it only while holding the folder's :class:`FolderLock` (then no
+    live run is using them). If ``target`` is missing but an earlier output
+    was set aside (``.<name>.old-*``, a run killed between the two renames of
+    a non-atomic swap), that output is put back first.
+
+    Parameters
+    ----------
+    target : str or path-like
+        The output folder.
+
+    Returns
+    -------
+    list of pathlib.Path
+        What was removed.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.output import clean_leftovers
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     (pathlib.Path(tmp) / ".figs.new-abc").mkdir()
+    ...     [p.name for p in clean_leftovers(pathlib.Path(tmp) / "figs")]
+    ['.figs.new-abc']
+    """
+    target = Path(os.path.abspath(target))
+    parent = target.parent
+    if not parent.is_dir():
+        return []
+    aside = sorted(parent.glob(f".{glob.escape(target.name)}.old-*"))
+    if not target.exists() and aside:
+        restore = next((p for p in aside if read_manifest(p) is not None), None)
+        if restore is not None:
+            os.replace(restore, target)
+            aside.remove(restore)
+    removed = []
+    for path in [*sorted(parent.glob(f".{glob.escape(target.name)}.new-*")), *aside]:
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink(missing_ok=True)
+        removed.append(path)
+    return removed
 
 
 def check_output_folder(target: str | os.PathLike[str]) -> None:
