@@ -1,9 +1,13 @@
-"""`uio-teach grade`: each submission run on a copy, its checks re-run, one gradebook row each.
+"""`uio-teach grade`: submissions run in a sandbox, their answers checked in the grader's process.
 
-The lab test grades the notebooks `uio-teach labs` writes (the solution passes every check, the
-untouched student version fails); the small synthetic notebooks show what a grader must survive
-(a cell that raises, loops or ignores the interrupt, deleted check cells, stored ✓ outputs, a file
-that is not a notebook) and the answer key's parameters replacing the group's own.
+One grading run (module fixture) holds the lab's solution notebooks, the untouched student
+notebook and submissions that attack the grader: a patched ``CheckResult``, ``PARAMS`` reset to
+another group's numbers, probes of ``/proc``, the answer key, the solution notebook, other
+submissions and the network, a fake ``kernel.pid``, signals to the grader's process group, a
+sandbox that kills itself, a loop that ignores interrupts, memory exhaustion, a background thread
+printing after the last cell. Each attack must fail to change a grade or to reach outside its
+copy. No test here decides on how long anything took: the time limits given to the grader are
+safety nets far above what the notebooks need, except where a notebook never ends.
 """
 
 from __future__ import annotations
@@ -11,17 +15,25 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-import time
+import os
+import signal
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
 import nbformat
 import pytest
 
-from uio_teach import checks
-from uio_teach.checks import CheckResult
-from uio_teach.instructor import cli, grade, output
+from uio_teach.instructor import cli, grade
+from uio_teach.instructor.labs import LABS
+from uio_teach.instructor.sandbox import sandbox_problem
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+needs_sandbox = pytest.mark.skipif(
+    sandbox_problem() is not None, reason=f"no sandbox here: {sandbox_problem()}"
+)
+CHECKS = ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise")
 
 
 def sha(path: Path) -> str:
@@ -33,332 +45,434 @@ def rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
-# the results the checks return -----------------------------------------------------------------
+def add_cell(nb, source: str, *, at: int | None = None, tags: tuple[str, ...] = ()) -> None:
+    cell = nbformat.v4.new_code_cell(textwrap.dedent(source))
+    if tags:
+        cell.metadata["tags"] = list(tags)
+    nb.cells.insert(len(nb.cells) if at is None else at, cell)
 
-
-def test_check_results_have_ids_and_json_and_are_collected():
-    checks.clear_collected()
-    assert checks.collected() == []
-    first = checks.pa9_design(None, None, None)
-    second = checks.pa9_simulation(None)
-    made_by_hand = CheckResult("not a check function", [(True, "fine")])
-    assert checks.collected() == [first, second]  # only what the check functions returned
-    assert first.check_id == "pa9.design" and second.check_id == "pa9.simulation"
-    data = first.to_dict()
-    assert json.loads(json.dumps(data)) == data
-    assert set(data) == {"check_id", "title", "passed", "items"}
-    assert data["passed"] is False and data["items"][0]["ok"] is False
-    assert all(set(item) == {"ok", "message"} for item in data["items"])
-    assert made_by_hand.to_dict()["check_id"] is None
-    checks.clear_collected()
-    assert checks.collected() == []
-
-
-# the lab: solution passes, untouched student notebook fails -------------------------------------
-
-
-@pytest.fixture(scope="module")
-def lab_notebooks(tmp_path_factory) -> tuple[Path, Path]:
-    out = tmp_path_factory.mktemp("labs")
-    assert cli.main(["labs", "--out", str(out), "-q"]) == 0
-    solution = sorted(out.rglob("solution/*pa9*.ipynb"))[0]
-    student = sorted(out.rglob("student/*pa9*.ipynb"))[0]
-    return solution, student
-
-
-def test_the_solution_passes_and_the_untouched_student_notebook_fails(
-    lab_notebooks, tmp_path, capsys
-):
-    solution, student = lab_notebooks
-    before = {p: sha(p) for p in (solution, student)}
-    out = tmp_path / "grades.csv"
-    start = time.perf_counter()
-    code = cli.main(["grade", str(solution), str(student), "--out", str(out)])
-    seconds = time.perf_counter() - start
-    print(f"\ngraded 2 lab notebooks in {seconds:.1f} s ({seconds / 2:.1f} s per notebook)")
-    assert code == 0, capsys.readouterr().err
-    assert {p: sha(p) for p in (solution, student)} == before  # submissions untouched
-    table = rows(out)
-    assert [r["file"] for r in table] == [str(solution), str(student)]
-    ids = [c for c in table[0] if c.startswith("pa9.")]
-    assert len(ids) >= 4 and "pa9.design" in ids
-    sol, stu = table
-    assert sol["lab"] == stu["lab"] == "pa9"
-    assert all(sol[i] == grade.PASS for i in ids) and sol["total"] == sol["out_of"] == str(len(ids))
-    assert all(stu[i] == grade.FAIL for i in ids) and stu["total"] == "0"
-    feedback = sorted((tmp_path / "grades_feedback").glob("*.txt"))
-    assert len(feedback) == 2
-    texts = {p.name: p.read_text(encoding="utf-8") for p in feedback}
-    (text,) = [t for t in texts.values() if f"Submission: {student}" in t]
-    assert "✗ pa9.design" in text and "is missing" in text
-
-
-# what a grader must survive ---------------------------------------------------------------------
 
 SETUP = """\
+import numpy as np
+import control as ct
+import uio_teach as ut
 from uio_teach import checks
-from uio_teach.checks import CheckResult
-from uio_teach.checks._common import _never_raises
-
-@_never_raises("demo: the value", check_id="demo.value")
-def check_value(x):
-    return CheckResult("demo: the value", [(x == 2, f"x is {x}; it must be 2")])
 """
+DESIGN = """\
+plant = ut.experiments.plant_from_params("pa9", PARAMS)
+A, B, C, E = plant.A, plant.B, plant.C, plant.E
+poles = [complex(s) if isinstance(s, str) else s for s in PARAMS["poles"]]
+H = E @ np.linalg.pinv(C @ E)
+T = np.eye(3) - H @ C
+K1 = ct.place((T @ A).T, C.T, poles).T
+F = T @ A - K1 @ C
+K2 = F @ H
+"""
+CHECK_DESIGN = 'checks.pa9_design(H, T, K1, F, K2, poles=PARAMS["poles"])'
 
 
-def notebook(path: Path, *cells: tuple[str, list[str]], meta: dict | None = None) -> Path:
+def small(path: Path, group: str, *cells: str, design: bool = True) -> Path:
+    """A short pa9 submission: set-up, parameters, (the design and its check), then ``cells``."""
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {
         "name": "python3",
         "display_name": "Python 3",
         "language": "python",
     }
-    if meta is not None:
-        nb.metadata["uio_teach"] = meta
-    for source, tags in cells:
-        cell = nbformat.v4.new_code_cell(source)
-        if tags:
-            cell.metadata["tags"] = tags
-        nb.cells.append(cell)
+    nb.metadata["uio_teach"] = {"lab": "pa9", "group": group}
+    add_cell(nb, SETUP)
+    add_cell(nb, "PARAMS = {'poles': [-1.0, -2.0, -3.0]}", tags=("parameters",))
+    if design:
+        add_cell(nb, DESIGN)
+        add_cell(nb, CHECK_DESIGN, tags=("check",))
+    for source in cells:
+        add_cell(nb, source)
     nbformat.write(nb, path)
     return path
 
 
 @pytest.fixture(scope="module")
-def graded(tmp_path_factory) -> dict:
-    """Several awkward submissions of the demo lab, graded once with an answer key."""
-    folder = tmp_path_factory.mktemp("submissions")
-    params = ("PARAMS = {'x': 1}", ["parameters"])
-    setup = (SETUP, [])
-    answer = ("x = PARAMS['x']", [])
-    check = ("check_value(x)", ["check"])
-    subs = {
-        # the key gives x = 2: passes although the group's own cell says 1
-        "keyed": notebook(folder / "demo_g01.ipynb", setup, params, answer, check),
-        # metadata names the group (the file name does not)
-        "meta": notebook(
-            folder / "renamed.ipynb",
-            setup,
-            params,
-            answer,
-            check,
-            meta={"lab": "demo", "group": "g02"},
-        ),
-        "raises": notebook(
-            folder / "demo_g03.ipynb", setup, params, ("raise RuntimeError('oops')", []), check
-        ),
-        "deleted": notebook(folder / "demo_g04.ipynb", setup, params, answer),
-        "loops": notebook(
-            folder / "demo_g05.ipynb", setup, params, answer, ("while True:\n    pass", []), check
-        ),
-        "outside": notebook(
-            folder / "demo_g06.ipynb",
-            setup,
-            params,
-            answer,
-            ("check_value(-1)  # shown on purpose, not a check cell", []),
-            check,
-        ),
-        "garbage": folder / "demo_g07.ipynb",
+def labs(tmp_path_factory) -> dict:
+    out = tmp_path_factory.mktemp("labs")
+    assert cli.main(["labs", "--out", str(out), "--groups", "2", "--seed", "3", "-q"]) == 0
+    # a key of this file's own: the course's numbers for group 1, other poles for group 2
+    key = out / "answer_key.csv"
+    course = LABS["pa9"].params().to_params()
+    params = {
+        ("pa9", "g01"): course,
+        ("pa9", "g02"): dict(course, poles=[-4.0, -5.0, -6.0]),
     }
-    subs["garbage"].write_text("{ not a notebook")
-    # a stored ✓ counts for nothing: the cell's code is what runs
-    nb = nbformat.read(subs["deleted"], as_version=4)
-    nb.cells[-1].outputs = [nbformat.v4.new_output("stream", text="✓ demo.value passed\n")]
-    nbformat.write(nb, subs["deleted"])
-    key = folder / "answer_key.csv"
-    with open(key, "w", newline="") as fh:
+    with open(key, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
-        writer.writerow(["lab", "group", "params", "x"])
-        for g in range(1, 8):
-            writer.writerow(["demo", f"g{g:02d}", json.dumps({"x": 2}), "2"])
-    before = {name: sha(path) for name, path in subs.items()}
-    out = folder / "out" / "grades.csv"
-    start = time.perf_counter()
-    results = grade.grade(list(subs.values()), out, answer_key=key, timeout=120, cell_timeout=15)
+        writer.writerow(["lab", "group", "params"])
+        for (lab, group), values in params.items():
+            writer.writerow([lab, group, json.dumps(values)])
+    return {
+        "out": out,
+        "key": key,
+        "params": params,
+        "solution": {g: out / "pa9" / "solution" / f"pa9_{g}.ipynb" for g in ("g01", "g02")},
+        "student": {g: out / "pa9" / "student" / f"pa9_{g}.ipynb" for g in ("g01", "g02")},
+    }
+
+
+def probe_source(labs: dict, others: list[Path], sleeper: int) -> str:
+    """A cell that tries to reach outside its copy and raises with what it reached."""
+    targets = {
+        "key": str(labs["key"]),
+        "solution": str(labs["solution"]["g01"]),
+        "labs": str(labs["out"]),
+        **{f"other{i}": str(p) for i, p in enumerate(others)},
+    }
+    return f"""\
+import glob, json, os, signal, socket
+reached = {{}}
+for name, path in {targets!r}.items():
+    try:
+        with open(path, "rb") as fh:
+            fh.read(1)
+        reached[name] = "read"
+    except Exception as exc:
+        pass
+    try:
+        with open(path, "a") as fh:
+            fh.write("tampered")
+        reached[name + ".write"] = "written"
+    except Exception:
+        pass
+procs = []
+for path in glob.glob("/proc/[0-9]*/cmdline"):
+    try:
+        text = open(path, "rb").read()
+    except OSError:
+        continue
+    if b"answer_key" in text or b"pytest" in text or b"groups-from" in text:
+        procs.append(path)
+reached["proc"] = procs
+reached["pids"] = sorted(int(p) for p in os.listdir("/proc") if p.isdigit())[-1]
+for where in ("kernel.pid", "../kernel.pid", "/tmp/kernel.pid"):
+    try:
+        with open(where, "w") as fh:
+            fh.write("{sleeper}")
+    except OSError:
+        pass
+for target in ({sleeper}, {os.getpgid(0)}):
+    try:
+        os.killpg(target, signal.SIGKILL)
+        reached["killed" + str(target)] = True
+    except OSError:
+        pass
+try:
+    socket.create_connection(("1.1.1.1", 53), timeout=5)
+    reached["network"] = True
+except OSError:
+    pass
+raise RuntimeError("PROBE " + json.dumps(reached))
+"""
+
+
+@pytest.fixture(scope="module")
+def graded(labs, tmp_path_factory) -> dict:
+    """Every submission of this file graded in one run with the answer key (2 at a time)."""
+    folder = tmp_path_factory.mktemp("handed_in")
+    subs: dict[str, Path] = {}
+    g1, g2 = labs["params"][("pa9", "g01")], labs["params"][("pa9", "g02")]
+
+    # the solution, with a thread printing after the last cell and answers undone afterwards
+    nb = nbformat.read(labs["solution"]["g01"], as_version=4)
+    add_cell(
+        nb,
+        """\
+        import threading, time
+        def chatter():
+            while True:
+                print("still here", flush=True)
+                time.sleep(0.001)
+        threading.Thread(target=chatter, daemon=True).start()
+        H = T = K1 = F = K2 = resp_sine = resp_steps = fig = None
+        """,
+    )
+    subs["solution"] = folder / "solution" / "pa9_g01.ipynb"
+    subs["solution"].parent.mkdir()
+    nbformat.write(nb, subs["solution"])
+
+    # group 2's solution with PARAMS reset to group 1's numbers after the parameters cell
+    nb = nbformat.read(labs["solution"]["g02"], as_version=4)
+    at = next(i for i, c in enumerate(nb.cells) if "parameters" in c.metadata.get("tags", []))
+    add_cell(nb, f"PARAMS = {json.dumps(g1)}", at=at + 1)
+    subs["params"] = folder / "params" / "pa9_g02.ipynb"
+    subs["params"].parent.mkdir()
+    nbformat.write(nb, subs["params"])
+
+    # the untouched student notebook, and one that fakes every check in the kernel
+    subs["student"] = folder / "student" / "pa9_g01.ipynb"
+    subs["student"].parent.mkdir()
+    subs["student"].write_bytes(labs["student"]["g01"].read_bytes())
+    nb = nbformat.read(labs["student"]["g01"], as_version=4)
+    add_cell(
+        nb,
+        """\
+        import uio_teach.checks as _c
+        from uio_teach.checks import CheckResult
+        CheckResult.passed = property(lambda self: True)
+        CheckResult.to_dict = lambda self: {"check_id": "pa9.design", "passed": True}
+        for _name in dir(_c):
+            if _name.startswith("pa9_"):
+                setattr(_c, _name, lambda *a, **k: CheckResult("ok", [(True, "fine")]))
+        """,
+        at=1,
+    )
+    subs["patched"] = folder / "patched" / "pa9_g01.ipynb"
+    subs["patched"].parent.mkdir()
+    nbformat.write(nb, subs["patched"])
+
+    sleeper = subprocess.Popen(["sleep", "100000"], start_new_session=True)
+    others = [subs["solution"], subs["student"]]
+    subs["probe"] = small(folder / "probe.ipynb", "g01", probe_source(labs, others, sleeper.pid))
+    subs["suicide"] = small(
+        folder / "suicide.ipynb", "g02", "import os, signal\nos.kill(-1, signal.SIGKILL)"
+    )
+    subs["stubborn"] = small(
+        folder / "stubborn.ipynb",
+        "g01",
+        "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+        "while True:\n    time.sleep(0.05)",
+        "checks.pa9_plot(fig, response=resp_sine)",
+    )
+    subs["limits"] = small(
+        folder / "limits.ipynb",
+        "g02",
+        """\
+import json, resource
+limits = [resource.getrlimit(getattr(resource, "RLIMIT_" + n)) for n in ("AS", "NPROC", "FSIZE")]
+try:
+    resource.setrlimit(resource.RLIMIT_AS, (resource.RLIM_INFINITY,) * 2)
+    limits.append("raised")
+except (ValueError, OSError):
+    pass
+raise RuntimeError("LIMITS " + json.dumps(limits))
+""",
+    )
+    subs["raises"] = small(
+        folder / "raises.ipynb",
+        "g01",
+        "plant = ut.experiments.plant_from_params('pa9', PARAMS)\n"
+        "A, B, C, E = plant.A, plant.B, plant.C, plant.E\n"
+        "H = np.linalg.inv(C @ E)",
+        CHECK_DESIGN,
+        design=False,
+    )
+    subs["garbage"] = folder / "pa9_g02.ipynb"
+    subs["garbage"].write_text("{ not a notebook")
+    for name in ("stubborn", "raises"):  # their last check cell is a check cell
+        nb = nbformat.read(subs[name], as_version=4)
+        nb.cells[-1].metadata["tags"] = ["check"]
+        nbformat.write(nb, subs[name])
+
+    protected = [labs["key"], labs["solution"]["g01"], labs["solution"]["g02"], *subs.values()]
+    before = {p: sha(p) for p in protected}
+    out = folder / "marks" / "grades.csv"
+    try:
+        results = grade.grade(
+            list(subs.values()),
+            out,
+            answer_key=labs["key"],
+            timeout=180,
+            cell_timeout=90,
+            jobs=2,
+        )
+        sleeper_alive = sleeper.poll() is None
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    feedback = out.parent / "grades_feedback"
     return {
         "subs": subs,
         "before": before,
+        "after": {p: sha(p) for p in protected},
         "results": dict(zip(subs, results, strict=True)),
         "rows": dict(zip(subs, rows(out), strict=True)),
+        "text": {
+            name: Path(sub.feedback_file).read_text(encoding="utf-8")
+            for name, sub in zip(subs, results, strict=True)
+        },
+        "sleeper_alive": sleeper_alive,
+        "g1": g1,
+        "g2": g2,
         "out": out,
-        "seconds": time.perf_counter() - start,
+        "feedback": feedback,
     }
 
 
-def test_every_submission_gets_a_row_and_none_is_touched(graded):
-    assert {name: sha(path) for name, path in graded["subs"].items()} == graded["before"]
-    header = list(next(iter(graded["rows"].values())))
-    assert header == ["file", "lab", "group", "status", "demo.value", "total", "out_of"]
-    feedback = graded["out"].parent / "grades_feedback"
-    assert len(list(feedback.glob("*.txt"))) == len(graded["subs"])
-    assert sorted(p.name for p in feedback.iterdir() if p.suffix != ".txt") == ["manifest.json"]
-    print(f"\n{len(graded['subs'])} small notebooks graded in {graded['seconds']:.1f} s")
+def marks(row: dict[str, str]) -> list[str]:
+    return [row[c] for c in CHECKS]
 
 
-def test_the_answer_key_sets_each_groups_parameters(graded):
-    keyed, meta = graded["rows"]["keyed"], graded["rows"]["meta"]
-    assert (keyed["group"], meta["group"]) == ("g01", "g02")
-    assert keyed["demo.value"] == meta["demo.value"] == grade.PASS
-    assert graded["results"]["keyed"].params == {"x": 2}
+@needs_sandbox
+def test_the_solution_passes_whatever_it_does_after_its_checks(graded):
+    row = graded["rows"]["solution"]
+    assert marks(row) == [grade.PASS] * 4 and row["total"] == row["out_of"] == "4"
+    # a thread printing after the last cell does not make the run look cut short
+    assert row["status"] == "ok", graded["text"]["solution"]
 
 
-@pytest.mark.parametrize(
-    ("name", "status", "note"),
-    [
-        ("raises", "error", "raised RuntimeError: oops"),
-        ("deleted", "ok", "not run"),
-        ("loops", "error", "interrupted"),
-        ("garbage", "unreadable", "not a notebook"),
-    ],
-)
-def test_broken_submissions_are_graded_not_crashed(graded, name, status, note):
-    row = graded["rows"][name]
-    assert row["status"] == status
-    if name == "loops":  # interrupted, then the next cells ran: x was right
-        assert row["demo.value"] == grade.PASS and row["total"] == "1"
-    else:  # the unreadable file is still group g07 of the demo lab, by its name
-        assert row["demo.value"] == grade.FAIL and (row["total"], row["out_of"]) == ("0", "1")
-    text = (graded["out"].parent / "grades_feedback" / f"{Path(row['file']).stem}.txt").read_text(
-        encoding="utf-8"
+@needs_sandbox
+def test_the_untouched_student_notebook_fails_every_check(graded):
+    row = graded["rows"]["student"]
+    assert marks(row) == [grade.FAIL] * 4 and row["total"] == "0"
+    assert "is missing" in graded["text"]["student"]
+
+
+@needs_sandbox
+def test_patching_the_checks_in_the_kernel_changes_nothing(graded):
+    assert marks(graded["rows"]["patched"]) == [grade.FAIL] * 4
+    assert graded["rows"]["patched"]["total"] == "0"
+
+
+@needs_sandbox
+def test_another_groups_parameters_do_not_pass_this_groups_key(graded):
+    assert graded["g1"]["poles"] != graded["g2"]["poles"]
+    row = graded["rows"]["params"]
+    assert row["group"] == "g02" and row["pa9.design"] == grade.FAIL
+    assert graded["results"]["params"].params == graded["g2"]
+
+
+@needs_sandbox
+def test_nothing_outside_the_copy_is_reachable(graded):
+    text = graded["text"]["probe"]
+    line = next(x for x in text.splitlines() if x.startswith("  - code cell") and "PROBE" in x)
+    reached = json.loads(line.split("PROBE ", 1)[1])
+    assert reached.pop("proc") == [] and reached.pop("pids") < 100  # a process table of its own
+    assert reached == {}, f"the submission reached {reached}"
+    assert graded["after"] == graded["before"]  # the key, solutions and submissions untouched
+    assert graded["sleeper_alive"]  # the pid it wrote into kernel.pid was not killed
+    assert graded["rows"]["probe"]["pa9.design"] == grade.PASS  # it ran, in its sandbox
+
+
+@needs_sandbox
+def test_a_sandbox_that_kills_itself_loses_no_other_row(graded):
+    row = graded["rows"]["suicide"]
+    assert row["status"] == "error" and row["pa9.design"] == grade.PASS
+    assert "could not be run to its end" in graded["text"]["suicide"]
+    assert len(graded["rows"]) == len(graded["subs"])
+
+
+@needs_sandbox
+def test_a_cell_that_never_ends_is_stopped_and_graded_on_what_ran(graded):
+    row = graded["rows"]["stubborn"]
+    assert row["status"] == "timeout"
+    assert marks(row) == [grade.PASS, grade.FAIL, grade.FAIL, grade.FAIL]
+    text = graded["text"]["stubborn"]
+    assert "time limit" in text and "fig is missing" in text
+
+
+@needs_sandbox
+def test_memory_processes_and_files_are_limited_for_good(graded):
+    row = graded["rows"]["limits"]
+    assert row["status"] == "error" and row["pa9.design"] == grade.PASS
+    text = graded["text"]["limits"]
+    line = next(x for x in text.splitlines() if x.startswith("  - code cell") and "LIMITS" in x)
+    limits = json.loads(line.split("LIMITS ", 1)[1])
+    default = grade.Limits()
+    mib = 1024 * 1024
+    assert limits == [
+        [default.memory_mb * mib] * 2,
+        [default.processes] * 2,
+        [default.file_mb * mib] * 2,
+    ]  # and the notebook could not raise them again
+
+
+@needs_sandbox
+def test_a_cell_that_raises_is_named_with_a_hint_not_a_traceback(graded):
+    text = graded["text"]["raises"]
+    assert graded["rows"]["raises"]["pa9.design"] == grade.FAIL
+    assert "H is missing: code cell 3 raised LinAlgError" in text
+    assert "Hint: np.linalg.inv needs a square" in text
+    assert "Traceback" not in text and 'File "' not in text
+
+
+@needs_sandbox
+def test_every_submission_has_its_row_and_no_temporary_folder_is_left(graded):
+    assert [r["file"] for r in graded["rows"].values()] == [str(p) for p in graded["subs"].values()]
+    assert graded["rows"]["garbage"]["status"] == "unreadable"
+    assert sorted(p.name for p in graded["out"].parent.iterdir()) == [
+        "grades.csv",
+        "grades_feedback",
+    ]
+    names = {p.name for p in graded["feedback"].iterdir()}
+    assert len(names) == len(graded["subs"]) + 1 and "manifest.json" in names
+
+
+@needs_sandbox
+def test_a_grader_killed_mid_run_resumes_without_losing_a_row(tmp_path, monkeypatch):
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    subs = [str(small(tmp_path / f"pa9_g{i:02d}.ipynb", f"g{i:02d}", "x = 1")) for i in range(1, 5)]
+    out = tmp_path / "grades.csv"
+    env = dict(os.environ, TMPDIR=str(temp))
+    grader = subprocess.Popen(
+        [sys.executable, "-m", "uio_teach", "grade", *subs, "--out", str(out)],
+        env=env,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
     )
-    assert note in text
-
-
-def test_only_check_cells_count(graded):
-    assert graded["rows"]["outside"]["demo.value"] == grade.PASS
-    assert len(graded["results"]["outside"].results["demo.value"]) == 1
-
-
-def test_a_notebook_over_the_time_limit_is_killed_and_graded(tmp_path):
-    other = SETUP.replace("check_value", "check_other").replace("demo.value", "demo.other")
-    cells = [(SETUP + other, []), ("x = 2", []), ("check_value(x)", ["check"])]
-    last = ("check_other(x)", ["check"])
-    stubborn = notebook(
-        tmp_path / "demo_g01.ipynb",
-        *cells,
-        (
-            "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nwhile True:\n"
-            "    time.sleep(0.01)",
-            [],
-        ),
-        last,
-    )
-    complete = notebook(tmp_path / "demo_g02.ipynb", *cells, last)
-    start = time.perf_counter()
-    sub, ok = grade.grade([stubborn, complete], tmp_path / "grades.csv", timeout=25, cell_timeout=3)
-    elapsed = time.perf_counter() - start
-    assert sub.status == "timeout" and elapsed < 90
-    # graded on the check cells that ran; the one after the loop is a ✗ (known from the other)
-    assert sub.verdicts() == {"demo.value": True, "demo.other": False}
-    assert ok.status == "ok" and ok.verdicts() == {"demo.value": True, "demo.other": True}
-    assert "time limit" in sub.feedback()
+    try:  # wait for the first row (an event, not a duration), then kill the whole grader
+        while grader.poll() is None and not (out.is_file() and len(rows(out)) >= 1):
+            try:
+                grader.wait(timeout=0.2)
+            except subprocess.TimeoutExpired:
+                pass
+    finally:
+        os.killpg(grader.pid, signal.SIGKILL)
+        grader.wait()
+    kept = rows(out)
+    assert 1 <= len(kept) < 4, grader.stderr.read().decode()
+    assert any(p.name.startswith(grade.TEMP_PREFIX) for p in temp.iterdir())  # left by the kill
+    monkeypatch.setattr("tempfile.tempdir", str(temp))
+    again = grade.grade(subs, out, resume=True)
+    done_before = {k["file"] for k in kept}
+    assert [s.file for s in again] == [f for f in subs if f not in done_before]
+    final = rows(out)
+    assert [r["file"] for r in final] == subs
+    assert all(r["pa9.design"] == grade.PASS for r in final)
+    assert {r["file"]: r for r in final if r["file"] in {k["file"] for k in kept}} == {
+        k["file"]: k for k in kept
+    }
+    assert list(temp.iterdir()) == []  # the killed run's folder removed, this run's too
 
 
 def test_grade_usage_errors(tmp_path, capsys):
     assert cli.main(["grade", str(tmp_path / "nope.ipynb"), "--out", "g.csv"]) == 2
     assert "no such submission" in capsys.readouterr().err
-    nb = notebook(tmp_path / "a.ipynb", ("x = 1", []))
+    nb = small(tmp_path / "a.ipynb", "g01", design=False)
     code = cli.main(["grade", str(nb), "--out", "g.csv", "--groups-from", "missing.csv"])
     assert code == 2 and "missing.csv: no such file" in capsys.readouterr().err
     assert cli.main(["grade", str(nb), "--out", "g.csv", "--timeout", "0"]) == 2
+    assert cli.main(["grade", str(nb), "--out", "g.csv", "--jobs", "0"]) == 2
     assert not Path("g.csv").exists()
     assert cli.main(["grade", "--help"]) == 0
-    assert "RUNS THE STUDENTS' CODE" in capsys.readouterr().out
+    help_text = capsys.readouterr().out
+    assert "RUNS THE STUDENTS' CODE" in help_text and "--no-sandbox" in help_text
 
 
-# the gradebook and its feedback folder are replaced together --------------------------------------
-
-
-def snapshot(folder: Path) -> dict[str, str]:
-    """Every file under ``folder`` (hidden ones too) -> its SHA-256."""
-    return {p.relative_to(folder).as_posix(): sha(p) for p in folder.rglob("*") if p.is_file()}
-
-
-def handed_in(folder: Path, *names: str) -> list[str]:
-    """Files that are not notebooks: graded "unreadable" at once, without a kernel."""
-    folder.mkdir(parents=True, exist_ok=True)
-    paths = [folder / f"{name}.ipynb" for name in names]
-    for path in paths:
-        path.write_text(f"{path.stem}: not a notebook")
-    return [str(path) for path in paths]
-
-
-def test_a_second_grading_leaves_only_its_own_feedback(tmp_path, capsys):
-    out = tmp_path / "marks" / "grades.csv"
-    first = handed_in(tmp_path / "first", "demo_g01", "demo_g02")
-    second = handed_in(tmp_path / "second", "demo_g03")
-    assert cli.main(["grade", *first, "--out", str(out), "-q"]) == 0
-    feedback = out.parent / "grades_feedback"
-    assert sorted(p.name for p in feedback.glob("*.txt")) == ["demo_g01.txt", "demo_g02.txt"]
-    assert cli.main(["grade", *second, "--out", str(out), "-q"]) == 0, capsys.readouterr().err
-    assert [r["group"] for r in rows(out)] == ["g03"]
-    assert sorted(p.name for p in feedback.iterdir()) == ["demo_g03.txt", "manifest.json"]
-    assert f"Submission: {second[0]}" in (feedback / "demo_g03.txt").read_text(encoding="utf-8")
-    manifest = output.read_manifest(feedback)
-    assert manifest is not None and manifest["command"] == "uio-teach grade"
-    assert manifest["config"] == {"gradebook": "grades.csv", "gradebook_sha256": sha(out)}
-    assert [f["name"] for f in manifest["files"]] == ["demo_g03.txt"]
-    assert sorted(p.name for p in out.parent.iterdir()) == ["grades.csv", "grades_feedback"]
-
-
-@pytest.mark.parametrize("where", ["writing a feedback text", "swapping the folder in"])
-def test_a_failed_grading_leaves_the_previous_gradebook_and_feedback(tmp_path, monkeypatch, where):
-    out = tmp_path / "marks" / "grades.csv"
-    grade.grade(handed_in(tmp_path / "first", "demo_g01", "demo_g02"), out)
-    before = snapshot(out.parent)
-    assert "grades_feedback/demo_g02.txt" in before
-
-    def fail(*args, **kwargs):
-        raise OSError(28, "No space left on device")
-
-    if where == "writing a feedback text":
-        monkeypatch.setattr(grade.Submission, "feedback", fail)
-    else:  # the CSV is already in place when the folder cannot be: it is put back
-        monkeypatch.setattr(output.StagedFolder, "commit", fail)
-    with pytest.raises(OSError, match="No space left"):
-        grade.grade(handed_in(tmp_path / "second", "demo_g03"), out)
-    assert snapshot(out.parent) == before
-
-
-def test_a_failed_first_grading_writes_nothing(tmp_path, monkeypatch):
+def test_without_a_sandbox_grading_is_refused_unless_asked(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(grade, "sandbox_problem", lambda: "bubblewrap (bwrap) is not installed")
+    nb = small(tmp_path / "pa9_g01.ipynb", "g01", design=False)
     out = tmp_path / "grades.csv"
-    monkeypatch.setattr(output.StagedFolder, "commit", lambda self: 1 / 0)
-    with pytest.raises(ZeroDivisionError):
-        grade.grade(handed_in(tmp_path / "in", "demo_g01"), out)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
-
-
-@pytest.mark.parametrize("content", ["someone's notes", "figures"])
-def test_a_folder_that_is_not_earlier_feedback_is_left_alone(
-    tmp_path, monkeypatch, capsys, content
-):
-    out = tmp_path / "grades.csv"
-    folder = tmp_path / "grades_feedback"
-    folder.mkdir()
-    if content == "figures":  # an output of uio-teach, but not of grading
-        (folder / "a.png").write_bytes(b"png")
-        output.write_manifest(folder, command="uio-teach figures", config={})
-    else:
-        (folder / "notes.txt").write_text("mine")
-    before = snapshot(folder)
-
-    def must_not_run(*args, **kwargs):
-        raise AssertionError("a notebook ran although the gradebook cannot be written")
-
-    monkeypatch.setattr(grade, "_grade_one", must_not_run)
-    code = cli.main(["grade", *handed_in(tmp_path / "in", "demo_g01"), "--out", str(out), "-q"])
+    assert cli.main(["grade", str(nb), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert code == 1 and "left alone" in err and str(folder) in err
-    assert len(err.strip().splitlines()) == 1
-    assert not out.exists() and snapshot(folder) == before
-    with pytest.raises(output.OutputError, match="left alone"):
-        grade.write_gradebook([grade.Submission("a.ipynb", "demo", "g01", "ok")], out)
-    assert not out.exists() and snapshot(folder) == before
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["grades_feedback", "in"]
+    assert "cannot isolate the submissions" in err and "--no-sandbox" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+    with pytest.raises(grade.SandboxRefused):
+        grade.grade([nb], out)
 
 
-def test_a_gradebook_that_is_a_folder_is_refused(tmp_path):
-    (tmp_path / "grades.csv").mkdir()
-    with pytest.raises(output.OutputError, match="is a folder"):
-        grade.grade(handed_in(tmp_path / "in", "demo_g01"), tmp_path / "grades.csv")
+def test_no_sandbox_grades_the_same_and_says_so_loudly(tmp_path, capsys):
+    nb = small(tmp_path / "pa9_g01.ipynb", "g01")
+    out = tmp_path / "grades.csv"
+    assert cli.main(["grade", str(nb), "--out", str(out), "--no-sandbox", "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "WARNING: --no-sandbox" in err and "your permissions" in err
+    (row,) = rows(out)
+    assert row["status"] == "ok" and row["pa9.design"] == grade.PASS and row["total"] == "1"

@@ -26,6 +26,7 @@ import os
 import sys
 import textwrap
 import time
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn, TextIO
@@ -181,21 +182,24 @@ exit status:
 
 _GRADE_DESCRIPTION = """\
 Grade the lab notebooks the groups handed in. Each one is run on a copy (the
-submission is only read), in a fresh kernel, with its stored outputs cleared,
-so only what its code does now counts. With --groups-from, the cell tagged
-`parameters` is replaced by the group's parameters from the answer key (the
-group comes from the notebook's metadata, else from a name like pa9_g03.ipynb).
-The cells tagged `check` are re-run and their verdicts recorded; a cell that
-raises or runs too long is noted and the rest still runs, and a notebook over
-the time limit is killed and graded as it stands.
+submission is only read), in a fresh kernel inside a sandbox (bubblewrap: only
+its own copy visible, no network, no other process, limits on memory,
+processes and time), with its stored outputs cleared. Its answer variables are
+then taken out as data and checked in the grader's own process, with the
+group's parameters from --groups-from (the group comes from the notebook's
+metadata, else from a name like pa9_g03.ipynb): the verdicts the notebook
+prints count for nothing. A cell that raises or runs too long is noted and the
+rest still runs; a notebook over the time limit is stopped and graded as it
+stands.
 
 Writes FILE (one row per submission: file, lab, group, status, one column per
 check with ✓ or ✗, total and out_of) and FILE's stem + _feedback/, one text
-per submission with every check message and error.
+per submission with every check message and error. Each row is written as
+soon as its submission is graded; --resume grades only the missing ones.
 
-GRADING RUNS THE STUDENTS' CODE with your permissions: it can read and delete
-what you can. Run it in a container or as a user that owns nothing else (see
-the instructors' page of the book).
+GRADING RUNS THE STUDENTS' CODE. Without bubblewrap (apt-get install
+bubblewrap) grading is refused; --no-sandbox runs the code with your
+permissions (it can read the answer key and delete what you can).
 """
 
 _GRADE_EPILOG = """\
@@ -203,10 +207,12 @@ examples:
   uio-teach grade handed_in/*.ipynb --out grades.csv
   uio-teach grade handed_in/*.ipynb --out grades.csv --groups-from labs/answer_key.csv
   uio-teach grade handed_in/*.ipynb --out grades.csv --timeout 600 --cell-timeout 120
+  uio-teach grade handed_in/*.ipynb --out grades.csv --jobs 2 --resume
 
 exit status:
   0 every submission graded (whatever its grade), 1 the gradebook could not be
-  written, 2 a usage error (no such submission, unreadable answer key).
+  written, 2 a usage error (no such submission, unreadable answer key, no
+  sandbox available).
 """
 
 
@@ -444,6 +450,23 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="seconds a cell may run before it is interrupted (default: 60)",
     )
+    grade.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep the rows already in the gradebook; grade only the submissions without one",
+    )
+    grade.add_argument(
+        "--jobs",
+        type=_positive_int,
+        default=1,
+        metavar="N",
+        help="grade N submissions at a time (default: 1)",
+    )
+    grade.add_argument(
+        "--no-sandbox",
+        action="store_true",
+        help="run the notebooks WITHOUT isolation, with your permissions (trusted notebooks only)",
+    )
     grade.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     return parser
 
@@ -605,15 +628,26 @@ def _grade(args: argparse.Namespace) -> int:
                 f"({sub.seconds:.1f} s)"
             )
 
-    try:
-        results = grade.grade(
-            args.submissions,
-            args.out,
-            answer_key=args.groups_from,
-            timeout=args.timeout,
-            cell_timeout=args.cell_timeout,
-            progress=progress,
+    if args.no_sandbox:
+        _error(
+            "grade",
+            "WARNING: --no-sandbox: the notebooks run with your permissions; a notebook can "
+            "read the answer key and your files, change the gradebook and end your processes",
         )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", grade.UnsandboxedWarning)
+            results = grade.grade(
+                args.submissions,
+                args.out,
+                answer_key=args.groups_from,
+                timeout=args.timeout,
+                cell_timeout=args.cell_timeout,
+                progress=progress,
+                resume=args.resume,
+                jobs=args.jobs,
+                sandbox=not args.no_sandbox,
+            )
     except ImportError as err:
         _error(
             "grade",

@@ -1,38 +1,30 @@
-"""Grade submitted lab notebooks: run each on a copy, re-run its checks, write a gradebook CSV.
+"""Grade submitted lab notebooks: each run sandboxed, its answers checked in the grader's process.
 
 :func:`grade` takes the notebooks the groups handed in and, for each one:
 
 1. reads it (the submission itself is never written to) and finds its lab and
    group: from the notebook's metadata ``{"uio_teach": {"lab": ..., "group":
    ...}}``, else from a file name such as ``pa9_g03.ipynb``;
-2. makes a copy in a temporary folder with every stored output cleared (a
-   stored ✓ counts for nothing), and, when an answer key is given, the cell
-   tagged ``parameters`` replaced by ``PARAMS = <that group's parameters>``
-   (added at the top if the group deleted it);
-3. runs the copy in a fresh kernel, in a separate process, with a time limit
-   per cell and for the whole notebook (the process is killed when it is
-   over); a cell that raises or loops is recorded and the next cells still
-   run;
-4. reads the verdict of every cell tagged ``check`` (not those of the
-   instructor notes, tagged ``instructor`` too): a small cell added after
-   each one records (and prints) the results of
-   :func:`uio_teach.checks.collected`, and a last added cell prints them all
-   as JSON between two marker lines. Results made outside the check cells (an
-   exercise that shows a failing check on purpose) do not count. A run killed
-   at the time limit is graded on the check cells that ran.
+2. makes a copy with every stored output cleared (a stored ✓ counts for
+   nothing), the ``parameters`` cell set to the group's parameters from the
+   answer key, and small cells added that write the answer variables out as
+   data (:mod:`uio_teach.instructor.runner`);
+3. runs the copy in a fresh kernel inside a sandbox
+   (:mod:`uio_teach.instructor.sandbox`: only its own copy visible, no
+   network, no other process, limits on memory, processes and time); a cell
+   that raises or loops is recorded and the next cells still run;
+4. rebuilds the answers as genuine objects in the grader's own process
+   (:mod:`uio_teach.checks.answers`) and runs the lab's checks on them with
+   **the answer key's parameters** (:mod:`uio_teach.checks.grading`). The
+   verdicts the check cells printed inside the notebook count for nothing, and
+   nothing the notebook defines (``PARAMS``, a patched class, a patched
+   module) reaches the checks: only right values pass;
+5. appends its row to the gradebook and writes its feedback text at once
+   (:mod:`uio_teach.instructor.gradebook`), so a killed run keeps every
+   finished row and ``resume=True`` grades only what is missing.
 
-The checks a lab must produce come from the lab registry
-(``uio_teach.instructor.labs.LABS``, the ``check_ids`` of each lab) when it
-exists; otherwise from what the check cells of all the submissions of that lab
-produced, so a check cell one group deleted is still a ✗ ("not run") for it.
-
-One row per submission goes to the CSV (file, lab, group, status, one column
-per check id with ✓ or ✗, the number passed and out of how many), and one
-feedback text per submission (every check message, every error) to a folder
-beside it.
-
-Grading runs the students' code with your permissions: run it in a container
-or as a user that can read nothing else (see the instructors' page).
+``jobs`` submissions run at a time. The temporary folders of a run are
+removed when it ends; those of runs that were killed are removed by the next.
 
 Examples
 --------
@@ -43,138 +35,75 @@ Examples
 
 from __future__ import annotations
 
+import ast
 import csv
 import json
 import os
 import re
 import shutil
-import signal
-import subprocess
-import sys
+import stat
 import tempfile
+import threading
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Any
 
+import nbformat
+
+from ..checks.answers import AnswerError, from_data
+from ..checks.grading import GRADED, Missing, grade_answers, lab_plant
+from .gradebook import (
+    FAIL,
+    PASS,
+    Gradebook,
+    GradebookBusy,
+    Submission,
+    check_gradebook_target,
+    feedback_folder,
+)
+from .labs import LABS
+from .runner import RunOutcome, prepare, run_notebook
+from .sandbox import Limits, sandbox_problem
+
 __all__ = [
     "GradeError",
+    "SandboxRefused",
+    "UnsandboxedWarning",
     "Submission",
+    "Gradebook",
+    "GradebookBusy",
+    "Limits",
     "grade",
     "read_answer_key",
-    "group_from_name",
     "write_gradebook",
-    "BEGIN",
-    "END",
+    "group_from_name",
+    "clean_leftovers",
+    "feedback_folder",
+    "PASS",
+    "FAIL",
+    "TEMP_PREFIX",
 ]
 
-BEGIN = "<<<uio-teach grade: results>>>"
-"""The line before the JSON of the check results in the executed copy."""
-CELL = "<<<uio-teach grade: check cell>>>"
-"""The line before the JSON of one check cell's results (read when a run is cut short)."""
-END = "<<<uio-teach grade: end>>>"
-"""The line after it."""
-
-PASS, FAIL = "✓", "✗"
+TEMP_PREFIX = "uio-teach-grade-"
+"""The name of every temporary folder of a grading run starts so."""
+_OWNER = "owner.json"
 _GROUP_NAME = re.compile(r"^(?P<lab>.+?)_(?P<group>g\d+)$")
-_TAG = "uio-teach-grade"
-_COMMAND = "uio-teach grade"
+_CHECKING = threading.Lock()  # the checks run one at a time in the grader's process
 
 
 class GradeError(ValueError):
-    """Grading cannot start (a missing answer key, an unreadable key); one line."""
+    """Grading cannot start (a missing answer key, an unreadable key, a bad option); one line."""
 
 
-@dataclass
-class Submission:
-    """The grade of one submitted notebook.
+class SandboxRefused(GradeError):
+    """Submissions cannot be isolated here, and running them unisolated was not asked for."""
 
-    Attributes
-    ----------
-    file : str
-        The submission, as given.
-    lab : str
-        The lab id ("" when unknown).
-    group : str
-        The group id ("" when unknown).
-    status : str
-        ``"ok"``, ``"error"`` (some cells raised), ``"timeout"`` (killed at the
-        time limit) or ``"unreadable"`` (not a notebook).
-    results : dict
-        Check id -> the JSON of the check's result(s) (``to_dict``), in order.
-    errors : list of str
-        One line per cell that raised, and any note on the run.
-    params : dict or None
-        The parameters the copy ran with, when an answer key set them.
-    expected : tuple of str
-        The check ids this lab must produce.
-    seconds : float
-        Time spent running it.
-    feedback_file : pathlib.Path or None
-        The feedback text, once :func:`write_gradebook` wrote it (named after
-        the submission; after its folder too when two submissions share a name).
 
-    Examples
-    --------
-    >>> from uio_teach.instructor.grade import Submission
-    >>> s = Submission("a.ipynb", "pa9", "g01", "ok",
-    ...                results={"pa9.design": [{"passed": True}]},
-    ...                expected=("pa9.design", "pa9.plot"))
-    >>> s.verdicts(), s.total
-    ({'pa9.design': True, 'pa9.plot': False}, 1)
-    """
-
-    file: str
-    lab: str
-    group: str
-    status: str
-    results: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
-    errors: list[str] = field(default_factory=list)
-    params: dict[str, Any] | None = None
-    expected: tuple[str, ...] = ()
-    seconds: float = 0.0
-    feedback_file: Path | None = None
-
-    def verdicts(self) -> dict[str, bool]:
-        """Check id -> passed: ran at least once, and passed every time it ran."""
-        ids = list(self.expected) + [i for i in self.results if i not in self.expected]
-        return {
-            i: bool(self.results.get(i)) and all(r.get("passed") for r in self.results[i])
-            for i in ids
-        }
-
-    @property
-    def total(self) -> int:
-        """The number of checks passed."""
-        return sum(self.verdicts().values())
-
-    def feedback(self) -> str:
-        """The feedback text for the group: every check's messages, then the errors."""
-        lines = [
-            f"Submission: {self.file}",
-            f"Lab: {self.lab or 'unknown'}    Group: {self.group or 'unknown'}",
-        ]
-        if self.params is not None:
-            lines.append(f"Parameters of this group: {json.dumps(self.params)}")
-        verdicts = self.verdicts()
-        lines += [f"Checks passed: {self.total} of {len(verdicts)}", ""]
-        for check_id, ok in verdicts.items():
-            runs = self.results.get(check_id, [])
-            title = runs[0].get("title", "") if runs else ""
-            lines.append(f"{PASS if ok else FAIL} {check_id}{': ' + title if title else ''}")
-            if not runs:
-                lines.append(
-                    "    not run: the check cell is missing, or it raised before the check"
-                )
-            for run in runs:
-                for item in run.get("items", []):
-                    mark = {True: PASS, False: FAIL}.get(item.get("ok"), "•")
-                    lines.append(f"    {mark} {item.get('message', '')}")
-        if self.errors:
-            lines += ["", "Problems while running the notebook:"]
-            lines += [f"  - {e}" for e in self.errors]
-        return "\n".join(lines) + "\n"
+class UnsandboxedWarning(UserWarning):
+    """The submissions run with the grader's permissions (``sandbox=False``)."""
 
 
 def group_from_name(path: str | os.PathLike[str]) -> tuple[str, str]:
@@ -245,362 +174,263 @@ def read_answer_key(path: str | os.PathLike[str]) -> dict[tuple[str, str], dict[
             params = json.loads(row["params"])
         except ValueError:
             raise GradeError(f"{name}: line {number}: params is not JSON") from None
+        if not isinstance(params, dict):
+            raise GradeError(f"{name}: line {number}: params is not a JSON object")
         key[(row["lab"], row["group"])] = params
     return key
 
 
-def _registry() -> Mapping[str, Any]:
-    """The lab registry, or an empty mapping when this version has none."""
+# temporary folders --------------------------------------------------------------------------
+
+
+def _start_time(pid: int) -> str | None:
     try:
-        from . import labs
-    except ImportError:  # pragma: no cover - jupytext missing
-        return {}
-    return getattr(labs, "LABS", None) or {}
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError):
+        return None
 
 
-def _record_field(record: Any, *names: str) -> Any:
-    for name in names:
-        if isinstance(record, Mapping) and name in record:
-            return record[name]
-        if hasattr(record, name):
-            return getattr(record, name)
-    return None
+def _remove(folder: Path) -> None:
+    def unlock(func: Callable[..., Any], path: str, _: Any) -> None:
+        try:  # a submission may leave a folder without write permission
+            os.chmod(os.path.dirname(path), stat.S_IRWXU)
+            os.chmod(path, stat.S_IRWXU)
+            func(path)
+        except OSError:
+            pass
+
+    shutil.rmtree(folder, onerror=unlock)
 
 
-def _lab_of(nb: Any, path: Path, registry: Mapping[str, Any]) -> tuple[str, str]:
+def clean_leftovers(root: str | os.PathLike[str] | None = None) -> list[Path]:
+    """Remove the temporary folders of grading runs that were killed (ours only).
+
+    A run's folder holds ``owner.json`` (the grading process and its start
+    time); it is removed when that process no longer runs. Folders of other
+    users, or without that file, are left alone.
+
+    Parameters
+    ----------
+    root : path, optional
+        Where the runs' folders are (the system's temporary folder by default).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The folders removed.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from uio_teach.instructor.grade import clean_leftovers
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     clean_leftovers(tmp)
+    []
+    """
+    root = Path(root or tempfile.gettempdir())
+    removed = []
+    for folder in sorted(root.glob(f"{TEMP_PREFIX}*")):
+        try:
+            info = folder.lstat()
+            if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
+                continue
+            owner = json.loads((folder / _OWNER).read_text(encoding="utf-8"))
+            pid, started = int(owner["pid"]), str(owner["start"])
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        if _start_time(pid) != started:
+            _remove(folder)
+            removed.append(folder)
+    return removed
+
+
+# one submission ----------------------------------------------------------------------------
+
+
+def _lab_of(nb: Any, path: Path) -> tuple[str, str]:
     meta = nb.get("metadata", {}).get("uio_teach", {}) if isinstance(nb, Mapping) else {}
-    lab = str(meta.get("lab", "") or "") if isinstance(meta, Mapping) else ""
-    group = str(meta.get("group", "") or "") if isinstance(meta, Mapping) else ""
+    meta = meta if isinstance(meta, Mapping) else {}
+    lab = str(meta.get("lab", "") or "")
+    group = str(meta.get("group", "") or "")
     name_lab, name_group = group_from_name(path)
     lab, group = lab or name_lab, group or name_group
     if not lab:
-        source = meta.get("source") if isinstance(meta, Mapping) else None
+        source = meta.get("source")
         stem = Path(str(source)).stem if source else path.stem
-        for lab_id, record in registry.items():
-            chapter = _record_field(record, "chapter", "source", "source_name")
-            if chapter is not None and Path(str(chapter)).stem == stem:
-                lab = lab_id
-                break
-        else:
-            lab = stem.removeprefix("lab_")
+        lab = next((k for k, v in LABS.items() if Path(v.source).stem == stem), "")
+        lab = lab or stem.removeprefix("lab_")
     return lab, group
 
 
-def _is_code(cell: Any) -> bool:
-    return cell.get("cell_type") == "code"
+def _read(path: Path) -> tuple[Any, str, str, str]:
+    """The notebook (or None), its lab, its group, and why it is unreadable."""
+    try:
+        nb = nbformat.reads(path.read_bytes().decode("utf-8"), as_version=4)
+        if not isinstance(nb.get("cells"), list):
+            raise ValueError("no cells")
+    except Exception as exc:
+        reason = " ".join(str(exc).split())[:200] or type(exc).__name__
+        return None, *group_from_name(path), f"not a notebook: {reason}"
+    return nb, *_lab_of(nb, path), ""
 
 
-def _tags(cell: Any) -> list[str]:
-    return list(cell.get("metadata", {}).get("tags", []) or [])
+def _defaults(lab: str) -> dict[str, Any]:
+    return LABS[lab].params().to_params()
 
 
-def _prepare(nb: Any, params: dict[str, Any] | None) -> tuple[Any, int]:
-    """The copy to run: outputs cleared, parameters set, recording cells added."""
-    import nbformat
-
-    setup = nbformat.v4.new_code_cell(
-        "import json as _uio_json\n"
-        "from uio_teach import checks as _uio_checks\n"
-        "_uio_grade = []\n"
-        "_uio_checks.clear_collected()"
+def _assigns(source: str, name: str) -> bool:
+    """Whether the code ``source`` assigns ``name`` (at any depth; ``=``, ``for``, ``with``...)."""
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return re.search(rf"^\s*{re.escape(name)}\s*=(?!=)", source, re.M) is not None
+    return any(
+        isinstance(node, ast.Name) and node.id == name and isinstance(node.ctx, ast.Store)
+        for node in ast.walk(tree)
     )
-    cells = [setup]
-    has_params = False
-    checks = 0
-    for cell in nb.cells:
-        if _is_code(cell):
-            cell.outputs = []
-            cell.execution_count = None
-        if _is_code(cell) and "parameters" in _tags(cell) and params is not None:
-            cell.source = f"PARAMS = {json.dumps(params)}"
-            has_params = True
-        if _is_code(cell) and "check" in _tags(cell) and "instructor" not in _tags(cell):
-            checks += 1
-            cells.append(nbformat.v4.new_code_cell("_uio_checks.clear_collected()"))
-            cells.append(cell)
-            cells.append(
-                nbformat.v4.new_code_cell(
-                    f"_uio_entry = {{'cell': {checks}, 'results': "
-                    "[r.to_dict() for r in _uio_checks.collected()]}\n"
-                    "_uio_grade.append(_uio_entry)\n"
-                    "_uio_checks.clear_collected()\n"
-                    f"print({CELL!r})\nprint(_uio_json.dumps(_uio_entry))\nprint({END!r})"
-                )
+
+
+def _missing(name: str, position: int | None, outcome: RunOutcome) -> Missing:
+    """Why ``name`` is absent at ``position``: the cell that raised before it, if any."""
+    before = [e for e in outcome.errors if position is None or e.position < position]
+    if not before:
+        return Missing(name)
+    culprit = next((e for e in reversed(before) if _assigns(e.source, name)), None)
+    if culprit is None:  # a check cell's error follows from an earlier one
+        culprit = ([e for e in before if not e.is_check] or before)[-1]
+    return Missing(name, culprit.cell, culprit.ename, culprit.evalue)
+
+
+def _answers(
+    lab: str, outcome: RunOutcome, plant: Any
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """The answers at the end, and those captured after each check cell, rebuilt."""
+    cache: dict[tuple[str, str], Any] = {}
+
+    def rebuild(tag: str, name: str) -> Any:
+        if (tag, name) not in cache:
+            raw = outcome.captures[tag]
+            if name not in raw:
+                cache[(tag, name)] = _missing(name, outcome.positions.get(tag), outcome)
+            else:
+                try:
+                    cache[(tag, name)] = from_data(raw[name], plant=plant)
+                except (AnswerError, ValueError, TypeError) as err:
+                    why = err if isinstance(err, AnswerError) else type(err).__name__
+                    cache[(tag, name)] = Missing(
+                        name, reason=f"its value could not be read ({why})"
+                    )
+        return cache[(tag, name)]
+
+    every = sorted({n for check in GRADED[lab] for n in check.names})
+    if "final" in outcome.captures:
+        final = {n: rebuild("final", n) for n in every}
+    else:
+        final = {n: _missing(n, None, outcome) for n in every}
+    per_check = []
+    for index, check in enumerate(GRADED[lab]):
+        tag = str(index)
+        if tag in outcome.captures:
+            per_check.append({n: rebuild(tag, n) for n in check.names})
+        else:  # its check cell was deleted or never reached: what the notebook ended with
+            per_check.append({n: final[n] for n in check.names})
+    return final, per_check
+
+
+def _error_notes(outcome: RunOutcome) -> list[str]:
+    notes = []
+    for e in outcome.errors:
+        if e.ename in ("KeyboardInterrupt", "TimeoutError"):
+            notes.append(
+                f"code cell {e.cell} was interrupted: it ran longer than the time limit of a cell"
             )
         else:
-            cells.append(cell)
-    if params is not None and not has_params:
-        cells.insert(1, nbformat.v4.new_code_cell(f"PARAMS = {json.dumps(params)}"))
-    cells.append(
-        nbformat.v4.new_code_cell(
-            f"print({BEGIN!r})\nprint(_uio_json.dumps(_uio_grade))\nprint({END!r})"
-        )
-    )
-    theirs = {id(cell) for cell in nb.cells}
-    for cell in cells:
-        if id(cell) not in theirs:
-            cell.metadata["tags"] = [_TAG]
-    nb.cells = cells
-    return nb, checks
-
-
-def _parse(
-    executed: Any,
-) -> tuple[list[dict[str, Any]] | None, list[dict[str, Any]], list[str]]:
-    """The results of the last cell (None if it did not run), of each check cell, the errors."""
-    errors: list[str] = []
-    partial: list[dict[str, Any]] = []
-    found = None
-    user_cell = 0
-    for cell in executed.cells:
-        if not _is_code(cell):
-            continue
-        ours = _TAG in _tags(cell)
-        if not ours:
-            user_cell += 1
-        for out in cell.get("outputs", []):
-            if out.get("output_type") == "error":
-                where = "a grading cell" if ours else f"code cell {user_cell}"
-                evalue = " ".join(str(out.get("evalue", "")).split())
-                if len(evalue) > 200:
-                    evalue = evalue[:197] + "..."
-                if out.get("ename") in ("KeyboardInterrupt", "TimeoutError"):
-                    errors.append(
-                        f"{where} was interrupted: it ran longer than the time limit of a cell"
-                    )
-                else:
-                    errors.append(f"{where} raised {out.get('ename', 'an error')}: {evalue}")
-            text = out.get("text", "") if out.get("output_type") == "stream" else ""
-            for marker in (CELL, BEGIN):
-                if ours and marker in text:
-                    body = text.split(marker, 1)[1].split(END, 1)[0]
-                    try:
-                        data = json.loads(body)
-                    except ValueError:
-                        continue
-                    if marker == BEGIN:
-                        found = data
-                    else:
-                        partial.append(data)
-    return found, partial, errors
-
-
-def _run_copy(path: Path, cell_timeout: float, timeout: float) -> tuple[str, Any, str]:
-    """Run the notebook at ``path`` in a separate process; (status, executed nb, note)."""
-    import nbformat
-
-    out_path = path.with_name("executed.ipynb")
-    pid_path = path.with_name("kernel.pid")
-    cmd = [
-        sys.executable,
-        "-m",
-        "uio_teach.instructor.grade",
-        "--run",
-        os.fspath(path),
-        os.fspath(out_path),
-        str(cell_timeout),
-        os.fspath(pid_path),
-    ]
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
-    proc = subprocess.Popen(
-        cmd,
-        cwd=path.parent,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
-    status, note = "ok", ""
-    try:
-        _, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        status, note = "timeout", f"stopped after {timeout:g} s, the time limit of a notebook"
-        _kill(proc.pid)
-        _, err = proc.communicate()
-    finally:
-        _kill_kernel(pid_path)
-    if status == "ok" and proc.returncode != 0:
-        lines = [line for line in (err or "").splitlines() if line.strip()]
-        note = f"the notebook could not be run: {lines[-1] if lines else 'no message'}"
-        status = "error"
-    executed = None
-    if out_path.is_file():
-        try:
-            executed = nbformat.read(out_path, as_version=4)
-        except Exception:  # a half-written file after a kill
-            executed = None
-    return status, executed, note
-
-
-def _kill(pgid: int) -> None:
-    try:
-        os.killpg(pgid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
-
-
-def _kill_kernel(pid_path: Path) -> None:
-    try:
-        pid = int(pid_path.read_text())
-    except (OSError, ValueError):
-        return
-    _kill(pid)  # the kernel leads its own session: this also ends what it started
+            notes.append(f"code cell {e.cell} raised {e.ename or 'an error'}: {e.evalue}")
+    return notes + list(outcome.notes)
 
 
 def _grade_one(
     path: Path,
     key: Mapping[tuple[str, str], dict[str, Any]] | None,
-    registry: Mapping[str, Any],
-    cell_timeout: float,
+    *,
+    root: Path,
+    index: int,
+    sandbox: bool,
     timeout: float,
+    cell_timeout: float,
+    limits: Limits,
+    stop: threading.Event,
 ) -> Submission:
-    import nbformat
-
     start = time.perf_counter()
-    try:
-        nb = nbformat.reads(path.read_bytes().decode("utf-8"), as_version=4)
-    except Exception as exc:
-        reason = " ".join(str(exc).split())[:200] or type(exc).__name__
-        lab, group = group_from_name(path)
-        note = f"not a notebook: {reason}"
-        return Submission(os.fspath(path), lab, group, "unreadable", errors=[note])
-    lab, group = _lab_of(nb, path, registry)
+    nb, lab, group, unreadable = _read(path)
     sub = Submission(os.fspath(path), lab, group, "ok")
-    params = None
-    if key is not None:
-        params = key.get((lab, group))
-        if params is None:
+    if lab in GRADED:
+        sub.expected = tuple(c.check_id for c in GRADED[lab])
+    if nb is None:
+        sub.status, sub.errors = "unreadable", [unreadable]
+        return sub
+    if lab not in GRADED:
+        sub.status = "unknown lab"
+        sub.errors.append(
+            f"lab {lab!r} is not one of the course's labs ({', '.join(GRADED)}): not run"
+        )
+        return sub
+    params = None if key is None else key.get((lab, group))
+    if params is None:
+        params = _defaults(lab)
+        if key is not None:
             sub.errors.append(
-                f"no parameters for lab {lab!r}, group {group!r} in the answer key: graded with "
-                "the notebook's own parameters cell"
+                f"no parameters for lab {lab!r}, group {group!r} in the answer key: graded "
+                "with the course's own numbers"
             )
     sub.params = params
-    record = registry.get(lab)
-    expected = _record_field(record, "check_ids", "checks") if record is not None else None
-    sub.expected = tuple(expected or ())
-    copy, _ = _prepare(nb, params)
-    with tempfile.TemporaryDirectory(prefix="uio-teach-grade-") as tmp:
-        work = Path(tmp) / "submission.ipynb"
-        nbformat.write(copy, work)
-        status, executed, note = _run_copy(work, cell_timeout, timeout)
-    sub.status = status
-    if note:
-        sub.errors.append(note)
-    found, partial = None, []
-    if executed is not None:
-        found, partial, errors = _parse(executed)
-        sub.errors += errors
-        if errors and sub.status == "ok":
-            sub.status = "error"
-    if found is None:
-        found = partial  # cut short: what the check cells that ran recorded
-        if sub.status == "ok":
-            sub.status = "error"
-            sub.errors.append("the notebook did not run to its end")
-    for entry in found or []:
-        for result in entry.get("results", []):
-            check_id = result.get("check_id") or result.get("title") or "unnamed check"
-            sub.results.setdefault(check_id, []).append(result)
+    copy, positions = prepare(nb, lab, params if key is not None else None)
+    folder = root / f"{index:04d}"
+    try:
+        outcome = run_notebook(
+            copy,
+            folder,
+            positions=positions,
+            sandbox=sandbox,
+            timeout=timeout,
+            cell_timeout=cell_timeout,
+            limits=limits,
+            stop=stop,
+        )
+    finally:
+        _remove(folder)
+    sub.status = outcome.status
+    sub.errors += _error_notes(outcome)
+    with _CHECKING:
+        try:
+            plant = lab_plant(lab, params)
+            final, per_check = _answers(lab, outcome, plant)
+            results = grade_answers(lab, final, params, plant=plant, per_check=per_check)
+        except Exception as exc:  # the key itself is wrong: no verdict, one line
+            sub.errors.append(f"the grader could not check this lab ({type(exc).__name__})")
+            results = []
+    sub.results = {r.check_id: r.to_dict() for r in results if r.check_id}
     sub.seconds = time.perf_counter() - start
     return sub
 
 
-def _feedback_folder(out: str | os.PathLike[str]) -> Path:
-    """The feedback folder that goes with the gradebook ``out``: ``<out stem>_feedback``.
-
-    Parameters
-    ----------
-    out : str or path-like
-        The gradebook CSV.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Examples
-    --------
-    >>> from uio_teach.instructor.grade import _feedback_folder
-    >>> _feedback_folder("marks/grades.csv").as_posix()
-    'marks/grades_feedback'
-    """
-    out = Path(out)
-    return out.with_name(f"{out.stem}_feedback")
-
-
-def _check_gradebook_target(out: str | os.PathLike[str]) -> None:
-    """Raise :class:`~uio_teach.instructor.output.OutputError` unless ``out`` may be (re)written.
-
-    The gradebook must not be a folder, and its feedback folder must not exist,
-    be empty, or be the feedback folder of an earlier run (it has the
-    ``manifest.json`` that run wrote). A folder of that name holding anything
-    else is never replaced.
-
-    Parameters
-    ----------
-    out : str or path-like
-        The gradebook CSV.
-
-    Raises
-    ------
-    uio_teach.instructor.output.OutputError
-        One line naming the file or folder and why.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import _check_gradebook_target
-    >>> from uio_teach.instructor.output import OutputError
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     mine = pathlib.Path(tmp) / "grades_feedback"
-    ...     mine.mkdir()
-    ...     _ = (mine / "notes.txt").write_text("mine")
-    ...     try:
-    ...         _check_gradebook_target(pathlib.Path(tmp) / "grades.csv")
-    ...     except OutputError as err:
-    ...         print("left alone" in str(err))
-    True
-    """
-    from .output import MANIFEST, OutputError, check_output_folder, read_manifest
-
-    out = Path(out)
-    if out.is_dir():
-        raise OutputError(f"the gradebook {os.fspath(out)} is a folder, not a file")
-    folder = _feedback_folder(out)
-    check_output_folder(folder)
-    manifest = read_manifest(folder) if folder.is_dir() else None
-    if manifest is not None and manifest.get("command") != _COMMAND:
-        raise OutputError(
-            f"the feedback folder {os.fspath(folder)} holds the output of "
-            f"{manifest.get('command') or 'another command'} (its {MANIFEST}), not feedback "
-            "of an earlier grading; it is left alone: choose another gradebook name"
-        )
+# the run ----------------------------------------------------------------------------------
 
 
 def write_gradebook(
     submissions: Sequence[Submission], out: str | os.PathLike[str]
 ) -> tuple[Path, Path]:
-    """Write the gradebook CSV and one feedback text per submission (in ``<out stem>_feedback``).
+    """Write a whole gradebook at once: the CSV and one feedback text per submission.
 
-    Columns: ``file``, ``lab``, ``group``, ``status``, one per check id (✓ or
-    ✗; empty for a check of another lab), ``total`` (checks passed) and
-    ``out_of``.
-
-    The CSV and its feedback folder are replaced together: both are written
-    beside their targets first, and only once everything is written are they
-    moved in place, the folder whole, so no feedback text of an earlier run is
-    left next to this run's gradebook. If writing fails, the previous CSV and
-    folder stay exactly as they were. The folder holds a ``manifest.json``
-    (the gradebook's name and SHA-256, every feedback file with its SHA-256);
-    a folder of that name without one is not an earlier feedback folder, and
-    it is left alone.
+    :func:`grade` writes its rows one by one as it goes; this writes graded
+    submissions in one call (a fresh gradebook, as a run without ``resume``).
 
     Parameters
     ----------
     submissions : sequence of Submission
-        The grades.
+        The grades, in the order of the rows.
     out : str or path-like
-        The CSV.
+        The CSV; the feedback goes to ``<stem>_feedback/`` beside it.
 
     Returns
     -------
@@ -610,8 +440,7 @@ def write_gradebook(
     Raises
     ------
     uio_teach.instructor.output.OutputError
-        ``out`` is a folder, or its feedback folder exists and is not one of an
-        earlier run; nothing is written.
+        ``out`` is a folder, or its feedback folder is not one of an earlier grading.
 
     Examples
     --------
@@ -625,77 +454,18 @@ def write_gradebook(
     a.ipynb,pa9,g01,ok,✗,0,1
     ['a.txt', 'manifest.json']
     """
-    from .output import StagedFolder, sha256_file, write_manifest
-
-    out = Path(out)
-    folder = _feedback_folder(out)
-    _check_gradebook_target(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     columns: list[str] = []
     for sub in submissions:
         columns += [c for c in sub.verdicts() if c not in columns]
-    with StagedFolder(folder, "feedback") as stage:
-        assert stage.path is not None
-        names: list[str] = []
+    with Gradebook(out, [s.file for s in submissions], columns) as book:
         for sub in submissions:
-            path = Path(sub.file)
-            candidates = [path.stem, f"{path.parent.name}_{path.stem}"]
-            candidates += [f"{path.stem}-{n}" for n in range(2, len(submissions) + 2)]
-            name = next(f"{c}.txt" for c in candidates if f"{c}.txt" not in names)
-            names.append(name)
-            (stage.path / name).write_text(sub.feedback(), encoding="utf-8")
-        new_csv = stage.path.parent / f".{out.name}.new"
-        try:
-            with open(new_csv, "w", newline="", encoding="utf-8") as fh:
-                writer = csv.writer(fh)
-                writer.writerow(["file", "lab", "group", "status", *columns, "total", "out_of"])
-                for sub in submissions:
-                    verdicts = sub.verdicts()
-                    marks = [
-                        "" if c not in verdicts else (PASS if verdicts[c] else FAIL)
-                        for c in columns
-                    ]
-                    writer.writerow(
-                        [sub.file, sub.lab, sub.group, sub.status, *marks, sub.total, len(verdicts)]
-                    )
-            write_manifest(
-                stage.path,
-                command=_COMMAND,
-                config={"gradebook": out.name, "gradebook_sha256": sha256_file(new_csv)},
-                options={"submissions": [sub.file for sub in submissions]},
-            )
-            _swap_in(new_csv, out, stage)
-        finally:
-            new_csv.unlink(missing_ok=True)
-    for sub, name in zip(submissions, names, strict=True):
-        sub.feedback_file = folder / name
-    return out, folder
+            book.add(sub)
+    return book.out, book.folder
 
 
-def _swap_in(new_csv: Path, out: Path, stage: Any) -> None:
-    """Move the new CSV to ``out`` and commit ``stage``; on failure, put the old CSV back."""
-    backup = None
-    if out.exists():
-        backup = new_csv.with_name(f".{out.name}.old")
-        backup.unlink(missing_ok=True)
-        try:
-            os.link(out, backup)
-        except OSError:  # no hard links on this file system: a copy
-            shutil.copy2(out, backup)
-    try:
-        os.replace(new_csv, out)
-        try:
-            stage.commit()
-        except BaseException:
-            if backup is not None:
-                os.replace(backup, out)
-                backup = None
-            else:
-                out.unlink(missing_ok=True)
-            raise
-    finally:
-        if backup is not None:
-            backup.unlink(missing_ok=True)
+def _positive(name: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise GradeError(f"{name}: must be > 0 s, got {value!r}")
 
 
 def grade(
@@ -706,6 +476,10 @@ def grade(
     timeout: float = 300.0,
     cell_timeout: float = 60.0,
     progress: Callable[[int, int, Submission], None] | None = None,
+    resume: bool = False,
+    jobs: int = 1,
+    sandbox: bool = True,
+    limits: Limits | None = None,
 ) -> list[Submission]:
     """Grade submitted notebooks; write the gradebook ``out`` (CSV) and the feedback texts.
 
@@ -714,31 +488,44 @@ def grade(
     submissions : sequence of path
         The notebooks handed in. They are only read.
     out : path
-        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it. Both
-        replace those of an earlier grading together (see :func:`write_gradebook`).
+        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it.
+        Each row is written as soon as its submission is graded.
     answer_key : path, optional
-        ``answer_key.csv`` of ``uio-teach labs --groups``: each notebook then
-        runs with its group's parameters, whatever its parameters cell says.
+        ``answer_key.csv`` of ``uio-teach labs --groups``: each submission is
+        graded with its group's parameters (and runs with them). Without it,
+        with the course's own numbers.
     timeout : float
-        Seconds a notebook may run in all; then its process and kernel are
-        killed and it is graded as it stands ("timeout").
+        Seconds a notebook may run in all; then every process of its run is
+        killed and it is graded on what it computed ("timeout").
     cell_timeout : float
-        Seconds a cell may run; then it is interrupted, recorded as an error,
-        and the next cells run.
+        Seconds a cell may run; then it is interrupted, and the next cells run.
     progress : callable, optional
         ``progress(index, total, submission)`` after each notebook.
+    resume : bool
+        Keep the rows of ``out`` and grade only the submissions that have none.
+    jobs : int
+        How many submissions run at a time.
+    sandbox : bool
+        Run each submission in the sandbox (refused where it is unavailable).
+        ``False`` runs the students' code with your permissions, with a
+        :class:`UnsandboxedWarning`.
+    limits : Limits, optional
+        Memory, processes, file size and CPU time of a run.
 
     Returns
     -------
     list of Submission
+        The submissions graded by this call (with ``resume``, not those kept).
 
     Raises
     ------
     GradeError
-        The answer key cannot be read, or a time limit is not positive.
+        The answer key cannot be read, an option is out of range.
+    SandboxRefused
+        The sandbox is unavailable and ``sandbox`` is True.
     uio_teach.instructor.output.OutputError
-        ``out`` is a folder, or its feedback folder exists and is not one of
-        an earlier grading (checked before any notebook runs).
+        ``out`` is a folder, its feedback folder is not ours, or another run
+        is writing it (checked before any notebook runs).
 
     Examples
     --------
@@ -749,71 +536,78 @@ def grade(
     ...     print(err)
     timeout: must be > 0 s, got 0
     """
-    for name, value in (("timeout", timeout), ("cell_timeout", cell_timeout)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-            raise GradeError(f"{name}: must be > 0 s, got {value!r}")
+    _positive("timeout", timeout)
+    _positive("cell_timeout", cell_timeout)
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise GradeError(f"jobs: must be a whole number >= 1, got {jobs!r}")
     key = read_answer_key(answer_key) if answer_key is not None else None
-    _check_gradebook_target(out)  # before the notebooks run, not after
-    registry = _registry()
+    check_gradebook_target(out)  # before the notebooks run, not after
+    if sandbox:
+        problem = sandbox_problem()
+        if problem is not None:
+            raise SandboxRefused(
+                f"cannot isolate the submissions: {problem}. Grading runs the students' code; "
+                "--no-sandbox runs it with your permissions (only for notebooks you trust)"
+            )
+    else:
+        warnings.warn(
+            "the submissions run WITHOUT a sandbox, with your permissions: a notebook can read "
+            "the answer key and your files, change the gradebook, and end your processes",
+            UnsandboxedWarning,
+            stacklevel=2,
+        )
+    limits = limits or Limits(cpu_seconds=int(timeout) + 60)
+    clean_leftovers()
+    files = [os.fspath(p) for p in submissions]
+    labs = [_read(Path(f))[1] for f in files]
+    columns: list[str] = []
+    for lab in labs:
+        columns += [c.check_id for c in GRADED.get(lab, ()) if c.check_id not in columns]
     graded: list[Submission] = []
-    paths = [Path(p) for p in submissions]
-    for index, path in enumerate(paths, start=1):
-        sub = _grade_one(path, key, registry, min(cell_timeout, timeout), timeout)
-        graded.append(sub)
-        if progress is not None:
-            progress(index, len(paths), sub)
-    # without a registry, a lab's checks are those its submissions' check cells produced
-    seen: dict[str, list[str]] = {}
-    for sub in graded:
-        ids = seen.setdefault(sub.lab, [])
-        ids += [i for i in (*sub.expected, *sub.results) if i not in ids]
-    for sub in graded:
-        if not sub.expected:
-            sub.expected = tuple(seen.get(sub.lab, ()))
-    write_gradebook(graded, out)
+    with Gradebook(out, files, columns, resume=resume) as book:
+        todo = [(i, f) for i, f in enumerate(files) if f not in book.done]
+        todo = [(i, f) for n, (i, f) in enumerate(todo) if f not in {g for _, g in todo[:n]}]
+        root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
+        try:
+            (root / _OWNER).write_text(
+                json.dumps({"pid": os.getpid(), "start": _start_time(os.getpid())}),
+                encoding="utf-8",
+            )
+            stop = threading.Event()
+            with ThreadPoolExecutor(max_workers=jobs) as pool:
+                running: dict[Future[Submission], str] = {}
+                queue = list(todo)
+                try:
+                    while queue or running:
+                        while queue and len(running) < jobs:
+                            index, file = queue.pop(0)
+                            future = pool.submit(
+                                _grade_one,
+                                Path(file),
+                                key,
+                                root=root,
+                                index=index,
+                                sandbox=sandbox,
+                                timeout=timeout,
+                                cell_timeout=min(cell_timeout, timeout),
+                                limits=limits,
+                                stop=stop,
+                            )
+                            running[future] = file
+                        finished, _ = wait(running, return_when=FIRST_COMPLETED)
+                        for future in finished:
+                            running.pop(future)
+                            sub = future.result()
+                            book.add(sub)
+                            graded.append(sub)
+                            if progress is not None:
+                                progress(len(graded), len(todo), sub)
+                finally:  # interrupted: stop every run still going, keep the finished rows
+                    stop.set()
+                    for future in running:
+                        future.cancel()
+        finally:
+            _remove(root)
+    order = {f: i for i, f in enumerate(files)}
+    graded.sort(key=lambda s: order[s.file])
     return graded
-
-
-def _execute(src: str, dst: str, cell_timeout: float, pid_file: str) -> int:
-    """Run a prepared copy in a fresh kernel (the child process of :func:`_run_copy`)."""
-    import nbformat
-    from nbclient import NotebookClient
-
-    nb = nbformat.read(src, as_version=4)
-    client = NotebookClient(
-        nb,
-        timeout=cell_timeout,
-        kernel_name="python3",
-        allow_errors=True,
-        interrupt_on_timeout=True,
-        error_on_timeout={
-            "ename": "TimeoutError",
-            "evalue": f"the cell ran longer than {cell_timeout:g} s and was interrupted",
-            "traceback": [],
-        },
-        resources={"metadata": {"path": os.path.dirname(os.path.abspath(src))}},
-    )
-
-    def started(**_: Any) -> None:
-        pid = getattr(getattr(client.km, "provisioner", None), "pid", None)
-        if pid:
-            Path(pid_file).write_text(str(pid))
-
-    def save(**_: Any) -> None:  # so that a run killed at the time limit still tells something
-        part = dst + ".part"
-        nbformat.write(nb, part)
-        os.replace(part, dst)
-
-    client.on_notebook_start = started
-    client.on_cell_executed = save
-    try:
-        client.execute()
-    finally:
-        save()
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover - the child process of _run_copy
-    if len(sys.argv) == 6 and sys.argv[1] == "--run":
-        sys.exit(_execute(sys.argv[2], sys.argv[3], float(sys.argv[4]), sys.argv[5]))
-    sys.exit("usage: python -m uio_teach.instructor.grade --run IN OUT CELL_TIMEOUT PID_FILE")

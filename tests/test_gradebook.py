@@ -1,0 +1,170 @@
+"""The gradebook keeps every finished row: written one by one, resumed, locked, never mixed."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from uio_teach.instructor import grade, output
+from uio_teach.instructor.gradebook import Gradebook, GradebookBusy, Submission
+
+IDS = ("pa9.design", "pa9.plot")
+
+
+def rows(path: Path) -> list[dict[str, str]]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def sub(file: str, passed: bool = True) -> Submission:
+    return Submission(
+        file,
+        "pa9",
+        "g01",
+        "ok",
+        results={"pa9.design": {"passed": passed, "title": "design", "items": []}},
+        expected=IDS,
+    )
+
+
+def test_each_row_is_on_disk_as_soon_as_it_is_added(tmp_path):
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["a.ipynb", "b.ipynb"], IDS) as book:
+        book.add(sub("b.ipynb"))
+        # another reader sees the row now, before the run ends
+        assert [r["file"] for r in rows(out)] == ["b.ipynb"]
+        assert (tmp_path / "grades_feedback" / "b.txt").is_file()
+        book.add(sub("a.ipynb", passed=False))
+    table = rows(out)
+    assert [r["file"] for r in table] == ["a.ipynb", "b.ipynb"]  # the order given
+    assert [r["pa9.design"] for r in table] == [grade.FAIL, grade.PASS]
+    manifest = output.read_manifest(tmp_path / "grades_feedback")
+    assert manifest["command"] == "uio-teach grade"
+    assert sorted(f["name"] for f in manifest["files"]) == ["a.txt", "b.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grades.csv", "grades_feedback"]
+
+
+def test_an_interrupted_run_keeps_its_rows_and_resume_skips_them(tmp_path):
+    out = tmp_path / "grades.csv"
+    files = ["a.ipynb", "b.ipynb", "c.ipynb"]
+    with pytest.raises(KeyboardInterrupt):
+        with Gradebook(out, files, IDS) as book:
+            book.add(sub("a.ipynb"))
+            raise KeyboardInterrupt
+    assert [r["file"] for r in rows(out)] == ["a.ipynb"]
+    with open(out, "a", encoding="utf-8") as fh:  # a row cut short by a kill
+        fh.write("b.ipynb,pa9,g0")
+    with Gradebook(out, files, IDS, resume=True) as book:
+        assert sorted(book.done) == ["a.ipynb"]  # the cut row is graded again
+        book.add(sub("c.ipynb"))
+        book.add(sub("b.ipynb"))
+    assert [r["file"] for r in rows(out)] == files
+    assert not (tmp_path / ".grades.csv.lock").exists()
+
+
+def test_a_fresh_run_starts_a_new_gradebook(tmp_path):
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["a.ipynb"], IDS) as book:
+        book.add(sub("a.ipynb"))
+    with Gradebook(out, ["z.ipynb"], IDS) as book:
+        book.add(sub("z.ipynb"))
+    assert [r["file"] for r in rows(out)] == ["z.ipynb"]
+    folder = tmp_path / "grades_feedback"
+    assert sorted(p.name for p in folder.iterdir()) == ["manifest.json", "z.txt"]
+
+
+def test_a_second_run_into_the_same_gradebook_is_refused(tmp_path):
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["a.ipynb"], IDS) as book:
+        with pytest.raises(GradebookBusy, match="another grading run"):
+            Gradebook(out, ["a.ipynb"], IDS, resume=True).__enter__()
+        book.add(sub("a.ipynb"))
+    assert [r["file"] for r in rows(out)] == ["a.ipynb"]
+
+
+def test_resume_widens_the_columns_for_a_new_lab(tmp_path):
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:
+        book.add(sub("a.ipynb"))
+    with Gradebook(out, ["a.ipynb", "m.ipynb"], ["missile.pmo"], resume=True) as book:
+        m = Submission("m.ipynb", "missile", "g01", "ok", expected=("missile.pmo",))
+        book.add(m)
+    table = rows(out)
+    assert list(table[0]) == [
+        "file",
+        "lab",
+        "group",
+        "status",
+        "pa9.design",
+        "missile.pmo",
+        "total",
+        "out_of",
+    ]
+    assert [(r["pa9.design"], r["missile.pmo"]) for r in table] == [
+        (grade.PASS, ""),
+        ("", grade.FAIL),
+    ]
+
+
+@pytest.mark.parametrize("content", ["someone's notes", "figures"])
+def test_a_folder_that_is_not_earlier_feedback_is_left_alone(tmp_path, content):
+    out = tmp_path / "grades.csv"
+    folder = tmp_path / "grades_feedback"
+    folder.mkdir()
+    if content == "figures":
+        (folder / "a.png").write_bytes(b"png")
+        output.write_manifest(folder, command="uio-teach figures", config={})
+    else:
+        (folder / "notes.txt").write_text("mine")
+    before = sorted(p.name for p in folder.iterdir())
+    with pytest.raises(output.OutputError, match="left alone"):
+        grade.grade([tmp_path / "x.ipynb"], out, sandbox=False)
+    assert not out.exists() and sorted(p.name for p in folder.iterdir()) == before
+
+
+def test_a_csv_that_is_not_a_gradebook_is_not_resumed_over(tmp_path):
+    out = tmp_path / "grades.csv"
+    out.write_text("name,mark\nann,5\n")
+    with pytest.raises(output.OutputError, match="not a gradebook"):
+        Gradebook(out, ["a.ipynb"], IDS, resume=True).__enter__()
+    assert out.read_text() == "name,mark\nann,5\n"
+
+
+def test_leftovers_of_killed_runs_are_removed_and_live_ones_kept(tmp_path):
+    dead = tmp_path / f"{grade.TEMP_PREFIX}dead"
+    live = tmp_path / f"{grade.TEMP_PREFIX}live"
+    stranger = tmp_path / f"{grade.TEMP_PREFIX}stranger"
+    for folder in (dead, live, stranger):
+        (folder / "0001" / "work").mkdir(parents=True)
+    (dead / "owner.json").write_text(json.dumps({"pid": os.getpid(), "start": "not-now"}))
+    me = Path(f"/proc/{os.getpid()}/stat").read_text().rsplit(")", 1)[1].split()[19]
+    (live / "owner.json").write_text(json.dumps({"pid": os.getpid(), "start": me}))
+    locked = dead / "0001" / "work" / "locked"
+    locked.mkdir()
+    (locked / "f").write_text("x")
+    locked.chmod(0o500)  # a submission may leave a folder it cannot write
+    assert grade.clean_leftovers(tmp_path) == [dead]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [live.name, stranger.name]
+
+
+def test_unreadable_submissions_are_graded_without_a_kernel(tmp_path):
+    paths = []
+    for name in ("pa9_g01", "pa9_g02"):
+        path = tmp_path / f"{name}.ipynb"
+        path.write_text("{ not a notebook")
+        paths.append(path)
+    out = tmp_path / "grades.csv"
+    with pytest.warns(grade.UnsandboxedWarning, match="WITHOUT a sandbox"):
+        graded = grade.grade(paths, out, sandbox=False)
+    assert [s.status for s in graded] == ["unreadable", "unreadable"]
+    table = rows(out)
+    assert [(r["group"], r["total"], r["out_of"]) for r in table] == [
+        ("g01", "0", "4"),
+        ("g02", "0", "4"),
+    ]
+    text = (tmp_path / "grades_feedback" / "pa9_g01.txt").read_text(encoding="utf-8")
+    assert "not a notebook" in text

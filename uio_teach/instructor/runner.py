@@ -1,0 +1,482 @@
+"""Run one submitted notebook in a sandbox and take its answers out, as data.
+
+:func:`prepare` makes the copy that runs: every stored output cleared, the
+``parameters`` cell set to the group's parameters from the answer key (so the
+in-notebook checks give the group feedback on its own numbers), and small
+cells added: one at the top that defines the exporter, one right after each
+check cell that writes the answer variables that check needs to
+``answers/<check>.json`` (so a later reassignment does not matter), and one at
+the end that writes every answer variable of the lab to ``answers/final.json``
+(used for a check whose cell the group deleted).
+
+:func:`run_notebook` runs that copy in a fresh kernel, in a separate process,
+inside the :class:`~uio_teach.instructor.sandbox.Sandbox` (unless told not to),
+with a time limit per cell (the cell is interrupted, the next ones run) and
+for the whole notebook (then every process of the run is killed). It reads
+back only data: the answer files (regular files, no links, bounded size) and
+the executed notebook (for the cells that raised). Nothing the notebook
+prints decides anything.
+
+Examples
+--------
+>>> from uio_teach.instructor.runner import check_function
+>>> check_function("checks.pa9_design(H, T, K1, F, K2, poles=PARAMS['poles'])")
+'pa9_design'
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import nbformat
+
+from ..checks.answers import AnswerError, parse
+from ..checks.grading import GRADED
+from .sandbox import HOME, Limits, Sandbox
+
+__all__ = [
+    "RunOutcome",
+    "CellError",
+    "prepare",
+    "run_notebook",
+    "check_function",
+    "read_limited",
+    "GRADING_TAG",
+    "MAX_FILE_BYTES",
+]
+
+GRADING_TAG = "uio-teach-grade"
+"""The tag of the cells the grader adds."""
+MAX_FILE_BYTES = 256 * 1024 * 1024
+"""The largest answer file or executed notebook read back."""
+_CALL = re.compile(r"\bchecks\.(\w+)\s*\(")
+_SETUP = """\
+def _uio_export(_uio_tag, _uio_names):
+    from uio_teach.checks import answers as _uio_answers
+    _uio_ns = globals()
+    _uio_values = {_n: _uio_ns[_n] for _n in _uio_names if _n in _uio_ns}
+    with open(f"answers/{_uio_tag}.json", "w", encoding="utf-8") as _uio_fh:
+        _uio_fh.write(_uio_answers.dumps(_uio_values))
+"""
+
+
+@dataclass(frozen=True)
+class CellError:
+    """A cell of the student's that raised.
+
+    Attributes
+    ----------
+    cell : int
+        Its number among the student's code cells (from 1).
+    position : int
+        Its index in the prepared notebook.
+    ename, evalue : str
+        The exception's class and message (one line).
+    source : str
+        The cell's code.
+    is_check : bool
+        Whether it is a check cell (its error then follows from an earlier one).
+    """
+
+    cell: int
+    position: int
+    ename: str
+    evalue: str
+    source: str
+    is_check: bool = False
+
+
+@dataclass
+class RunOutcome:
+    """What one run gave.
+
+    Attributes
+    ----------
+    status : str
+        ``"ok"``, ``"error"`` or ``"timeout"``.
+    captures : dict
+        Capture tag (``"0"``, ``"1"``, ... per check, ``"final"``) -> name -> plain data.
+    positions : dict
+        Capture tag -> index of its cell in the prepared notebook.
+    errors : list of CellError
+    notes : list of str
+        The grader's notes on the run (a killed run, a dead kernel).
+    """
+
+    status: str
+    captures: dict[str, dict[str, Any]] = field(default_factory=dict)
+    positions: dict[str, int] = field(default_factory=dict)
+    errors: list[CellError] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def check_function(source: str) -> str | None:
+    """The check function a check cell calls (``checks.<name>(...)``), or None.
+
+    Parameters
+    ----------
+    source : str
+
+    Returns
+    -------
+    str or None
+    """
+    match = _CALL.search(source)
+    return match[1] if match else None
+
+
+def _tags(cell: Any) -> list[str]:
+    return list(cell.get("metadata", {}).get("tags", []) or [])
+
+
+def _ours(source: str) -> Any:
+    cell = nbformat.v4.new_code_cell(source)
+    cell.metadata["tags"] = [GRADING_TAG]
+    return cell
+
+
+def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, dict[str, int]]:
+    """The copy to run: outputs cleared, the key's parameters set, the export cells added.
+
+    Parameters
+    ----------
+    nb : nbformat.NotebookNode
+        The submission (modified in place and returned).
+    lab : str
+        Its lab (a key of :data:`uio_teach.checks.grading.GRADED`; another
+        lab gets no export cells).
+    params : mapping or None
+        The group's parameters from the answer key.
+
+    Returns
+    -------
+    (NotebookNode, dict)
+        The copy, and capture tag -> index of its cell.
+    """
+    graded = GRADED.get(lab, ())
+    by_function = {c.check_id.replace(".", "_"): i for i, c in enumerate(graded)}
+    every = sorted({n for c in graded for n in c.names})
+    cells = [_ours(_SETUP)]
+    has_params = False
+    placed: set[int] = set()
+    for cell in nb.cells:
+        if cell.get("cell_type") == "code":
+            cell.outputs = []
+            cell.execution_count = None
+            tags = _tags(cell)
+            if GRADING_TAG in tags:  # a cell pretending to be ours is the student's
+                cell.metadata["tags"] = [t for t in tags if t != GRADING_TAG]
+            if "parameters" in tags and params is not None:
+                cell.source = f"PARAMS = {json.dumps(params)}"
+                has_params = True
+        cells.append(cell)
+        if cell.get("cell_type") != "code":
+            continue
+        tags = _tags(cell)
+        index = by_function.get(check_function(cell.source) or "")
+        if "check" in tags and "instructor" not in tags and index is not None:
+            if index not in placed:
+                placed.add(index)
+                names = list(graded[index].names)
+                cells.append(_ours(f"_uio_export({str(index)!r}, {names!r})"))
+    if params is not None and not has_params:
+        cells.insert(1, _ours(f"PARAMS = {json.dumps(params)}"))
+    cells.append(_ours(f"_uio_export('final', {every!r})"))
+    nb.cells = cells
+    positions = {}
+    for position, cell in enumerate(cells):
+        if GRADING_TAG in _tags(cell) and "_uio_export(" in cell.source:
+            tag = re.search(r"_uio_export\('(\w+)'", cell.source)
+            if tag:
+                positions[tag[1]] = position
+    return nb, positions
+
+
+def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes | None:
+    """The bytes of a regular file written by the sandbox; None if absent, a link or too large.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    limit : int
+
+    Returns
+    -------
+    bytes or None
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return None
+    with os.fdopen(fd, "rb") as fh:
+        info = os.fstat(fh.fileno())
+        if not stat.S_ISREG(info.st_mode) or info.st_size > limit:
+            return None
+        return fh.read(limit + 1)[:limit]
+
+
+def _one_line(text: str, limit: int = 200) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _errors(executed: Any) -> list[CellError]:
+    out = []
+    number = 0
+    for position, cell in enumerate(executed.cells):
+        if cell.get("cell_type") != "code":
+            continue
+        if GRADING_TAG in _tags(cell):
+            continue
+        number += 1
+        for output in cell.get("outputs", []):
+            if output.get("output_type") == "error":
+                out.append(
+                    CellError(
+                        number,
+                        position,
+                        _one_line(output.get("ename", ""), 60),
+                        _one_line(output.get("evalue", "")),
+                        str(cell.get("source", "")),
+                        "check" in _tags(cell),
+                    )
+                )
+                break
+    return out
+
+
+def _kill_group(pgid: int) -> None:
+    try:
+        os.killpg(pgid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+def _kill_child_kernel(pid_file: Path, parent: int) -> None:
+    """Kill the kernel named in ``pid_file`` only if it is a child of ``parent`` (no sandbox)."""
+    raw = read_limited(pid_file, 64)
+    try:
+        pid = int(raw or b"")
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, ValueError, IndexError):
+        return
+    ppid, pgid = int(fields[1]), int(fields[2])
+    if ppid == parent and pgid == pid:  # our runner's kernel, leading its own group
+        _kill_group(pgid)
+
+
+def _matplotlib_cache(work: Path) -> None:
+    """Copy the font list of matplotlib into the work folder (or the kernel rebuilds it)."""
+    try:
+        import matplotlib  # deferred on purpose: only to find its cache folder
+
+        cache = Path(matplotlib.get_cachedir())
+    except Exception:  # pragma: no cover - no usable matplotlib cache
+        return
+    target = work / ".config" / "matplotlib"
+    target.mkdir(parents=True, exist_ok=True)
+    for font_list in cache.glob("fontlist-*.json"):
+        shutil.copy2(font_list, target / font_list.name)
+
+
+def run_notebook(
+    nb: Any,
+    folder: Path,
+    *,
+    positions: Mapping[str, int],
+    sandbox: bool,
+    timeout: float,
+    cell_timeout: float,
+    limits: Limits,
+    stop: threading.Event | None = None,
+) -> RunOutcome:
+    """Run a prepared copy in ``folder`` (ours, emptied by the caller); read back its data.
+
+    Parameters
+    ----------
+    nb : NotebookNode
+        The prepared copy (:func:`prepare`).
+    folder : pathlib.Path
+        A fresh folder of the grader's; the sandbox sees only its ``work``.
+    positions : mapping
+        Capture tag -> cell index, from :func:`prepare`.
+    sandbox : bool
+        Run under bubblewrap (False: directly, with a loud warning by the caller).
+    timeout, cell_timeout : float
+        Seconds for the whole notebook and for one cell.
+    limits : Limits
+        Resource limits applied by the runner before the kernel starts.
+    stop : threading.Event, optional
+        When set (the grader was interrupted), the run is killed at once.
+
+    Returns
+    -------
+    RunOutcome
+    """
+    work = folder / "work"
+    (work / "answers").mkdir(parents=True)
+    _matplotlib_cache(work)
+    nbformat.write(nb, work / "submission.ipynb")
+    inside = Path(HOME) if sandbox else work
+    pid_file = folder / "kernel.pid"
+    limit_arg = f"{limits.memory_mb},{limits.processes},{limits.file_mb},{limits.cpu_seconds}"
+    command = [
+        sys.executable,
+        "-m",
+        "uio_teach.instructor.runner",
+        "--run",
+        os.fspath(inside / "submission.ipynb"),
+        os.fspath(inside / "executed.ipynb"),
+        repr(float(cell_timeout)),
+        limit_arg,
+        "" if sandbox else os.fspath(pid_file),
+    ]
+    err_path = folder / "runner.err"
+    status = "ok"
+    notes: list[str] = []
+    with open(err_path, "wb") as err:
+        if sandbox:
+            proc = Sandbox(work).popen(command, stdin=subprocess.DEVNULL, stdout=err, stderr=err)
+        else:
+            env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
+            env["MPLCONFIGDIR"] = os.fspath(work / ".config" / "matplotlib")
+            proc = subprocess.Popen(
+                command,
+                cwd=work,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=err,
+                stderr=err,
+                start_new_session=True,
+            )
+        deadline = time.monotonic() + timeout
+        try:
+            while proc.poll() is None:
+                if stop is not None and stop.is_set():
+                    status = "interrupted"
+                    break
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    status = "timeout"
+                    notes.append(
+                        f"the notebook ran longer than the time limit of {timeout:g} s and was "
+                        "stopped; it is graded on what it computed until then"
+                    )
+                    break
+                try:
+                    proc.wait(timeout=min(left, 0.5))
+                except subprocess.TimeoutExpired:
+                    pass
+        finally:
+            if not sandbox:
+                _kill_child_kernel(pid_file, proc.pid)
+            _kill_group(proc.pid)  # the sandbox's own session: everything it started
+            proc.wait()
+    outcome = RunOutcome(status, positions=dict(positions), notes=notes)
+    raw = read_limited(work / "executed.ipynb")
+    executed = None
+    if raw is not None:
+        try:
+            executed = nbformat.reads(raw.decode("utf-8"), as_version=4)
+        except Exception:  # a half-written or tampered file: no cell errors to report
+            executed = None
+    if executed is not None:
+        outcome.errors = _errors(executed)
+    if status == "ok" and proc.returncode != 0:
+        text = (read_limited(err_path, 1 << 20) or b"").decode("utf-8", "replace")
+        lines = [line for line in text.splitlines() if line.strip()]
+        last = _one_line(lines[-1]) if lines else f"exit status {proc.returncode}"
+        if "DeadKernelError" in text or "Kernel died" in text:
+            last = "the kernel died (the notebook ended its own process, or ran out of memory)"
+        notes.append(f"the notebook could not be run to its end: {last}")
+        status = "error"
+    for tag in positions:
+        data = read_limited(work / "answers" / f"{tag}.json")
+        if data is None:
+            continue
+        try:
+            outcome.captures[tag] = parse(data)
+        except AnswerError as err:
+            notes.append(f"the answers after one check could not be read ({err})")
+    if status == "ok" and "final" not in outcome.captures:
+        status = "error"
+        notes.append("the notebook did not run to its end")
+    if status == "ok" and outcome.errors:
+        status = "error"
+    outcome.status = status
+    outcome.notes = notes
+    return outcome
+
+
+def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str) -> int:
+    """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts)."""
+    from nbclient import NotebookClient  # deferred on purpose: only the runner needs it
+
+    memory, processes, file_mb, cpu = (int(v) for v in limits.split(","))
+    Limits(memory, processes, file_mb, cpu).apply()
+    nb = nbformat.read(src, as_version=4)
+    client = NotebookClient(
+        nb,
+        timeout=cell_timeout,
+        kernel_name="python3",
+        allow_errors=True,
+        interrupt_on_timeout=True,
+        error_on_timeout={
+            "ename": "TimeoutError",
+            "evalue": f"the cell ran longer than {cell_timeout:g} s and was interrupted",
+            "traceback": [],
+        },
+        resources={"metadata": {"path": os.path.dirname(os.path.abspath(src))}},
+    )
+
+    def started(**_: Any) -> None:
+        pid = getattr(getattr(client.km, "provisioner", None), "pid", None)
+        if pid and pid_file:
+            Path(pid_file).write_text(str(pid))
+
+    def save(**_: Any) -> None:  # a run stopped at the time limit still shows its errors
+        part = dst + ".part"
+        nbformat.write(nb, part)
+        os.replace(part, dst)
+
+    client.on_notebook_start = started
+    client.on_cell_executed = save
+    try:
+        client.execute()
+    finally:
+        save()
+    return 0
+
+
+def main(argv: Sequence[str]) -> int:
+    """The runner's command line: ``--run SRC DST CELL_TIMEOUT LIMITS PID_FILE``.
+
+    Parameters
+    ----------
+    argv : sequence of str
+
+    Returns
+    -------
+    int
+    """
+    if len(argv) == 6 and argv[0] == "--run":
+        return _execute(argv[1], argv[2], float(argv[3]), argv[4], argv[5])
+    print("usage: python -m uio_teach.instructor.runner --run SRC DST CELL_TIMEOUT LIMITS PID")
+    return 2
+
+
+if __name__ == "__main__":  # pragma: no cover - the process run_notebook starts
+    sys.exit(main(sys.argv[1:]))
