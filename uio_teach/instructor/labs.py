@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import lab_registry
 from .book import BookIndex, default_book_dir
 from .lab_notebook import (
     LAB_PATTERN,
@@ -41,7 +42,7 @@ from .lab_notebook import (
     make_notebook,
     params_source,
 )
-from .lab_registry import LABS, Lab, LabError, LabUsageError, lab_of
+from .lab_registry import Lab, LabError, LabUsageError, lab_of
 from .output import MANIFEST, StagedFolder, write_manifest
 from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
@@ -97,6 +98,9 @@ class UnreadKeys:
         labs = "every lab" if set(self.labs) == set(LABS) else " and ".join(self.labs)
         return f"{' and '.join(self.keys)} ({labs}): {self.why}"
 
+
+LABS: dict[str, Lab] = lab_registry.LABS
+"""The labs of the course, by id (:data:`uio_teach.instructor.lab_registry.LABS`, also here)."""
 
 UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (
     UnreadKeys(
@@ -176,7 +180,7 @@ def write_labs(
     JSON). Always ``out/manifest.json``: the command, the configuration and
     its hash, the options, the versions and every file with its SHA-256.
 
-    All or nothing (:class:`~uio_teach.instructor.output.StagedFolder`): the
+    All or nothing (``uio_teach.instructor.output.StagedFolder``): the
     notebooks are written into a staging folder beside ``out`` that replaces
     ``out`` whole when every file is written, so a rerun (``groups=3``, then
     ``groups=2``) leaves no notebook of the earlier run, and a failed or
