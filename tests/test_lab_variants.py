@@ -8,11 +8,13 @@ import json
 import re
 from pathlib import Path
 
+import control as ct
 import jupytext
 import nbformat
 import numpy as np
 import pytest
 
+import uio_teach as ut
 from uio_teach import checks
 from uio_teach.instructor import cli, labs
 from uio_teach.instructor.config import load_config
@@ -86,8 +88,10 @@ def test_every_lab_notebook_has_one_parameters_cell_and_its_lab_in_the_metadata(
 
 TERM = """\
 seed = 9
+style = "ggplot"
 [pa9]
 poles = [-2.0, -3.0, -4.0]
+noise = 0.05
 [pa9.sine]
 amplitude = 0.5
 frequency = 3.0
@@ -95,6 +99,11 @@ frequency = 3.0
 poles = [0.1]
 [missile]
 pmo_poles = [-90.0, -130.0]
+duration = 0.4
+samples = 8001
+[missile.noise]
+sigma = 0.02
+seed = 11
 """
 
 
@@ -115,12 +124,35 @@ def test_the_term_config_sets_the_numbers_of_every_lab(tmp_path):
     assert PA9Params.from_config(load_config(config)).poles == (-2.0, -3.0, -4.0)
 
 
+def test_every_config_key_of_a_lab_reaches_its_params(tmp_path):
+    """pa9.noise, the seeds, missile.duration/samples, the noise of the missile lab and style."""
+    config = tmp_path / "term.toml"
+    config.write_text(TERM)
+    cfg = load_config(config)
+    pa9 = PA9Params.from_config(cfg).to_params()
+    assert (pa9["noise"], pa9["seed"], pa9["style"]) == (0.05, 9, "ggplot")
+    case = CaseStudyParams.from_config(cfg).to_params()
+    assert (case["v"]["seed"], case["pole"], case["style"]) == (9, 0.1, "ggplot")
+    missile = MissileParams.from_config(cfg).to_params()
+    assert (missile["duration"], missile["samples"]) == (0.4, 8001)
+    assert missile["noise"] == {"sigma": 0.02, "seed": 11} and missile["style"] == "ggplot"
+    # every key of the config that a lab's experiment declares for its lab is read
+    for params in (PA9Params, CaseStudyParams, MissileParams):
+        for name, spec in params.declared():
+            key = spec.config_key(params.lab, name)
+            if key is not None and key != "case_study.poles":
+                assert key in cfg, key
+    # a style file travels as its settings (the students do not have the file)
+    style = tmp_path / "term.mplstyle"
+    style.write_text("axes.grid: True\nlines.linewidth: 2  # thicker\n")
+    config.write_text(f'style = "{style.name}"\n')
+    params = PA9Params.from_config(load_config(config)).to_params()
+    assert params["style"] == {"axes.grid": "True", "lines.linewidth": "2"}
+    assert PA9Params.from_params(json.loads(json.dumps(params))).to_params() == params
+
+
 def test_the_checks_follow_the_config_poles():
     """A design for the default poles fails the check of a term with other poles."""
-    import control as ct
-
-    import uio_teach as ut
-
     plant = ut.examples.pa9()
     A, C, E = plant.A, plant.C, plant.E
     H = E @ np.linalg.pinv(C @ E)
@@ -174,7 +206,7 @@ def test_every_variant_is_a_fair_exercise(variants):
             assert not params.problems()
     for variant in labs.draw_variants(labs.LABS["pa9"], 30, seed=1):
         poles = np.array(variant.poles, dtype=float)
-        assert len(set(poles)) == 3 and np.all(poles <= -1) and np.all(poles >= -5)
+        assert len(set(poles)) == 3 and np.all(poles <= -1) and np.all(poles >= -6)
         assert abs(variant.sine_amplitude) >= 0.5 and max(map(abs, variant.switch_values)) >= 0.5
     for variant in labs.draw_variants(labs.LABS["case_study"], 30, seed=1):
         assert abs(variant.pole) < 1 and abs(variant.pole - 0.5) >= 0.2
@@ -184,7 +216,7 @@ def test_the_same_seed_gives_byte_identical_files(variants, tmp_path):
     assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "5", "-q"]) == 0
     files = sorted(p.relative_to(variants) for p in variants.rglob("*") if p.is_file())
     again = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
-    assert files == again and len(files) == 3 * 3 * 2 + 1
+    assert files == again and len(files) == 3 * 3 * 2 + 2  # and the key, the manifest
     for name in files:
         assert (variants / name).read_bytes() == (tmp_path / name).read_bytes(), name
 
@@ -197,10 +229,6 @@ def test_another_seed_gives_other_numbers(variants, tmp_path):
 
 
 def test_the_answer_key_has_one_row_per_lab_and_group_with_the_right_answers(variants):
-    import control as ct
-
-    import uio_teach as ut
-
     with (variants / "answer_key.csv").open(newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
     assert [(r["lab"], r["group"]) for r in rows] == [
@@ -212,30 +240,33 @@ def test_the_answer_key_has_one_row_per_lab_and_group_with_the_right_answers(var
         )
         assert json.loads(row["params"]) == params_of(nb)
         params = json.loads(row["params"])
+        plant = ut.experiments.plant_from_params(row["lab"], params)
+        assert "plant" in params  # every group has a plant of its own
         if row["lab"] == "pa9":
             F = np.array(json.loads(row["pa9.F"]))
             assert np.allclose(
                 np.sort(np.linalg.eigvals(F).real), sorted(params["poles"]), atol=1e-6
             )
-            plant = ut.examples.pa9()
             K1 = np.array(json.loads(row["pa9.K1"]))
             H = np.array(json.loads(row["pa9.H"]))
             T = np.array(json.loads(row["pa9.T"]))
+            K2 = np.array(json.loads(row["pa9.K2"]))
             assert checks.pa9_design(
-                H, T, K1, F, np.array(json.loads(row["pa9.K2"])), poles=params["poles"], tol=1e-8
+                H, T, K1, F, K2, plant=plant, poles=params["poles"], tol=1e-8
             ).passed
             assert np.allclose(
                 K1, ct.place((T @ plant.A).T, plant.C.T, params["poles"]).T, atol=1e-8
             )
         elif row["lab"] == "case_study":
             L = np.array(json.loads(row["case_study.L_pole"]))
-            assert checks.case_study_pole(L, params["pole"]).passed
+            assert checks.case_study_pole(L, params["pole"], plant).passed
+            M = np.array(json.loads(row["case_study.M"]))
+            assert checks.case_study_projection(M, plant).passed
         else:
             M = np.array(json.loads(row["missile.M"]))
             L = np.array(json.loads(row["missile.L"]))
-            plant = ut.examples.missile_autopilot()
             F = (np.eye(4) - M @ plant.C) @ plant.A - L @ plant.C
-            assert checks.missile_pmo(M, L, F, poles=params["pmo_poles"]).passed
+            assert checks.missile_pmo(M, L, F, poles=params["pmo_poles"], plant=plant).passed
 
 
 def test_groups_need_a_lab_of_the_course_and_sane_numbers(tmp_path, capsys):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import itertools
 
 import control as ct
@@ -11,8 +12,9 @@ import pytest
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.existence import decoupling
-from uio_teach.instructor.labs import LABS
+from uio_teach.instructor.lab_registry import LABS
 from uio_teach.instructor.variants import draw_variants
+from uio_teach.lmi import lmi_gain
 
 GROUPS = 4
 SEED = 2027
@@ -38,9 +40,9 @@ def pa9_solution(params):
 def case_study_solution(params):
     plant = ut.experiments.plant_from_params("case_study", params)
     dec = decoupling(plant)
-    lmi = ut.design_pmo(plant, method="lmi")
+    lmi = lmi_gain(dec.A1, plant.C, D=plant.D, dt=plant.dt)
     moved = ut.design_pmo(plant, poles=[params["pole"]])
-    return {"M": dec.M, "A1": dec.A1, "L": lmi.L, "L_pole": moved.L}
+    return {"M": dec.M, "A1": dec.A1, "L": lmi.L, "P": lmi.P, "Y": lmi.P @ lmi.L, "L_pole": moved.L}
 
 
 def missile_solution(params):
@@ -67,7 +69,9 @@ def verdicts(lab, answer, params):
     if lab == "case_study":
         return {
             "case_study.projection": checks.case_study_projection(answer["M"], plant).passed,
-            "case_study.lmi": checks.case_study_lmi(answer["L"], plant=plant).passed,
+            "case_study.lmi": checks.case_study_lmi(
+                answer["L"], answer["P"], plant, **traced(answer)
+            ).passed,
             "case_study.pole": checks.case_study_pole(
                 answer["L_pole"], params["pole"], plant
             ).passed,
@@ -80,6 +84,12 @@ def verdicts(lab, answer, params):
             answer["Cg"], answer["Pc"], answer["K"], plant
         ).passed,
     }
+
+
+def traced(answer):
+    """The solver's ``Y`` for the LMI check, where the check traces ``L`` to it."""
+    takes_y = "Y" in inspect.signature(checks.case_study_lmi).parameters
+    return {"Y": answer["Y"]} if takes_y else {}
 
 
 SOLVE = {"pa9": pa9_solution, "case_study": case_study_solution, "missile": missile_solution}
@@ -133,7 +143,8 @@ def test_every_variant_keeps_the_teaching_point(variants, lab):
             assert report.movable == 3  # the rank and observability conditions hold
         elif lab == "case_study":
             fixed = report.fixed_modes
-            assert report.movable == 1 and fixed.size == 2 and np.all(np.abs(fixed) < 1)
+            assert report.movable == 1 and fixed.size == 2
+            np.testing.assert_allclose(fixed, [0.5, 0.5], atol=1e-6)  # as the chapter tells
             pmo = ut.design_pmo(plant, method="lmi")  # the LMI is feasible, with L D = 0
             np.testing.assert_allclose(pmo.L @ plant.D, 0, atol=1e-6)
         else:
@@ -167,4 +178,6 @@ def test_every_graded_value_differs_between_groups(variants, lab):
     answers = [SOLVE[lab](v.to_params()) for v in variants[lab]]
     for a, b in itertools.combinations(answers, 2):
         for name in a:
+            if name in ("P", "Y"):  # the LMI's certificate: any solution is right
+                continue
             assert not np.allclose(a[name], b[name], atol=1e-3), (lab, name)

@@ -17,7 +17,13 @@ figure, explorer and lab that uses it.
   state, the observer started at ``q(0) = -M C x(0)`` (so ``xhat(0) = 0``).
 
 Each is a frozen dataclass; :meth:`Experiment.simulate` runs an observer on it
-with :func:`uio_teach.simulate`.
+with :func:`uio_teach.simulate`. The numbers an instructor may change are
+fields declared once with :func:`param` (type, unit, help, bounds, range): the
+term config (:mod:`uio_teach.instructor.config`), the lab parameters
+(:mod:`uio_teach.instructor.lab_params`) and the explorers' ranges are derived
+from these declarations (:func:`experiment_params`), so a new field is one
+line here. :func:`plant_from_params` gives a lab's plant, the course's or a
+group's own.
 
 Examples
 --------

@@ -22,12 +22,20 @@ from typing import Any
 import numpy as np
 
 from ..existence import check_existence
-from ..experiments import CASE_STUDY, MISSILE, PA9
+from ..experiments import CASE_STUDY, MISSILE, PA9, experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
 from .model import FAMILIES, Channel, Scenario, Settings, expand_poles
 
 __all__ = ["pa9_scenario", "case_study_scenario", "missile_scenario", "make_scenario"]
+
+
+def _range(experiment: Any, name: str) -> tuple[float, float]:
+    """The range a student explores of an experiment's field (its declared ``Param.range``)."""
+    spec = dict(experiment_params(experiment))[name]
+    if spec.range is None:  # pragma: no cover - every field read here declares one
+        raise ValueError(f"{type(experiment).__name__}.{name} declares no range")
+    return spec.range
 
 
 def _scenario(plant: Plant, family: str, **kwargs: Any) -> Scenario:
@@ -84,10 +92,10 @@ def pa9_scenario() -> Scenario:
         ),
         pole_limits=(-10.0, 1.0),
         frequency_limits=(0.0, 10.0),
-        amplitude_limits=(0.0, 5.0),
-        disturbance_frequency_limits=(0.1, 10.0),
+        amplitude_limits=_range(PA9, "sine_amplitude"),
+        disturbance_frequency_limits=_range(PA9, "sine_frequency"),
         period_limits=(0.25, 5.0),
-        noise_limits=(0.0, 0.2),
+        noise_limits=_range(PA9, "noise"),
         tau_limits=None,
         decay_limits=None,
         d_channels=(Channel(),),
@@ -137,8 +145,8 @@ def case_study_scenario() -> Scenario:
         ),
         pole_limits=(-1.1, 1.1),
         frequency_limits=(0.0, 180.0),
-        amplitude_limits=(0.0, 5.0),
-        disturbance_frequency_limits=(0.05, 3.0),
+        amplitude_limits=_range(CASE_STUDY, "u2_amplitude"),
+        disturbance_frequency_limits=_range(CASE_STUDY, "u2_frequency"),
         period_limits=(1.0, 20.0),
         noise_limits=(0.0, 0.5),
         tau_limits=None,

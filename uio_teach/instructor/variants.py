@@ -7,7 +7,7 @@ writes the expected matrices and numbers of every (lab, group) to a CSV file.
 
 Examples
 --------
->>> from uio_teach.instructor.labs import LABS
+>>> from uio_teach.instructor.lab_registry import LABS
 >>> from uio_teach.instructor.variants import draw_variants
 >>> [v.to_params()["poles"] for v in draw_variants(LABS["pa9"], 2, seed=5)] != []
 True
@@ -15,6 +15,8 @@ True
 
 from __future__ import annotations
 
+import csv
+import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -56,7 +58,8 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
 
     Examples
     --------
-    >>> from uio_teach.instructor.labs import LABS, draw_variants
+    >>> from uio_teach.instructor.lab_registry import LABS
+    >>> from uio_teach.instructor.variants import draw_variants
     >>> a, b = draw_variants(LABS["pa9"], 2, seed=5)
     >>> a != b and not a.problems() and not b.problems()
     True
@@ -79,7 +82,10 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
             seen.setdefault(name, set()).add(value)
         out.append(variant)
     if len(out) < groups:
-        raise LabUsageError(f"cannot draw {groups} distinct variants of the {lab.id} lab")
+        raise LabUsageError(
+            f"cannot draw {groups} distinct variants of the {lab.id} lab "
+            "(no two groups share poles or plant); give fewer groups"
+        )
     return out
 
 
@@ -100,7 +106,8 @@ def write_answer_key(path: Path, rows: Sequence[tuple[Any, str, Any]]) -> Path:
     Examples
     --------
     >>> import tempfile, pathlib, csv
-    >>> from uio_teach.instructor.labs import LABS, write_answer_key
+    >>> from uio_teach.instructor.lab_registry import LABS
+    >>> from uio_teach.instructor.variants import write_answer_key
     >>> from uio_teach.instructor.lab_params import PA9Params
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     key = write_answer_key(pathlib.Path(tmp) / "k.csv", [(LABS["pa9"], "g01", PA9Params())])
@@ -108,9 +115,6 @@ def write_answer_key(path: Path, rows: Sequence[tuple[Any, str, Any]]) -> Path:
     >>> row["lab"], row["group"], row["pa9.K2"] != ""
     ('pa9', 'g01', True)
     """
-    import csv
-    import json
-
     table = []
     columns: list[str] = []
     for lab, group, params in rows:
