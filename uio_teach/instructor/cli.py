@@ -142,8 +142,8 @@ is still missing; a question answered in words gets a "Your answer" cell.
 The numbers of each lab (poles, disturbances, switching times, noise, seeds)
 are in its cell tagged `parameters` (`PARAMS = {...}`); the code and the checks
 read them from there. --config takes them from the term config (the keys of
-`uio-teach figures --print-config`). These keys go into PARAMS but the notebooks
-do not read them:
+`uio-teach figures --print-config`), style included. These keys go into PARAMS
+but the notebooks do not read them:
 {unread}
 
 --groups N --seed S draws numbers of its own for every group, each a fair

@@ -85,8 +85,8 @@ class UnreadKeys:
     Examples
     --------
     >>> from uio_teach.instructor.labs import UNREAD_CONFIG_KEYS
-    >>> "style" in UNREAD_CONFIG_KEYS[0].keys
-    True
+    >>> UNREAD_CONFIG_KEYS[0].text().split(":")[0]
+    'pa9.noise and seed (pa9)'
     """
 
     keys: tuple[str, ...]
@@ -103,12 +103,6 @@ LABS: dict[str, Lab] = lab_registry.LABS
 """The labs of the course, by id (:data:`uio_teach.instructor.lab_registry.LABS`, also here)."""
 
 UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (
-    UnreadKeys(
-        ("style",),
-        tuple(LABS),
-        "the notebooks draw with the matplotlib settings of the Jupyter they run in, the "
-        "student's own",
-    ),
     UnreadKeys(
         ("pa9.noise", "seed"),
         ("pa9",),
