@@ -486,7 +486,7 @@ def _figures(args: argparse.Namespace) -> int:
         return 2
     out = args.out
     try:
-        check_output_folder(out)
+        check_output_folder(out, "uio-teach figures")
     except OSError as err:
         _error("figures", str(err))
         return 1

@@ -99,6 +99,9 @@ class UnreadKeys:
         return f"{' and '.join(self.keys)} ({labs}): {self.why}"
 
 
+COMMAND = "uio-teach labs"
+"""The command recorded in the manifest of a labs folder."""
+
 LABS: dict[str, Lab] = lab_registry.LABS
 """The labs of the course, by id (:data:`uio_teach.instructor.lab_registry.LABS`, also here)."""
 
@@ -286,7 +289,7 @@ def write_labs(
 
     target = Path(out)
     results = []
-    with StagedFolder(target, "labs") as stage:
+    with StagedFolder(target, "labs", command=COMMAND) as stage:
         for i, (path, lab, group, _params, nbs, seconds) in enumerate(built, start=1):
             start = time.perf_counter()
             written = {}
@@ -323,7 +326,7 @@ def write_labs(
         }
         write_manifest(
             stage.path,
-            command="uio-teach labs",
+            command=COMMAND,
             config=dict(config) if config is not None else {},
             options=options,
         )
