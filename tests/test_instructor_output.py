@@ -574,3 +574,18 @@ def test_an_unknown_edition_is_refused(tmp_path):
     proc = build_edition(tmp_path, "teachers")
     assert proc.returncode != 0
     assert "UIO_TEACH_EDITION must be one of student, instructor, got 'teachers'" in proc.stderr
+
+
+def test_labs_and_figures_never_replace_each_others_folders(tmp_path, capsys):
+    figs, notebooks = tmp_path / "figs", tmp_path / "labs"
+    assert make(figs) == 0 and cli.main(labs_argv(notebooks, 1)) == 0
+    before = snapshot(tmp_path)
+    assert cli.main(labs_argv(figs, 1)) == 1
+    assert "holds the output of `uio-teach figures`, not of `uio-teach labs`" in (
+        capsys.readouterr().err
+    )
+    assert make(notebooks) == 1
+    assert "holds the output of `uio-teach labs`, not of `uio-teach figures`" in (
+        capsys.readouterr().err
+    )
+    assert snapshot(tmp_path) == before

@@ -520,8 +520,8 @@ TERM_CHANGES = {
     "pa9.duration": 12.0,
     "pa9.samples": 1201,
     "pa9.sine.amplitude": 0.5,
-    "missile.duration": 4.0,
-    "missile.samples": 401,
+    "missile.duration": 0.4,
+    "missile.samples": 8001,
     "missile.noise.seed": 11,
     "missile.noise.sigma": 0.02,
     "case_study.steps": 50,
@@ -618,3 +618,16 @@ def test_every_config_key_reaches_a_lab_that_reads_it_or_the_help_says_why_not(
     help_text = " ".join(capsys.readouterr().out.split())
     for entry in labs.UNREAD_CONFIG_KEYS:
         assert " ".join(entry.text().split()) in help_text
+
+
+@pytest.mark.book
+@pytest.mark.parametrize("lab_id", list(labs.LABS))
+def test_a_term_configs_solution_runs_with_every_check_passing(term_labs, lab_id, tmp_path):
+    """The term's numbers (TERM_CHANGES) run through the lab: its checks pass with them."""
+    nb = nbformat.read(term_labs["results"][lab_id].solution, as_version=4)
+    nb = execute(nb, tmp_path)
+    checks = [c for c in nb.cells if "check" in tags(c)]
+    assert checks
+    for cell in checks:
+        out = text_output(cell)
+        assert re.search(r"All \d+ checks passed\.", out), f"{cell.source}\n{out}"

@@ -90,8 +90,8 @@ is seeded and no time stamp is written into PNG, PDF or SVG files.
 All or nothing: the files are written into a temporary folder beside DIR,
 which replaces DIR only when every figure was made. A failed or interrupted
 run leaves DIR as it was; a good run leaves only its own files (with --only,
-just those figures). DIR is replaced only if it is empty or holds an earlier
-output (its manifest.json); any other folder is left alone (exit status 1), and
+just those figures). DIR is replaced only if it is empty or holds earlier
+figures (their manifest.json); any other folder is left alone (exit status 1), and
 so is a folder that another run is writing (a lock beside it, .DIR.lock).
 Staging folders left by a killed run (.DIR.new-*) are removed by the next run.
 
@@ -143,8 +143,8 @@ is still missing; a question answered in words gets a "Your answer" cell.
 The numbers of each lab (poles, disturbances, switching times, noise, seeds)
 are in its cell tagged `parameters` (`PARAMS = {...}`); the code and the checks
 read them from there. --config takes them from the term config (the keys of
-`uio-teach figures --print-config`). These keys go into PARAMS but the notebooks
-do not read them:
+`uio-teach figures --print-config`), style included. These keys go into PARAMS
+but the notebooks do not read them:
 {unread}
 
 --groups N --seed S draws numbers of its own for every group, each a fair
@@ -163,8 +163,8 @@ All or nothing, as for figures: the notebooks are written into a temporary
 folder beside DIR, which replaces DIR whole only when every file is written,
 so a rerun (--groups 3, then --groups 2) leaves no notebook of the earlier run
 and a failed or killed run leaves DIR as it was. DIR is replaced only if it is
-empty or holds an earlier output (its manifest.json); any other folder is left
-alone (exit status 1), and so is a folder another run is writing.
+empty or holds earlier lab notebooks (their manifest.json); any other folder is
+left alone (exit status 1), and so is a folder another run is writing.
 """
 
 _LABS_EPILOG = """\
@@ -509,7 +509,7 @@ def _figures(args: argparse.Namespace) -> int:
         return 2
     out = args.out
     try:
-        check_output_folder(out)
+        check_output_folder(out, "uio-teach figures")
     except OSError as err:
         _error("figures", str(err))
         return 1

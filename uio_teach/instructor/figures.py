@@ -609,7 +609,7 @@ def generate(
     cfg = config if config is not None else FigureConfig()
     runs = _Runs(cfg)
     results: list[FigureResult] = []
-    with StagedFolder(target, "figures") as stage:
+    with StagedFolder(target, "figures", command="uio-teach figures") as stage:
         folder = stage.path
         for index, name in enumerate(wanted, start=1):
             spec = FIGURES[name]

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import lab_registry
 from .book import BookIndex, default_book_dir
 from .lab_notebook import (
     LAB_PATTERN,
@@ -41,7 +42,7 @@ from .lab_notebook import (
     make_notebook,
     params_source,
 )
-from .lab_registry import LABS, Lab, LabError, LabUsageError, lab_of
+from .lab_registry import Lab, LabError, LabUsageError, lab_of
 from .output import MANIFEST, StagedFolder, write_manifest
 from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
@@ -84,8 +85,8 @@ class UnreadKeys:
     Examples
     --------
     >>> from uio_teach.instructor.labs import UNREAD_CONFIG_KEYS
-    >>> "style" in UNREAD_CONFIG_KEYS[0].keys
-    True
+    >>> UNREAD_CONFIG_KEYS[0].text().split(":")[0]
+    'pa9.noise and seed (pa9)'
     """
 
     keys: tuple[str, ...]
@@ -98,13 +99,13 @@ class UnreadKeys:
         return f"{' and '.join(self.keys)} ({labs}): {self.why}"
 
 
+COMMAND = "uio-teach labs"
+"""The command recorded in the manifest of a labs folder."""
+
+LABS: dict[str, Lab] = lab_registry.LABS
+"""The labs of the course, by id (:data:`uio_teach.instructor.lab_registry.LABS`, also here)."""
+
 UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (
-    UnreadKeys(
-        ("style",),
-        tuple(LABS),
-        "the notebooks draw with the matplotlib settings of the Jupyter they run in, the "
-        "student's own",
-    ),
     UnreadKeys(
         ("pa9.noise", "seed"),
         ("pa9",),
@@ -176,7 +177,7 @@ def write_labs(
     JSON). Always ``out/manifest.json``: the command, the configuration and
     its hash, the options, the versions and every file with its SHA-256.
 
-    All or nothing (:class:`~uio_teach.instructor.output.StagedFolder`): the
+    All or nothing (``uio_teach.instructor.output.StagedFolder``): the
     notebooks are written into a staging folder beside ``out`` that replaces
     ``out`` whole when every file is written, so a rerun (``groups=3``, then
     ``groups=2``) leaves no notebook of the earlier run, and a failed or
@@ -288,7 +289,7 @@ def write_labs(
 
     target = Path(out)
     results = []
-    with StagedFolder(target, "labs") as stage:
+    with StagedFolder(target, "labs", command=COMMAND) as stage:
         for i, (path, lab, group, _params, nbs, seconds) in enumerate(built, start=1):
             start = time.perf_counter()
             written = {}
@@ -325,7 +326,7 @@ def write_labs(
         }
         write_manifest(
             stage.path,
-            command="uio-teach labs",
+            command=COMMAND,
             config=dict(config) if config is not None else {},
             options=options,
         )

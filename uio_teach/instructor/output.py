@@ -521,12 +521,15 @@ class StagedFolder:
         The folder to make or replace.
     what : str
         What goes in it, for messages (``"figures"``).
+    command : str, optional
+        The command writing it (``"uio-teach labs"``): an earlier output of
+        another command is not replaced (see :func:`check_output_folder`).
 
     Raises
     ------
     OutputError
         ``target`` is a file; or it is a folder that is not empty and has no
-        :data:`MANIFEST` of uio-teach (it does not look like an earlier output:
+        :data:`MANIFEST` of uio-teach (or of ``command``) (it does not look like an earlier output:
         empty it, or choose another folder); or another run is writing it; or
         the staging folder cannot be made beside it.
 
@@ -546,19 +549,22 @@ class StagedFolder:
     ['a.txt', 'manifest.json']
     """
 
-    def __init__(self, target: str | os.PathLike[str], what: str = "output") -> None:
+    def __init__(
+        self, target: str | os.PathLike[str], what: str = "output", command: str | None = None
+    ) -> None:
         self.target = Path(target)
         self.what = what
+        self.command = command
         self.committed = False
         self.path: Path | None = None
         self._lock = FolderLock(self.target)
-        check_output_folder(self.target)
+        check_output_folder(self.target, self.command)
 
     def __enter__(self) -> StagedFolder:
         self._lock.acquire()
         try:
             clean_leftovers(self.target)
-            check_output_folder(self.target)
+            check_output_folder(self.target, self.command)
             parent = self._lock.target.parent
             try:
                 self.path = Path(tempfile.mkdtemp(dir=parent, prefix=f".{self.target.name}.new-"))
@@ -580,7 +586,7 @@ class StagedFolder:
     def commit(self) -> Path:
         """Swap the written folder in place of ``target``; returns ``target``."""
         assert self.path is not None, "use StagedFolder in a with block"
-        check_output_folder(self.target)  # it may have changed while we were writing
+        check_output_folder(self.target, self.command)  # it may have changed while we were writing
         _step()
         target = self._lock.target
         if target.exists() and _exchange(self.path, target):
@@ -662,22 +668,26 @@ def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
     return removed
 
 
-def check_output_folder(target: str | os.PathLike[str]) -> None:
+def check_output_folder(target: str | os.PathLike[str], command: str | None = None) -> None:
     """Raise :class:`OutputError` unless ``target`` may be made or replaced by a run.
 
     It may if it does not exist, is an empty folder, or holds an earlier
-    output (a :data:`MANIFEST` of uio-teach).
+    output (a :data:`MANIFEST` of uio-teach; of ``command``, when given, so
+    that the lab notebooks never replace the figures by mistake).
 
     Parameters
     ----------
     target : str or path-like
         The output folder.
+    command : str, optional
+        The command about to write it (``"uio-teach labs"``): an earlier
+        output of another command is refused too.
 
     Raises
     ------
     OutputError
         ``target`` is a file, or a folder that is not empty and has no
-        manifest of uio-teach.
+        manifest of uio-teach (or of ``command``).
 
     Examples
     --------
@@ -694,9 +704,18 @@ def check_output_folder(target: str | os.PathLike[str]) -> None:
     target = Path(target)
     if target.exists() and not target.is_dir():
         raise OutputError(f"the output folder {os.fspath(target)} is a file, not a folder")
-    if target.is_dir() and any(target.iterdir()) and read_manifest(target) is None:
+    if not target.is_dir() or not any(target.iterdir()):
+        return
+    manifest = read_manifest(target)
+    if manifest is None:
         raise OutputError(
             f"the output folder {os.fspath(target)} is not empty and has no {MANIFEST} of "
             "uio-teach, so it does not look like an earlier output; it is left alone: empty "
             "it or choose another folder"
+        )
+    if command is not None and manifest.get("command") != command:
+        raise OutputError(
+            f"the output folder {os.fspath(target)} holds the output of "
+            f"`{manifest.get('command')}`, not of `{command}`; it is left alone: choose "
+            "another folder"
         )
