@@ -12,7 +12,7 @@ import numpy as np
 from ._display import matrices_html, matrices_text
 from ._validation import as_matrix
 
-__all__ = ["Plant"]
+__all__ = ["Plant", "check_plant"]
 
 _ROWS = {
     "B": "n x m: one row per state",
@@ -350,3 +350,21 @@ class Plant:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def check_plant(plant: Any) -> Plant:
+    """Return ``plant`` if it is a :class:`Plant`; otherwise raise a clear ``ValueError``.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.plant.check_plant(ut.examples.pa9()).n
+    3
+    >>> ut.plant.check_plant([[1.0]])
+    Traceback (most recent call last):
+    ...
+    ValueError: plant must be a uio_teach.Plant, got list
+    """
+    if not isinstance(plant, Plant):
+        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+    return plant

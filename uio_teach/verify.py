@@ -39,6 +39,7 @@ __all__ = [
     "PlacementAccuracyError",
     "check_poles",
     "check_identity",
+    "relative_residual",
 ]
 
 POLE_RTOL = 1e-6
@@ -155,8 +156,50 @@ def check_poles(
     return obtained
 
 
-def check_identity(name: str, residual, scale: float, *, what: str = "the observer") -> float:
-    """Raise if ``||residual|| > IDENTITY_RTOL * scale``; return the relative residual.
+def relative_residual(residual, bound) -> float:
+    """Largest ``|R_ij| / bound_ij``: a residual judged entry by entry against its data.
+
+    ``bound`` is the entrywise size of the terms that formed ``R``, e.g.
+    ``|H| |C| |E| + |E|`` for ``R = H C E - E`` (absolute values entrywise,
+    then matrix products). Round-off makes ``|R_ij|`` at most a few ``n eps``
+    times ``bound_ij``, and the ratio does not change when states, outputs or
+    inputs are measured in other units (diagonal scalings cancel entry by
+    entry), unlike a ratio of norms.
+
+    Parameters
+    ----------
+    residual : array_like
+        The matrix that should be zero.
+    bound : array_like or float
+        Entrywise size of its terms (same shape), or one number.
+
+    Returns
+    -------
+    float
+        0 for an empty or exactly zero residual; ``inf`` when it is not finite
+        or non-zero where its terms are all zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import relative_residual
+    >>> relative_residual(np.array([[1e-20, 0.0]]), np.array([[1e-4, 1e6]]))
+    1e-16
+    """
+    R = np.abs(np.asarray(residual, float))
+    if R.size == 0:
+        return 0.0
+    if not np.all(np.isfinite(R)):
+        return np.inf
+    B = np.broadcast_to(np.abs(np.asarray(bound, float)), R.shape)
+    with np.errstate(all="ignore"):
+        ratio = np.where(R == 0, 0.0, R / B)
+    ratio = np.where(np.isnan(ratio), np.inf, ratio)
+    return float(np.max(ratio))
+
+
+def check_identity(name: str, residual, scale, *, what: str = "the observer") -> float:
+    """Raise if the identity's residual exceeds ``IDENTITY_RTOL`` of its data.
 
     Parameters
     ----------
@@ -164,8 +207,10 @@ def check_identity(name: str, residual, scale: float, *, what: str = "the observ
         The identity, e.g. ``"T E = 0"``.
     residual : array_like
         The matrix that should be zero.
-    scale : float
-        Product of the norms of the factors that form it.
+    scale : float or array_like
+        Either the product of the norms of the factors that form it, or,
+        preferably, the entrywise bound of :func:`relative_residual` (then the
+        check does not depend on the units of the data).
     what : str
         How the design is called in messages.
 
@@ -179,8 +224,11 @@ def check_identity(name: str, residual, scale: float, *, what: str = "the observ
     R = np.asarray(residual, float)
     if R.size == 0:
         return 0.0
-    res = float(np.linalg.norm(R, 2)) if np.all(np.isfinite(R)) else np.inf
-    rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
+    if np.ndim(scale) == 0:
+        res = float(np.linalg.norm(R, 2)) if np.all(np.isfinite(R)) else np.inf
+        rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
+    else:
+        rel = relative_residual(R, scale)
     if not rel <= IDENTITY_RTOL:
         raise PlacementAccuracyError(
             f"{what}: the identity {name} holds only to {rel:.2g} relative to its factors "
