@@ -9,18 +9,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._display import format_poles
+from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
 from .linalg import (
     MARGIN,
     ObservabilitySplit,
     invariant_zeros,
     is_stable,
     left_null,
-    observability_decomposition,
     pinv,
     rank_decision,
     sort_poles,
 )
-from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
 from .plant import Plant, check_plant
 from .verify import IDENTITY_RTOL, relative_residual
 
