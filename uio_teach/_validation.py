@@ -220,3 +220,18 @@ def as_poles(name: str, value: Any) -> np.ndarray:
     # values whose imaginary part is round-off are real
     poles[np.abs(poles.imag) <= tol] = poles[np.abs(poles.imag) <= tol].real
     return poles
+
+
+def read_only(values: Any) -> np.ndarray:
+    """A read-only float copy of ``values`` (results and designs cannot be changed in place).
+
+    Examples
+    --------
+    >>> from uio_teach._validation import read_only
+    >>> a = read_only([1, 2])
+    >>> a.flags.writeable, a.dtype.name
+    (False, 'float64')
+    """
+    arr = np.array(values, dtype=float)
+    arr.setflags(write=False)
+    return arr

@@ -158,11 +158,11 @@ def plant_scaling(plant: Plant) -> Scaling:
     lt, ly, ld, lv = np.zeros(n), np.zeros(p), np.zeros(q), np.zeros(nv)
     for _ in range(_SWEEPS):
         moved = 0.0
-        # the size of the balanced A (its off-diagonal part, else its diagonal, else 1)
+        # the size of the balanced A (its Frobenius norm; 1 when A is zero)
         As = LA + lt[None, :] - lt[:, None] if n else LA
-        target = _lse(As) if n else -np.inf
+        target = float(np.logaddexp2(2 * _lse(As), 2 * _lse(diag)) / 2) if n else -np.inf
         if not np.isfinite(target):
-            target = float(np.max(diag)) if n and np.isfinite(np.max(diag)) else 0.0
+            target = 0.0
         # outputs: each row of [C_s, D_s] to the size of A_s
         rows = (
             np.logaddexp2(2 * _lse(LC + lt[None, :], axis=1), 2 * _lse(LD + lv[None, :], axis=1))

@@ -21,7 +21,7 @@ from .linalg import (
     sort_poles,
 )
 from .plant import Plant, check_plant
-from .verify import IDENTITY_RTOL, relative_residual
+from .verify import IDENTITY_RTOL, product_bound, relative_residual
 
 __all__ = [
     "Condition",
@@ -166,7 +166,7 @@ def projection_gain(plant: Plant, scaling: Scaling | None = None) -> np.ndarray:
         Eb = np.hstack([plant.E, np.zeros((n, nv))])
         if np.all(np.isfinite(G)):
             M = Eb @ pinv(G)
-            bound = np.abs(M) @ np.abs(G) + np.abs(Eb)
+            bound = product_bound((M, G), Eb)
             if np.all(np.isfinite(M)) and relative_residual(M @ G - Eb, bound) <= IDENTITY_RTOL:
                 return M
     s = plant_scaling(plant) if scaling is None else scaling

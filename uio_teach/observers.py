@@ -26,7 +26,7 @@ from .linalg import is_stable, observability_decomposition, pinv, rank, sort_pol
 from .lmi import lmi_gain
 from .placement import place_observer_poles, place_pair_poles, requested_poles
 from .plant import Plant
-from .verify import check_identity, check_poles
+from .verify import check_identity, check_poles, product_bound
 
 __all__ = [
     "Observer",
@@ -527,15 +527,14 @@ def _verify_projection(obs: _ProjectionObserver, what: str) -> None:
     """UIO/PMO decoupling identities: ``H C E = E``, ``T E = 0``, ``H D = 0``, ``L D = 0``."""
     pl = obs.plant
     H, T, K1 = obs._H, obs._T, obs._K1
-    aH, aC, aE, aD = np.abs(H), np.abs(pl.C), np.abs(pl.E), np.abs(pl.D)
     # each identity against the entrywise size of its terms: the same verdict in any units
     if pl.q:
-        HCE = aH @ (aC @ aE) + aE
+        HCE = product_bound((H, np.abs(pl.C) @ np.abs(pl.E)), pl.E)
         check_identity("H C E = E", H @ pl.C @ pl.E - pl.E, HCE, what=what)
         check_identity("T E = 0", T @ pl.E, HCE, what=what)
     if pl.nv:
-        check_identity("H D = 0", H @ pl.D, aH @ aD, what=what)
-        check_identity("L D = 0", K1 @ pl.D, np.abs(K1) @ aD, what=what)
+        check_identity("H D = 0", H @ pl.D, product_bound((H, pl.D)), what=what)
+        check_identity("L D = 0", K1 @ pl.D, product_bound((K1, pl.D)), what=what)
 
 
 def _verify_ginverse(obs: GInverseObserver) -> None:

@@ -40,6 +40,7 @@ __all__ = [
     "check_poles",
     "check_identity",
     "relative_residual",
+    "product_bound",
 ]
 
 POLE_RTOL = 1e-6
@@ -156,15 +157,43 @@ def check_poles(
     return obtained
 
 
+def product_bound(*terms) -> np.ndarray:
+    """Entrywise size of a sum of products, for :func:`relative_residual`.
+
+    Each term is a matrix ``X`` (its entries' sizes ``|X_ij|``) or a pair
+    ``(X, Y)`` standing for the product ``X Y``, whose entry ``(i, j)`` is at
+    most ``||X_i,:|| ||Y_:,j||`` (Cauchy-Schwarz): round-off in any entry of
+    row ``i`` of ``X`` (a computed gain) is judged against that row, not
+    against the entry alone. Rows of ``X`` and columns of ``Y`` scale with the
+    units of the states and inputs they belong to, so the bound does too.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import product_bound
+    >>> product_bound((np.array([[3.0, 4.0]]), np.eye(2)), np.array([[1.0, 0.0]])).tolist()
+    [[16.0, 20.0]]
+    """
+    total = None
+    for term in terms:
+        if isinstance(term, tuple):
+            X, Y = (np.abs(np.atleast_2d(np.asarray(a, float))) for a in term)
+            part = np.outer(np.linalg.norm(X, axis=1), np.linalg.norm(Y, axis=0))
+        else:
+            part = np.abs(np.atleast_2d(np.asarray(term, float)))
+        total = part if total is None else total + part
+    return np.zeros((0, 0)) if total is None else total
+
+
 def relative_residual(residual, bound) -> float:
     """Largest ``|R_ij| / bound_ij``: a residual judged entry by entry against its data.
 
-    ``bound`` is the entrywise size of the terms that formed ``R``, e.g.
-    ``|H| |C| |E| + |E|`` for ``R = H C E - E`` (absolute values entrywise,
-    then matrix products). Round-off makes ``|R_ij|`` at most a few ``n eps``
-    times ``bound_ij``, and the ratio does not change when states, outputs or
-    inputs are measured in other units (diagonal scalings cancel entry by
-    entry), unlike a ratio of norms.
+    ``bound`` is the entrywise size of the terms that formed ``R``
+    (:func:`product_bound`), e.g. ``product_bound((H, |C||E|), E)`` for
+    ``R = H C E - E``. Round-off makes ``|R_ij|`` at most a few ``n eps``
+    times ``bound_ij``, and the ratio does not change when states or inputs
+    are measured in other units (diagonal scalings cancel entry by entry),
+    unlike a ratio of whole-matrix norms.
 
     Parameters
     ----------
