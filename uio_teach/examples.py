@@ -107,7 +107,7 @@ def pa9() -> Plant:
     --------
     >>> from uio_teach import examples
     >>> examples.pa9()
-    Plant('PA9', continuous-time, n=3, m=2, q=1, p=2, r=0)
+    Plant('PA9', continuous-time, n=3, m=2, q=1, p=2, nv=0)
     """
     return Plant(
         [[0, 1, 0], [-2, -3, 0], [0, 0, -2]],
@@ -145,7 +145,7 @@ def missile_autopilot() -> Plant:
     --------
     >>> from uio_teach import examples
     >>> examples.missile_autopilot()
-    Plant('missile autopilot', continuous-time, n=4, m=1, q=2, p=2, r=0)
+    Plant('missile autopilot', continuous-time, n=4, m=1, q=2, p=2, nv=0)
     """
     return Plant(
         [[0, 0, 0, 0], [-86, 0, -12, 0], [0, 0, 0, 1], [0, 0, -32400, -216]],

@@ -326,7 +326,7 @@ class Plant:
             else ("discrete-time" if self.dt is True else f"discrete-time, dt={self.dt:g}")
         )
         name = f"{self.name!r}, " if self.name else ""
-        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, r={self.nv})"
+        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, nv={self.nv})"
 
     def __repr__(self) -> str:
         return self._title()

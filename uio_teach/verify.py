@@ -41,6 +41,7 @@ __all__ = [
     "check_identity",
     "relative_residual",
     "product_bound",
+    "check_fixed_modes",
 ]
 
 POLE_RTOL = 1e-6
@@ -172,7 +173,7 @@ def product_bound(*terms) -> np.ndarray:
     >>> import numpy as np
     >>> from uio_teach.verify import product_bound
     >>> product_bound((np.array([[3.0, 4.0]]), np.eye(2)), np.array([[1.0, 0.0]])).tolist()
-    [[16.0, 20.0]]
+    [[6.0, 5.0]]
     """
     total = None
     for term in terms:
@@ -212,7 +213,7 @@ def relative_residual(residual, bound) -> float:
     --------
     >>> import numpy as np
     >>> from uio_teach.verify import relative_residual
-    >>> relative_residual(np.array([[1e-20, 0.0]]), np.array([[1e-4, 1e6]]))
+    >>> float(relative_residual(np.array([[1e-20, 0.0]]), np.array([[1e-4, 1e6]])))
     1e-16
     """
     R = np.abs(np.asarray(residual, float))
@@ -265,3 +266,53 @@ def check_identity(name: str, residual, scale, *, what: str = "the observer") ->
             "too badly conditioned (scale the plant's states or outputs)"
         )
     return rel
+
+
+def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
+    """Raise unless every fixed mode is among ``values`` (the observer's error poles).
+
+    A decoupling observer cannot move the invariant zeros: they are always
+    error poles. An error matrix without them does not decouple (its error
+    depends on the unknown input), whatever its gain was meant to do.
+
+    Parameters
+    ----------
+    values : array_like of complex
+        The observer's error poles.
+    fixed : array_like of complex
+        The fixed modes (the invariant zeros).
+    what : str
+        How the design is called in messages.
+
+    Raises
+    ------
+    PlacementAccuracyError
+
+    Examples
+    --------
+    >>> from uio_teach.verify import check_fixed_modes
+    >>> check_fixed_modes([-1.0, -2.0, -3.0], [-2.0])
+    >>> try:
+    ...     check_fixed_modes([-1.0, -3.0], [-2.0])
+    ... except ValueError as err:
+    ...     print(str(err)[:50])
+    the observer: the fixed mode(s) {-2} are not error
+    """
+    w = np.asarray(values, complex).ravel()
+    z = np.asarray(fixed, complex).ravel()
+    if not z.size:
+        return
+    if w.size < z.size:
+        missing, nearest = z, np.zeros(0)
+    else:
+        cost = np.abs(z[:, None] - w[None, :])
+        rows, cols = linear_sum_assignment(cost)
+        err = cost[rows, cols] / np.maximum(1.0, np.abs(z[rows]))
+        bad = err > WARN_RTOL
+        missing, nearest = z[rows[bad]], w[cols[bad]]
+    if missing.size:
+        raise PlacementAccuracyError(
+            f"{what}: the fixed mode(s) {_fmt(missing)} are not error poles (nearest "
+            f"{_fmt(nearest)}): the error would depend on the unknown input, so the observer "
+            "is refused"
+        )
