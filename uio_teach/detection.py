@@ -6,9 +6,10 @@ notation ``R1``, ``R2``)::
     x' = A x + B u + E d + R1 f,        y = C x + D v + R2 f
 
 An actuator fault ``i`` has ``R1 = B[:, i]``, a sensor fault ``j`` has
-``R2 = e_j``. The UIO's residual ``r = y - C xhat`` obeys
+``R2 = e_j``. The UIO's residual ``r = y - C xhat`` obeys (``H D = 0``,
+``K1 D = 0``, so ``v`` does not enter the error)::
 
-    e' = F e + T R1 f - K1 R2 f - H R2 f',        r = C e + R2 f
+    e' = F e + T R1 f - K1 R2 f - H R2 f',        r = C e + D v + R2 f
 
 so an actuator or process fault shows in ``r`` unless ``T R1 = 0``, that is
 unless it enters through ``E`` (``R1`` in the range of ``E``). This module
