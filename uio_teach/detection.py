@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from ._display import call_repr
 from ._validation import as_matrix, read_only
 from .observers import Observer
 from .plant import Plant, check_plant
@@ -51,6 +52,13 @@ __all__ = [
 
 
 # faults -------------------------------------------------------------------------------------
+
+
+class _Num(float):
+    """A float shown with 4 significant digits in a repr."""
+
+    def __repr__(self) -> str:
+        return f"{float(self):.4g}"
 
 
 @dataclass(frozen=True)
@@ -92,6 +100,9 @@ class Fault:
     state_direction: np.ndarray
     output_direction: np.ndarray
     signal: Callable[[np.ndarray], Any]
+
+    def __repr__(self) -> str:
+        return call_repr("Fault", [("name", self.name), ("kind", self.kind), ("index", self.index)])
 
 
 def _check_index(name: str, index: Any, size: int, what: str) -> int:
@@ -575,6 +586,19 @@ class Threshold:
         _start(self.start, np.zeros(1), 1.0)
         _per(self.per)
 
+    def __repr__(self) -> str:
+        return call_repr(
+            "Threshold",
+            [
+                ("value", _Num(self.value)),
+                ("window", _Num(self.window)),
+                ("design_rate", _Num(self.design_rate)),
+                ("start", _Num(self.start)),
+                ("samples", self.samples),
+                ("per", self.per),
+            ],
+        )
+
     def __float__(self) -> float:
         return self.value
 
@@ -703,6 +727,19 @@ class Detection:
     evaluation: np.ndarray
     alarm: np.ndarray
     threshold: Threshold
+
+    def __repr__(self) -> str:
+        first = self.first_alarm
+        return call_repr(
+            "Detection",
+            [
+                ("fired", self.fired),
+                ("first_alarm", None if first is None else _Num(first)),
+                ("alarm_samples", int(np.sum(self.alarm))),
+                ("samples", int(self.alarm.size)),
+                ("threshold", _Num(self.threshold.value)),
+            ],
+        )
 
     @property
     def fired(self) -> bool:

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import html
-import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._display import format_poles
+from ._display import LINE_WIDTH, fit_lines, format_poles
 from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
 from .linalg import (
     MARGIN,
@@ -230,16 +229,16 @@ class ExistenceReport:
 
     def __str__(self) -> str:
         head = f"Existence of an unknown input observer for {self.plant!r}"
-        if len(head) > 88:
-            head = f"Existence of an unknown input observer for\n  {self.plant!r}"
+        if len(head) > LINE_WIDTH:
+            head = fit_lines(f"Existence of an unknown input observer for\n  {self.plant!r}")
         width = max(len(c.name) for c in self.conditions)
         lines = [head]
         indent = " " * (width + 6)
         for c in self.conditions:
             tag = "" if c.required else " (info)"
             text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
-            # wrap long reasons under their column so the table fits a notebook page
-            lines.extend(textwrap.wrap(text, 88, subsequent_indent=indent) or [text])
+            # wrap long reasons under their column so the table fits the book's column
+            lines.append(fit_lines(text, indent=indent))
         verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
         lines.append(f"  => {verdict}")
         return "\n".join(lines)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ._display import format_poles
+from ._display import call_repr, fit_lines, format_poles
 from .detection import Threshold, detect, observer_residual, residual_threshold
 from .existence import ExistenceReport, check_existence
 from .linalg import rank
@@ -69,6 +69,18 @@ class BankMember:
     outputs: tuple[int, ...]
     report: ExistenceReport
     observer: UIO | None
+
+    def __repr__(self) -> str:
+        state = "exists" if self.exists else "does not exist"
+        return call_repr(
+            "BankMember",
+            [
+                ("fault", self.fault),
+                ("inputs", self.inputs),
+                ("outputs", self.outputs),
+                ("observer", state),
+            ],
+        )
 
     @property
     def exists(self) -> bool:
@@ -122,6 +134,12 @@ class Isolation:
     faults: tuple[str, ...]
     fired: tuple[bool | None, ...]
     first_alarms: tuple[float | None, ...]
+
+    def __repr__(self) -> str:
+        return call_repr(
+            "Isolation",
+            [("faults", self.faults), ("fired", self.fired), ("suspect", self.suspect)],
+        )
 
     @property
     def suspect(self) -> str:
@@ -348,7 +366,7 @@ class UIOBank:
             else:
                 state = "does not exist: " + ", ".join(c.name for c in m.report.failed)
             lines.append(f"  blind to {m.fault}: {state}")
-        return "\n".join(lines)
+        return fit_lines("\n".join(lines))
 
 
 def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:

@@ -8,7 +8,7 @@ from typing import Any, NamedTuple
 import control as ct
 import numpy as np
 
-from .._display import format_complex, matrices_html, matrices_text
+from .._display import fit_lines, format_complex, matrices_html, matrices_text
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
 
@@ -157,10 +157,10 @@ class Observer:
         return [(k, getattr(self, k)) for k in self._display_names]
 
     def __repr__(self) -> str:
-        return self._title()
+        return fit_lines(self._title())
 
     def __str__(self) -> str:
-        return matrices_text(self._title(), self._items())
+        return fit_lines(matrices_text(self._title(), self._items()))
 
     def _repr_html_(self) -> str:
         return matrices_html(self._title(), self._items())
