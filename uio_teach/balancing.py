@@ -31,6 +31,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
 from .linalg import ObservabilitySplit, left_null, observability_decomposition, sort_poles
 from .plant import Plant
@@ -41,6 +42,7 @@ __all__ = [
     "balanced_plant",
     "BalancedPair",
     "balanced_pair",
+    "modes_agree",
     "pow2",
 ]
 
@@ -306,7 +308,11 @@ class BalancedPair(NamedTuple):
 
 
 def balanced_pair(
-    A1: np.ndarray, C: np.ndarray, D: np.ndarray, scaling: Scaling | None = None
+    A1: np.ndarray,
+    C: np.ndarray,
+    D: np.ndarray,
+    scaling: Scaling | None = None,
+    zeros: np.ndarray | None = None,
 ) -> BalancedPair:
     """Balance the pair ``(A1, N C)`` (``N D = 0``) and split it into observable parts.
 
@@ -317,6 +323,12 @@ def balanced_pair(
     D : array_like, shape (p, nv)
     scaling : Scaling, optional
         The plant's scaling; by default one is computed for ``(A1, C, D)``.
+    zeros : array_like, optional
+        The plant's invariant zeros. In exact arithmetic they are the
+        unobservable modes of the pair; when the staircase's rank decisions
+        find other modes, it is run again with a tighter and a looser rank
+        threshold and the split that agrees with the zeros is kept, so the
+        number of movable poles always agrees with the list of zeros.
 
     Returns
     -------
@@ -339,4 +351,31 @@ def balanced_pair(
     R = Nb * wy[None, :]
     Cn = Nb @ Cb
     split = observability_decomposition(Ab, Cn)
+    if zeros is not None and not modes_agree(split.unobservable_modes * sigma, zeros):
+        for rtol in (1e1, 1e5, 1e7, 1e9):
+            other = observability_decomposition(Ab, Cn, rtol=rtol)
+            if modes_agree(other.unobservable_modes * sigma, zeros):
+                split = other._replace(margin=min(other.margin, 1.0))  # flagged: marginal
+                break
     return BalancedPair(A=Ab, C=Cn, t=t, R=R, sigma=sigma, split=split)
+
+
+def modes_agree(modes: np.ndarray, zeros: np.ndarray, rtol: float = 1e-5) -> bool:
+    """True when ``modes`` and ``zeros`` are the same values (count and, matched, value).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.balancing import modes_agree
+    >>> modes_agree(np.array([-1.0, -2.0]), np.array([-2.0, -1.0 + 1e-9]))
+    True
+    """
+    modes = np.asarray(modes, complex).ravel()
+    zeros = np.asarray(zeros, complex).ravel()
+    if modes.size != zeros.size:
+        return False
+    if not modes.size:
+        return True
+    cost = np.abs(modes[:, None] - zeros[None, :]) / np.maximum(1.0, np.abs(zeros))[None, :]
+    rows, cols = linear_sum_assignment(cost)
+    return bool(np.all(cost[rows, cols] <= rtol))

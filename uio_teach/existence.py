@@ -104,7 +104,10 @@ class Decoupling:
 
 
 def decoupling(
-    plant: Plant, Mv: np.ndarray | None = None, scaling: Scaling | None = None
+    plant: Plant,
+    Mv: np.ndarray | None = None,
+    scaling: Scaling | None = None,
+    zeros: np.ndarray | None = None,
 ) -> Decoupling:
     """Compute ``M``, ``A1`` and the balanced pair ``(A1, N C)`` (rank condition assumed).
 
@@ -116,6 +119,10 @@ def decoupling(
         and invertible).
     scaling : Scaling, optional
         The plant's balancing (:func:`uio_teach.balancing.plant_scaling`).
+    zeros : array_like, optional
+        The plant's invariant zeros (``check_existence(plant).invariant_zeros``):
+        the fixed modes of the pair are made to agree with them (see
+        :func:`uio_teach.balancing.balanced_pair`).
 
     Returns
     -------
@@ -137,7 +144,7 @@ def decoupling(
         M = M + Mv @ (np.eye(p) - G @ pinv(G))
     A1 = (np.eye(n) - M @ plant.C) @ plant.A
     N = left_null(plant.D)
-    pair = balanced_pair(A1, plant.C, plant.D, scaling)
+    pair = balanced_pair(A1, plant.C, plant.D, scaling, zeros)
     return Decoupling(M=M, A1=A1, N=N, pair=pair)
 
 
@@ -525,7 +532,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
     movable = 0
     if rank_cond.holds:
         more, fixed, movable = detectability_conditions(
-            plant, decoupling(plant, scaling=scaling), zeros, size
+            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size
         )
         conds.extend(more)
     else:

@@ -271,7 +271,9 @@ class ObservabilitySplit(NamedTuple):
         return sort_poles(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
 
 
-def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySplit:
+def observability_decomposition(
+    A: np.ndarray, C: np.ndarray, *, rtol: float = 1e3
+) -> ObservabilitySplit:
     """Split ``(A, C)`` into its observable and unobservable parts.
 
     The unobservable subspace is computed by a staircase of orthogonal
@@ -282,6 +284,9 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     ----------
     A : array_like, shape (n, n)
     C : array_like, shape (p, n)
+    rtol : float
+        A singular value of a staircase step counts as zero below
+        ``rtol * max(shape) * eps`` times the data's size.
 
     Returns
     -------
@@ -300,12 +305,12 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     n = A.shape[0]
     # Staircase: W spans the current candidate unobservable subspace (start: ker C).
     margins = [np.inf]
-    W = _null(C, margins=margins) if C.shape[0] else np.eye(n)
+    W = _null(C, margins=margins, rtol=rtol) if C.shape[0] else np.eye(n)
     ref = max(np.linalg.norm(A, 2), np.linalg.norm(C, 2), np.finfo(float).tiny)
     while W.shape[1]:
         # keep the part of W that A maps back into W: ker((I - W W^T) A W)
         R = A @ W - W @ (W.T @ A @ W)
-        K = _null(R, ref=ref, margins=margins)
+        K = _null(R, ref=ref, margins=margins, rtol=rtol)
         if K.shape[1] == W.shape[1]:
             break
         W = W @ K
@@ -321,7 +326,9 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     )
 
 
-def _null(M: np.ndarray, ref: float | None = None, margins: list | None = None) -> np.ndarray:
+def _null(
+    M: np.ndarray, ref: float | None = None, margins: list | None = None, rtol: float = 1e3
+) -> np.ndarray:
     """Orthonormal basis of the right null space of ``M`` (columns).
 
     With ``margins`` (a list), the ratio of the smallest kept singular value to
@@ -333,7 +340,7 @@ def _null(M: np.ndarray, ref: float | None = None, margins: list | None = None) 
         return np.eye(n)
     _, s, Vt = np.linalg.svd(M, full_matrices=True)
     scale = ref if ref is not None else (s[0] if s.size else 0.0)
-    tol = max(M.shape) * 1e3 * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
+    tol = max(M.shape) * rtol * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
     k = int(np.sum(s > tol))
     if margins is not None and k and tol > 0:
         margins.append(float(s[k - 1] / tol))

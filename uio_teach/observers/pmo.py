@@ -168,12 +168,12 @@ def design_pmo(
         raise ValueError("give exactly one of poles= or L= (or use method='lmi')")
     if decay is not None and method != "lmi":
         raise ValueError("decay= is the LMI's bound: use it with method='lmi'")
-    require_existence(plant, "a projection-operator observer")
+    report = require_existence(plant, "a projection-operator observer")
     if Mv is not None:
         if plant.nv:
             raise ValueError("Mv is not supported together with a measurement disturbance D")
         Mv = as_matrix("Mv", Mv, plant.n, plant.p, what="n x p")
-    dec = decoupling(plant, Mv)
+    dec = decoupling(plant, Mv, zeros=report.invariant_zeros)
     certificate = None
     if method == "lmi":
         res = lmi_gain(dec.A1, plant.C, D=plant.D if plant.nv else None, dt=plant.dt, decay=decay)

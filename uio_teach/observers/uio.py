@@ -124,8 +124,8 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     plant = check_plant(plant)
     if (poles is None) == (K1 is None):
         raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
-    require_existence(plant, "an unknown input observer")
-    dec = decoupling(plant)
+    report = require_existence(plant, "an unknown input observer")
+    dec = decoupling(plant, zeros=report.invariant_zeros)
     requested = None
     if K1 is None:
         K1, requested = place_pair_poles(dec.pair, poles)
