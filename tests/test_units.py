@@ -210,7 +210,7 @@ def test_an_inaccurate_solver_status_is_not_a_proof(monkeypatch):
     assert np.max(np.abs(np.linalg.eigvals(F))) < 1
     assert np.all(np.linalg.eigvalsh(F.T @ res.P @ F - res.P) < 0)
     # nothing decides (no placed gain either): "could not decide", never "infeasible"
-    monkeypatch.setattr(ut.lmi, "placed_solution", lambda *args: None)
+    monkeypatch.setattr(ut.lmi, "placed_solution", lambda *args, **kwargs: None)
     with pytest.raises(LMIUndecidedError, match="could not decide"):
         ut.lmi_gain([[1.2, 0.0], [0.0, 0.5]], [[1.0, 0.0]], dt=True)
 

@@ -12,8 +12,9 @@ import scipy.linalg as sla
 
 from ._display import format_complex
 from ._validation import as_matrix
-from .linalg import is_stable, left_null, observability_decomposition, pinv
-from .placement import place_observer_poles
+from .balancing import BalancedPair, balanced_pair
+from .linalg import is_stable, pinv
+from .placement import place_pair_poles
 
 __all__ = [
     "LMIError",
@@ -125,6 +126,7 @@ def lmi_gain(
     dt: float | bool | None = None,
     decay: float | None = None,
     solver: str | None = None,
+    fixed_modes=None,
 ) -> LMIResult:
     r"""Observer gain ``L`` that makes ``A1 - L C`` stable, from an LMI.
 
@@ -159,8 +161,11 @@ def lmi_gain(
         minimum decay rate (decay >= 0).
     solver : str, optional
         An installed cvxpy solver (e.g. ``"CLARABEL"``, ``"SCS"``). By default
-        Clarabel, then SCS if Clarabel fails numerically (as it may on an
-        infeasible LMI).
+        Clarabel, then SCS when Clarabel's answer is inaccurate or fails.
+    fixed_modes : array_like, optional
+        The modes no gain can move, when known (the designs pass the
+        invariant zeros); by default the unobservable modes of the balanced
+        pair ``(A1, N C)``.
 
     Returns
     -------
@@ -218,9 +223,10 @@ def lmi_gain(
         bound = f"poles left of {-(decay or 0.0)}"
     with_d = " with L D = 0" if has_d else ""
 
-    # modes no gain can move: on or beyond the bound, the LMI is infeasible (say which)
-    N = left_null(D) if has_d else np.eye(p)
-    fixed = observability_decomposition(A1, N @ C).unobservable_modes
+    # modes no gain can move: on or beyond the bound, the LMI is infeasible (say which);
+    # decided on the balanced pair, so that the verdict does not depend on the units
+    pair = balanced_pair(A1, C, D if has_d else np.zeros((p, 0)))
+    fixed = pair.fixed_modes if fixed_modes is None else np.asarray(fixed_modes, complex)
     bad = [z for z in fixed if not _meets(np.array([z]), discrete, decay)]
     if bad:
         raise LMIInfeasibleError(
@@ -247,9 +253,10 @@ def lmi_gain(
     except LMIError as err:
         # cross-check: a placed gain that meets the bound, with its Lyapunov certificate,
         # is a solution of the LMI; the solver's word is then not the last one
-        placed = placed_solution(As, Cs, Dd, discrete, decay)
+        placed = placed_solution(A1, C, Dd, discrete, decay, pair=pair)
         if placed is not None:
-            L, P = placed
+            # already in the plant's units: express it in the balanced ones undone below
+            L, P = placed[0] / t[:, None], placed[1] * t[:, None] * t[None, :]
         elif isinstance(err, LMIInfeasibleError):
             raise
         else:
@@ -366,10 +373,12 @@ def placed_solution(
     D: np.ndarray | None,
     discrete: bool,
     decay: float | None,
+    pair: BalancedPair | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """A solution of the LMI from a placed gain and its Lyapunov certificate, or None.
 
-    The movable poles are placed well inside the bound (distinct, real), the
+    The movable poles are placed well inside the bound (distinct, real) on
+    the balanced pair (:func:`uio_teach.placement.place_pair_poles`), the
     fixed modes are checked against it, and ``P`` solves the Lyapunov
     equation of ``A1 - L C``, scaled to meet ``P >= 0.01 I`` and the LMI's
     margin. Used to cross-check a solver that reports infeasibility or
@@ -381,6 +390,8 @@ def placed_solution(
         As for :func:`lmi_gain` (``D`` None when absent).
     discrete : bool
     decay : float or None
+    pair : BalancedPair, optional
+        The balanced pair of ``(A1, C, D)``, when already computed.
 
     Returns
     -------
@@ -395,10 +406,9 @@ def placed_solution(
     True
     """
     n, p = A1.shape[0], C.shape[0]
-    N = left_null(D) if D is not None else np.eye(p)
-    Cn = N @ C
-    split = observability_decomposition(A1, Cn)
-    k = split.Ao.shape[0]
+    if pair is None:
+        pair = balanced_pair(A1, C, D if D is not None else np.zeros((p, 0)))
+    k = pair.movable
     if discrete:
         rho = 1.0 if decay is None else float(decay)
         poles = 0.5 * rho * np.linspace(0.2, 1.0, k)
@@ -409,7 +419,7 @@ def placed_solution(
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            L = place_observer_poles(A1, Cn, poles, split=split, verify=False) @ N
+            L = place_pair_poles(pair, poles)[0] if k else np.zeros((n, p))
         F = A1 - L @ C
         if not np.all(np.isfinite(F)) or not _meets(np.linalg.eigvals(F), discrete, decay):
             return None

@@ -176,7 +176,14 @@ def design_pmo(
     dec = decoupling(plant, Mv, zeros=report.invariant_zeros)
     certificate = None
     if method == "lmi":
-        res = lmi_gain(dec.A1, plant.C, D=plant.D if plant.nv else None, dt=plant.dt, decay=decay)
+        res = lmi_gain(
+            dec.A1,
+            plant.C,
+            D=plant.D if plant.nv else None,
+            dt=plant.dt,
+            decay=decay,
+            fixed_modes=dec.pair.fixed_modes,
+        )
         L, certificate = res.L, res.P
     requested = None
     if method == "lmi":
