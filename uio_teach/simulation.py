@@ -208,6 +208,7 @@ class UIOResponse:
         >>> len(fig.axes)
         5
         """
+        # deferred on purpose: matplotlib is heavy and only plotting needs it
         from .plotting import plot_response
 
         return plot_response(self, **kwargs)
