@@ -10,6 +10,7 @@ import numpy as np
 from ._display import LINE_WIDTH, fit_lines, format_poles
 from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
 from .linalg import (
+    DROP_MARGIN,
     MARGIN,
     ObservabilitySplit,
     invariant_zeros,
@@ -58,8 +59,9 @@ class Condition:
     required: bool = True
     margin: float | None = None
     """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
-    rank threshold); below ``uio_teach.linalg.MARGIN`` the verdict hangs on round-off and
-    the reason says so."""
+    rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
+    threshold, that ratio (threshold / dropped value); below ``uio_teach.linalg.MARGIN`` the
+    verdict hangs on round-off and the reason says so. A rank-0 verdict carries it too."""
 
     @property
     def marginal(self) -> bool:
@@ -277,6 +279,10 @@ class UIOExistenceError(ValueError):
         super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
 
 
+RANK_RTOL = 100.0
+"""The rank condition's thresholds are ``RANK_RTOL * eps`` (``RANK_RTOL * n * eps`` for the
+product ``C E``) times the size of the balanced data: round-off stays well below them."""
+
 ZERO_MARGIN = 1e-6
 """A zero or fixed mode closer than this (relative to ``max(1, ||A||)`` in balanced units) to
 the stability boundary is reported as marginal: round-off of the data could move it across."""
@@ -362,10 +368,16 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     """
     C, E, D = bal.C, bal.E, bal.D
     nC, nE, nD = (float(np.linalg.norm(X, 2)) if X.size else 0.0 for X in (C, E, D))
-    dE, dD = rank_decision(E), rank_decision(D)
-    dG = rank_decision(np.hstack([C @ E, D]), scale=max(nC * nE, nD))
+    # data known to double precision; C E is a sum of n products, so its round-off
+    # grows with n: the thresholds leave room for it (RANK_RTOL)
+    eps = np.finfo(float).eps
+    dE, dD = rank_decision(E, rtol=RANK_RTOL * eps), rank_decision(D, rtol=RANK_RTOL * eps)
+    dG = rank_decision(
+        np.hstack([C @ E, D]), scale=max(nC * nE, nD), rtol=RANK_RTOL * max(bal.n, 1) * eps
+    )
     rE, rD, rG = dE.rank, dD.rank, dG.rank
     margin = min(dE.margin, dD.margin, dG.margin)
+    below = min(dE.below, dD.below, dG.below)
     if bal.nv:
         lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
     else:
@@ -378,7 +390,15 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
             f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
             "at once, so it cannot be cancelled"
         )
-    cond = Condition("rank condition", ok, reason + _margin_note(margin), margin=margin)
+    note = _margin_note(margin)
+    if below < DROP_MARGIN:
+        note += (
+            f" (within the numerical margin: a singular value taken as 0 is only {below:.3g} "
+            "times below the rank threshold, so round-off of the data could change this "
+            "verdict)"
+        )
+        margin = min(margin, below)
+    cond = Condition("rank condition", ok, reason + note, margin=margin)
     return cond, rE
 
 

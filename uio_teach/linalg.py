@@ -40,6 +40,7 @@ import scipy.linalg as sla
 
 __all__ = [
     "MARGIN",
+    "DROP_MARGIN",
     "RankDecision",
     "rank_decision",
     "rank",
@@ -57,6 +58,11 @@ __all__ = [
 MARGIN = 1e4
 """A kept singular value below ``MARGIN`` times the rank threshold makes the verdict marginal."""
 
+DROP_MARGIN = 10.0
+"""A dropped singular value above ``1 / DROP_MARGIN`` of the rank threshold makes a rank-deficient
+verdict marginal (round-off sits well below the threshold when ``rtol`` covers the data's
+precision, e.g. ``100 n eps`` for a product over ``n`` terms)."""
+
 
 class RankDecision(NamedTuple):
     """A numerical rank with the evidence for it.
@@ -72,7 +78,12 @@ class RankDecision(NamedTuple):
         rank is 0 or no singular value was dropped by a hair): how far the
         verdict is from the boundary.
     marginal : bool
-        ``margin < MARGIN``: the verdict hangs on round-off.
+        ``margin < MARGIN`` or ``below < DROP_MARGIN``: the verdict hangs on
+        round-off.
+    below : float
+        The threshold divided by the largest dropped singular value (``inf``
+        when none was dropped or it is exactly 0): how far a rank-deficient
+        verdict is from the boundary on the other side.
 
     Examples
     --------
@@ -85,6 +96,7 @@ class RankDecision(NamedTuple):
     threshold: float
     margin: float
     marginal: bool
+    below: float = np.inf
 
 
 def _threshold(shape, scale: float, rtol: float | None = None) -> float:
@@ -136,7 +148,8 @@ def rank_decision(
     tol = _threshold(M.shape, ref, rtol)
     r = int(np.sum(s > tol))
     margin = float(s[r - 1] / tol) if r and tol > 0 else np.inf
-    return RankDecision(r, tol, margin, bool(margin < MARGIN))
+    below = float(tol / s[r]) if r < s.size and s[r] > 0 else np.inf
+    return RankDecision(r, tol, margin, bool(margin < MARGIN or below < DROP_MARGIN), below)
 
 
 def rank(M: np.ndarray, *, scale: float | None = None) -> int:
