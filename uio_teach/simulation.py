@@ -234,7 +234,12 @@ class UIOResponse:
 # validation -----------------------------------------------------------------------------
 
 
-def _check_timepts(timepts: Any) -> np.ndarray:
+def check_timepts(timepts: Any) -> np.ndarray:
+    """Time points: a read-only 1-D array, finite and strictly increasing.
+
+    >>> check_timepts([0, 1, 2]).tolist()
+    [0.0, 1.0, 2.0]
+    """
     t = as_time("timepts", timepts)
     t.setflags(write=False)
     return t
@@ -309,8 +314,14 @@ _WHAT = {
 }
 
 
-def _signal(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
-    """Sample a signal argument on the grid ``t``: a ``(k, N)`` float array, validated."""
+def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
+    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`simulate`) on the grid ``t``.
+
+    Returns a validated ``(k, N)`` float array; ``name`` names it in messages.
+
+    >>> input_samples("d", lambda t: 2 * t, 1, np.array([0.0, 1.0])).tolist()
+    [[0.0, 2.0]]
+    """
     N = t.size
     if value is None:
         return np.zeros((k, N))
@@ -645,34 +656,6 @@ def linear_response(
         return _recursion(Phi, G0, G1, S, z0)
 
 
-def check_timepts(timepts: Any) -> np.ndarray:
-    """Time points as a 1-D float array of at least two increasing, finite values.
-
-    Examples
-    --------
-    >>> from uio_teach.simulation import check_timepts
-    >>> check_timepts([0, 1, 2]).tolist()
-    [0.0, 1.0, 2.0]
-    """
-    return _check_timepts(timepts)
-
-
-def input_samples(name: str, value: SignalLike, k: int, timepts: np.ndarray) -> np.ndarray:
-    """Samples ``(k, N)`` of a signal given as callable(s), array or None (zero).
-
-    The rules of :func:`simulate`'s ``u``, ``d`` and ``v`` arguments; ``name``
-    names the signal in error messages.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from uio_teach.simulation import input_samples
-    >>> input_samples("d", lambda t: 2 * t, 1, np.array([0.0, 1.0])).tolist()
-    [[0.0, 2.0]]
-    """
-    return _signal(name, value, k, np.asarray(timepts, float))
-
-
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
 
 
@@ -856,7 +839,7 @@ def simulate(
         )
 
     as_seed("seed", seed)
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     N = t.size
     if plant.is_discrete:
         _check_discrete_grid(plant, t)
@@ -864,9 +847,9 @@ def simulate(
     # all inputs in one array s = [u; d; v; noise]; the recorded inputs are views of it
     m, q, r, p = plant.m, plant.q, plant.nv, plant.p
     S = np.empty((m + q + r + p, N))
-    S[:m] = _signal("u", u, m, t)
-    S[m : m + q] = _signal("d", d, q, t)
-    S[m + q : m + q + r] = _signal("v", v, r, t)
+    S[:m] = input_samples("u", u, m, t)
+    S[m : m + q] = input_samples("d", d, q, t)
+    S[m + q : m + q + r] = input_samples("v", v, r, t)
     S[m + q + r :] = _noise(noise, seed, p, N)
     S.setflags(write=False)
     inputs = SimulationInputs(u=S[:m], d=S[m : m + q], v=S[m + q : m + q + r], noise=S[m + q + r :])
