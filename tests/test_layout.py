@@ -28,7 +28,8 @@ ABOVE = {
 }
 # The algorithm layer (with the worked examples and plotting): every other top-level module.
 ALGORITHMS = sorted(
-    p.stem for p in PACKAGE.glob("*.py") if p.stem not in ABOVE and p.stem != "__init__"
+    [p.stem for p in PACKAGE.glob("*.py") if p.stem not in ABOVE and p.stem != "__init__"]
+    + [p.parent.name for p in PACKAGE.glob("*/__init__.py") if p.parent.name not in ABOVE]
 )
 
 
@@ -62,9 +63,13 @@ MODULES = sorted(PACKAGE.rglob("*.py"))
 
 @pytest.mark.parametrize("name", ALGORITHMS)
 def test_algorithms_import_nothing_above_them(name):
-    path = PACKAGE / f"{name}.py"
+    paths = [PACKAGE / f"{name}.py"] if (PACKAGE / f"{name}.py").exists() else []
+    paths += sorted((PACKAGE / name).glob("*.py")) if (PACKAGE / name).is_dir() else []
     above = sorted(
-        m for m in _imports(path) if m.startswith("uio_teach.") and m.split(".")[1] in ABOVE
+        m
+        for path in paths
+        for m in _imports(path)
+        if m.startswith("uio_teach.") and m.split(".")[1] in ABOVE
     )
     assert not above, f"uio_teach.{name} imports {above}"
 

@@ -39,12 +39,20 @@ def test_rank_decision_reports_a_marginal_verdict():
 
 
 def test_marginal_rank_condition_says_so_in_the_report():
-    # C E = 1e-13: rank 1 against ||C|| ||E|| = 1, but only ~200 times the threshold
-    plant = ut.Plant(np.diag([-1.0, -2.0]), [[1.0, 0.0]], E=[1e-13, 1.0])
+    # two unknown inputs whose directions differ by 1e-13: in any units, rank(E) = 2
+    # only ~100 times above the threshold
+    plant = ut.Plant(np.diag([-1.0, -2.0]), np.eye(2), E=[[1.0, 1.0], [1.0, 1.0 + 1e-13]])
     cond = ut.check_existence(plant)["rank condition"]
     assert cond.holds is True
     assert cond.marginal and cond.margin < MARGIN
     assert "within the numerical margin" in cond.reason and f"{cond.margin:.3g}" in cond.reason
+
+
+def test_a_tiny_product_is_not_marginal_when_it_is_a_matter_of_units():
+    # C E = 1e-13 only because the first state is measured in tiny units
+    plant = ut.Plant(np.diag([-1.0, -2.0]), [[1.0, 0.0]], E=[1e-13, 1.0])
+    cond = ut.check_existence(plant)["rank condition"]
+    assert cond.holds is True and not cond.marginal
 
 
 def test_clear_verdicts_carry_no_margin_note():
@@ -89,8 +97,10 @@ def test_observability_split_reports_its_margin():
     # the second mode is seen through 1e-11 only: observable, but close to the threshold
     split = ut.linalg.observability_decomposition(np.diag([-1.0, -2.0]), [[1.0, 1e-11]])
     assert split.Au.size == 0 and split.marginal
+    # the report decides in balanced units: the second state in other units is seen clearly
     report = ut.check_existence(ut.Plant(np.diag([-1.0, -2.0]), [[1.0, 1e-11]]))
-    assert "within the numerical margin" in report["observable (TA, C)"].reason
+    assert report["observable (TA, C)"].holds
+    assert "within the numerical margin" not in report["observable (TA, C)"].reason
     split = ut.linalg.observability_decomposition(np.diag([-1.0, -2.0]), [[1.0, 1.0]])
     assert not split.marginal
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import textwrap
 from collections.abc import Iterable
 
 import numpy as np
@@ -14,7 +15,71 @@ __all__ = [
     "format_complex",
     "format_poles",
     "format_matrix_line",
+    "LINE_WIDTH",
+    "fit_lines",
+    "call_repr",
 ]
+
+LINE_WIDTH = 76
+"""Printed lines fit the book's column (1280 px): at most this many characters."""
+
+
+def fit_lines(text: str, width: int = LINE_WIDTH, indent: str | None = None) -> str:
+    """Wrap every line of ``text`` longer than ``width`` at spaces (never inside a word).
+
+    Continuation lines get ``indent``, by default the line's own leading
+    spaces plus two.
+
+    Examples
+    --------
+    >>> from uio_teach._display import fit_lines
+    >>> print(fit_lines("a UIO for a plant with many outputs and inputs", 20))
+    a UIO for a plant
+      with many outputs
+      and inputs
+    """
+    out = []
+    for line in text.split("\n"):
+        if len(line) <= width:
+            out.append(line)
+            continue
+        lead = line[: len(line) - len(line.lstrip())]
+        hang = lead + "  " if indent is None else indent
+        out.extend(
+            textwrap.wrap(
+                line,
+                width,
+                subsequent_indent=hang,
+                break_long_words=False,
+                break_on_hyphens=False,
+            )
+            or [line]
+        )
+    return "\n".join(out)
+
+
+def call_repr(name: str, fields: Iterable[tuple[str, object]], width: int = LINE_WIDTH) -> str:
+    """``name(key=value, ...)`` wrapped after commas to fit ``width``.
+
+    Examples
+    --------
+    >>> from uio_teach._display import call_repr
+    >>> call_repr("Threshold", [("value", 0.5), ("per", "run")])
+    "Threshold(value=0.5, per='run')"
+    """
+    parts = [f"{k}={v!r}" for k, v in fields]
+    pad = " " * (len(name) + 1)
+    lines, cur = [], name + "("
+    for i, part in enumerate(parts):
+        piece = part + ("," if i < len(parts) - 1 else ")")
+        if len(cur) + len(piece) + 1 > width and cur.strip() not in (name + "(", ""):
+            lines.append(cur.rstrip())
+            cur = pad
+        cur += piece if cur.endswith("(") or cur == pad else " " + piece
+    if not parts:
+        cur += ")"
+    lines.append(cur)
+    return "\n".join(lines)
 
 
 def format_complex(z: complex, digits: int = 4) -> str:

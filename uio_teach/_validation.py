@@ -178,7 +178,19 @@ def as_matrix(
 
 
 def as_poles(name: str, value: Any) -> np.ndarray:
-    """Return requested poles as a 1-D complex array; conjugate pairs are required."""
+    """Return requested poles as a 1-D complex array; conjugate pairs are required.
+
+    A pair conjugate to within ``1e-9`` (relative) is made exactly conjugate
+    and a round-off imaginary part dropped, so the designs place exactly the
+    poles the validator accepted.
+
+    Examples
+    --------
+    >>> from uio_teach._validation import as_poles
+    >>> p = as_poles("poles", [-1 + 2j, -1 - 2j + 1e-13j])
+    >>> bool(p[0] == p[1].conjugate())
+    True
+    """
     if isinstance(value, (str, bytes)) or np.asarray(value).dtype.kind in "US":
         raise ValueError(f"{name} must be a list of numbers, got {value!r}")
     try:
@@ -189,14 +201,38 @@ def as_poles(name: str, value: Any) -> np.ndarray:
         raise ValueError(f"{name} must be finite numbers, got {value!r}")
     scale = max(1.0, float(np.max(np.abs(poles)))) if poles.size else 1.0
     tol = 1e-9 * scale
-    unmatched = list(poles[np.abs(poles.imag) > tol])
+    poles = poles.copy()
+    unmatched = [int(i) for i in np.flatnonzero(np.abs(poles.imag) > tol)]
     while unmatched:
-        p = unmatched.pop(0)
-        idx = [i for i, q in enumerate(unmatched) if abs(q - np.conj(p)) <= tol]
+        i = unmatched.pop(0)
+        p = poles[i]
+        idx = [j for j in unmatched if abs(poles[j] - np.conj(p)) <= tol]
         if not idx:
             raise ValueError(
                 f"{name}: the complex pole {p:.6g} has no conjugate partner; complex poles "
                 "must come in conjugate pairs so that the gain is real"
             )
-        unmatched.pop(idx[0])
+        # a pair conjugate to within round-off is made exactly conjugate, so that the
+        # design sees the same pair the validator accepted
+        j = idx[0]
+        unmatched.remove(j)
+        mid = 0.5 * (p + np.conj(poles[j]))
+        poles[i], poles[j] = mid, np.conj(mid)
+    # values whose imaginary part is round-off are real
+    poles[np.abs(poles.imag) <= tol] = poles[np.abs(poles.imag) <= tol].real
     return poles
+
+
+def read_only(values: Any) -> np.ndarray:
+    """A read-only float copy of ``values`` (results and designs cannot be changed in place).
+
+    Examples
+    --------
+    >>> from uio_teach._validation import read_only
+    >>> a = read_only([1, 2])
+    >>> a.flags.writeable, a.dtype.name
+    (False, 'float64')
+    """
+    arr = np.array(values, dtype=float)
+    arr.setflags(write=False)
+    return arr

@@ -6,9 +6,10 @@ notation ``R1``, ``R2``)::
     x' = A x + B u + E d + R1 f,        y = C x + D v + R2 f
 
 An actuator fault ``i`` has ``R1 = B[:, i]``, a sensor fault ``j`` has
-``R2 = e_j``. The UIO's residual ``r = y - C xhat`` obeys
+``R2 = e_j``. The UIO's residual ``r = y - C xhat`` obeys (``H D = 0``,
+``K1 D = 0``, so ``v`` does not enter the error)::
 
-    e' = F e + T R1 f - K1 R2 f - H R2 f',        r = C e + R2 f
+    e' = F e + T R1 f - K1 R2 f - H R2 f',        r = C e + D v + R2 f
 
 so an actuator or process fault shows in ``r`` unless ``T R1 = 0``, that is
 unless it enters through ``E`` (``R1`` in the range of ``E``). This module
@@ -27,19 +28,11 @@ from typing import Any
 
 import numpy as np
 
-from ._validation import as_matrix
+from ._display import call_repr
+from ._validation import as_matrix, read_only
 from .observers import Observer
-from .plant import Plant
-from .simulation import (
-    UIOResponse,
-    _check_timepts,
-    _one_blas_thread,
-    _recursion,
-    _signal,
-    _uniform_step,
-    foh_matrices,
-    simulate,
-)
+from .plant import Plant, check_plant
+from .simulation import UIOResponse, check_timepts, input_samples, linear_response, simulate
 
 __all__ = [
     "Fault",
@@ -59,6 +52,13 @@ __all__ = [
 
 
 # faults -------------------------------------------------------------------------------------
+
+
+class _Num(float):
+    """A float shown with 4 significant digits in a repr."""
+
+    def __repr__(self) -> str:
+        return f"{float(self):.4g}"
 
 
 @dataclass(frozen=True)
@@ -101,11 +101,8 @@ class Fault:
     output_direction: np.ndarray
     signal: Callable[[np.ndarray], Any]
 
-
-def _check_plant(plant: Any) -> Plant:
-    if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
-    return plant
+    def __repr__(self) -> str:
+        return call_repr("Fault", [("name", self.name), ("kind", self.kind), ("index", self.index)])
 
 
 def _check_index(name: str, index: Any, size: int, what: str) -> int:
@@ -118,7 +115,7 @@ def _check_index(name: str, index: Any, size: int, what: str) -> int:
     return int(index)
 
 
-def _check_signal(signal: Any) -> Callable:
+def _checkinput_samples(signal: Any) -> Callable:
     if not callable(signal):
         raise ValueError(
             f"signal must be a callable of time (e.g. ut.signals.step(1.0, 2.0)), got "
@@ -149,15 +146,15 @@ def actuator_fault(plant: Plant, index: int, signal: Callable) -> Fault:
     >>> ut.actuator_fault(ut.examples.pa9(), 1, ut.signals.step(1.0)).state_direction
     array([0., 0., 1.])
     """
-    plant = _check_plant(plant)
+    plant = check_plant(plant)
     i = _check_index("index", index, plant.m, "actuators (columns of B)")
     return Fault(
         name=f"actuator {i + 1}",
         kind="actuator",
         index=i,
-        state_direction=_ro(plant.B[:, i]),
-        output_direction=_ro(np.zeros(plant.p)),
-        signal=_check_signal(signal),
+        state_direction=read_only(plant.B[:, i]),
+        output_direction=read_only(np.zeros(plant.p)),
+        signal=_checkinput_samples(signal),
     )
 
 
@@ -183,15 +180,15 @@ def sensor_fault(plant: Plant, index: int, signal: Callable) -> Fault:
     >>> ut.sensor_fault(ut.examples.pa9(), 1, ut.signals.step(1.0)).output_direction
     array([0., 1.])
     """
-    plant = _check_plant(plant)
+    plant = check_plant(plant)
     j = _check_index("index", index, plant.p, "sensors (rows of C)")
     return Fault(
         name=f"sensor {j + 1}",
         kind="sensor",
         index=j,
-        state_direction=_ro(np.zeros(plant.n)),
-        output_direction=_ro(np.eye(plant.p)[j]),
-        signal=_check_signal(signal),
+        state_direction=read_only(np.zeros(plant.n)),
+        output_direction=read_only(np.eye(plant.p)[j]),
+        signal=_checkinput_samples(signal),
     )
 
 
@@ -223,22 +220,16 @@ def process_fault(
     >>> ut.process_fault(plant, plant.E[:, 0], ut.signals.step(1.0), name="through E").name
     'through E'
     """
-    plant = _check_plant(plant)
+    plant = check_plant(plant)
     R1 = as_matrix("direction", direction, plant.n, 1, what="n: one entry per state")
     return Fault(
         name=str(name),
         kind="process",
         index=None,
-        state_direction=_ro(R1[:, 0]),
-        output_direction=_ro(np.zeros(plant.p)),
-        signal=_check_signal(signal),
+        state_direction=read_only(R1[:, 0]),
+        output_direction=read_only(np.zeros(plant.p)),
+        signal=_checkinput_samples(signal),
     )
-
-
-def _ro(a: np.ndarray) -> np.ndarray:
-    arr = np.array(a, dtype=float)
-    arr.setflags(write=False)
-    return arr
 
 
 def faulty_plant(plant: Plant, fault: Fault) -> Plant:
@@ -265,7 +256,7 @@ def faulty_plant(plant: Plant, fault: Fault) -> Plant:
     >>> faulty_plant(plant, ut.sensor_fault(plant, 0, ut.signals.step(1.0)))
     Plant('PA9 with sensor 1 fault', continuous-time, n=3, m=2, q=2, p=2, nv=1)
     """
-    plant = _check_plant(plant)
+    plant = check_plant(plant)
     if not isinstance(fault, Fault):
         raise ValueError(f"fault must be a Fault (actuator_fault, ...), got {type(fault).__name__}")
     if fault.state_direction.shape != (plant.n,) or fault.output_direction.shape != (plant.p,):
@@ -345,7 +336,7 @@ def simulate_fault(
     >>> float(np.abs(resp.residual[:, t < 2]).max()), bool(np.abs(resp.residual).max() > 0.1)
     (0.0, True)
     """
-    plant = _check_plant(plant)
+    plant = check_plant(plant)
     if fault is None:
         return simulate(
             plant,
@@ -360,10 +351,10 @@ def simulate_fault(
             seed=seed,
         )
     true_plant = faulty_plant(plant, fault)
-    t = _check_timepts(timepts)
-    f = _signal("fault.signal", fault.signal, 1, t)
-    d_all = np.vstack([_signal("d", d, plant.q, t), f])
-    v_all = np.vstack([_signal("v", v, plant.nv, t), f])
+    t = check_timepts(timepts)
+    f = input_samples("fault.signal", fault.signal, 1, t)
+    d_all = np.vstack([input_samples("d", d, plant.q, t), f])
+    v_all = np.vstack([input_samples("v", v, plant.nv, t), f])
     return simulate(
         true_plant,
         observer,
@@ -384,8 +375,8 @@ def observer_residual(
     """Run an observer on recorded inputs and measurements and return its residual ``y - C xhat``.
 
     The observer is driven by ``[u; y]``, solved exactly for data linear
-    between samples as in :func:`uio_teach.simulate` (a continuous-time
-    observer needs uniformly spaced ``timepts``), so it can be an observer for a different
+    between samples as in :func:`uio_teach.simulate` (both run on
+    :func:`uio_teach.simulation.linear_response`), so it can be an observer for a different
     plant model than the one that produced the data: a member of a bank that
     reads only some inputs and outputs.
 
@@ -427,7 +418,7 @@ def observer_residual(
             f"{type(observer).__name__}"
         )
     pl = observer.plant
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     N = t.size
     U = _samples("u", u, pl.m, N)
     Y = _samples("y", y, pl.p, N)
@@ -440,19 +431,10 @@ def observer_residual(
             "observer_state", observer_state, nw, 1, what=f"one value per observer state, {nw}"
         )[:, 0]
     )
+    # the observer alone, driven by [u; y], on the package's one simulation engine
     S = np.vstack([U, Y])
     Bs = np.hstack([real.B_u, real.B_y])
-    with _one_blas_thread():
-        if pl.is_discrete:
-            # w[k+1] = A w[k] + B s[k]
-            w = _recursion(real.A, Bs, None, S, w0)
-        else:
-            h = _uniform_step(t)
-            if h is None:
-                raise ValueError("timepts must be uniformly spaced for a continuous-time observer")
-            # exact for inputs linear between samples: w[k+1] = Phi w[k] + G0 s[k] + G1 s[k+1]
-            Phi, G0, G1 = foh_matrices(real.A, Bs, h)
-            w = _recursion(Phi, G0, G1, S, w0)
+    w = linear_response(real.A, Bs, t, S, w0, discrete=pl.is_discrete)
     xhat = real.C @ w + real.D_y @ Y
     return Y - pl.C @ xhat
 
@@ -531,7 +513,7 @@ def residual_rms(timepts: Any, residual: Any, window: float) -> np.ndarray:
     >>> float(J[-1].round(6))  # |r| = sqrt(2) everywhere
     1.414214
     """
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     w = _positive("window", window)
     one = np.ndim(residual) <= 2
     R = _residual_runs("residual", residual, t.size)
@@ -604,6 +586,19 @@ class Threshold:
         _start(self.start, np.zeros(1), 1.0)
         _per(self.per)
 
+    def __repr__(self) -> str:
+        return call_repr(
+            "Threshold",
+            [
+                ("value", _Num(self.value)),
+                ("window", _Num(self.window)),
+                ("design_rate", _Num(self.design_rate)),
+                ("start", _Num(self.start)),
+                ("samples", self.samples),
+                ("per", self.per),
+            ],
+        )
+
     def __float__(self) -> float:
         return self.value
 
@@ -660,7 +655,7 @@ def residual_threshold(
     >>> round(ut.false_alarm_rate(t, fresh, thr), 3)
     0.0...
     """
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     rate = _rate(false_alarm_rate)
     w = _positive("window", window)
     s = _start(start, t, w)
@@ -733,6 +728,19 @@ class Detection:
     alarm: np.ndarray
     threshold: Threshold
 
+    def __repr__(self) -> str:
+        first = self.first_alarm
+        return call_repr(
+            "Detection",
+            [
+                ("fired", self.fired),
+                ("first_alarm", None if first is None else _Num(first)),
+                ("alarm_samples", int(np.sum(self.alarm))),
+                ("samples", int(self.alarm.size)),
+                ("threshold", _Num(self.threshold.value)),
+            ],
+        )
+
     @property
     def fired(self) -> bool:
         """True if an alarm was raised at any monitored time point."""
@@ -784,7 +792,7 @@ def detect(timepts: Any, residual: Any, threshold: Threshold) -> Detection:
     >>> 5.0 < det.first_alarm < 6.0
     True
     """
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     thr = _check_threshold(threshold)
     R = _residual_runs("residual", residual, t.size)
     if R.shape[0] != 1:
@@ -827,7 +835,7 @@ def false_alarm_rate(
     >>> ut.false_alarm_rate(t, np.zeros((3, 2, t.size)), thr)
     0.0
     """
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     thr = _check_threshold(threshold)
     R = _residual_runs("residuals", residuals, t.size)
     J = residual_rms(t, R, thr.window)[:, t >= thr.start]
@@ -871,7 +879,7 @@ def detection_time(timepts: Any, residual: Any, threshold: Threshold, fault_time
     >>> ut.detection_time(t, 0 * r, thr, fault_time=4.0)
     inf
     """
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     if (
         isinstance(fault_time, bool)
         or not isinstance(fault_time, Real)

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from . import signals
+from ._validation import read_only
 from .plant import Plant
 
 __all__ = [
@@ -34,12 +35,6 @@ __all__ = [
     "PA9_PUBLISHED",
     "MISSILE_PUBLISHED",
 ]
-
-
-def _ro(a) -> np.ndarray:
-    arr = np.array(a, dtype=float)
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True)
@@ -96,9 +91,9 @@ DT_CASE_STUDY_PUBLISHED = Published(
     decimals=4,
     values=MappingProxyType(
         {
-            "M": _ro([[-0.5, 2.5], [-0.5, 2.5], [-0.5, 2.5]]),
-            "L": _ro([[0.1667, -0.8333], [0.2833, -1.4167], [0.2667, -1.3333]]),
-            "poles": _ro([0.0, 0.5, 0.5]),
+            "M": read_only([[-0.5, 2.5], [-0.5, 2.5], [-0.5, 2.5]]),
+            "L": read_only([[0.1667, -0.8333], [0.2833, -1.4167], [0.2667, -1.3333]]),
+            "poles": read_only([0.0, 0.5, 0.5]),
         }
     ),
 )
@@ -112,7 +107,7 @@ def pa9() -> Plant:
     --------
     >>> from uio_teach import examples
     >>> examples.pa9()
-    Plant('PA9', continuous-time, n=3, m=2, q=1, p=2, r=0)
+    Plant('PA9', continuous-time, n=3, m=2, q=1, p=2, nv=0)
     """
     return Plant(
         [[0, 1, 0], [-2, -3, 0], [0, 0, -2]],
@@ -128,12 +123,12 @@ PA9_PUBLISHED = Published(
     decimals=2,
     values=MappingProxyType(
         {
-            "H": _ro([[0.94, 0.23], [0, 0], [0.23, 0.05]]),
-            "T": _ro([[0.05, 0, -0.23], [0, 1, 0], [-0.23, 0, 0.94]]),
-            "K1": _ro([[1.97, 0.32], [-2.04, -0.02], [-0.16, -0.86]]),
-            "K2": _ro([[-1.82, -0.45], [0.04, 0.01], [-0.08, -0.02]]),
-            "F": _ro([[-1.97, 0.05, 0.14], [0.04, -3, 0.02], [0.16, -0.23, -1.02]]),
-            "poles": _ro([-3.0, -2.0, -1.0]),
+            "H": read_only([[0.94, 0.23], [0, 0], [0.23, 0.05]]),
+            "T": read_only([[0.05, 0, -0.23], [0, 1, 0], [-0.23, 0, 0.94]]),
+            "K1": read_only([[1.97, 0.32], [-2.04, -0.02], [-0.16, -0.86]]),
+            "K2": read_only([[-1.82, -0.45], [0.04, 0.01], [-0.08, -0.02]]),
+            "F": read_only([[-1.97, 0.05, 0.14], [0.04, -3, 0.02], [0.16, -0.23, -1.02]]),
+            "poles": read_only([-3.0, -2.0, -1.0]),
         }
     ),
 )
@@ -150,7 +145,7 @@ def missile_autopilot() -> Plant:
     --------
     >>> from uio_teach import examples
     >>> examples.missile_autopilot()
-    Plant('missile autopilot', continuous-time, n=4, m=1, q=2, p=2, r=0)
+    Plant('missile autopilot', continuous-time, n=4, m=1, q=2, p=2, nv=0)
     """
     return Plant(
         [[0, 0, 0, 0], [-86, 0, -12, 0], [0, 0, 0, 1], [0, 0, -32400, -216]],
@@ -184,8 +179,8 @@ MISSILE_PUBLISHED = Published(
     decimals=2,
     values=MappingProxyType(
         {
-            "Mv": _ro([[-5, 7], [2, 7], [5, 8], [5, 9]]),
-            "x0": _ro([20, 0.25, 1.43, 100]),
+            "Mv": read_only([[-5, 7], [2, 7], [5, 8], [5, 9]]),
+            "x0": read_only([20, 0.25, 1.43, 100]),
             # Table II: time (s) after which each estimate "catches" the true signal
             "catch_pmo": MappingProxyType(
                 {"x1": 0.03, "x2": 0.03, "x3": 0.04, "x4": 0.05, "v1": 0.08, "v2": 0.07}

@@ -3,25 +3,38 @@
 from __future__ import annotations
 
 import html
-import textwrap
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._display import format_poles
+from ._display import LINE_WIDTH, fit_lines, format_poles
+from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
 from .linalg import (
+    DROP_MARGIN,
     MARGIN,
     ObservabilitySplit,
     invariant_zeros,
     is_stable,
     left_null,
-    observability_decomposition,
     pinv,
     rank_decision,
+    sort_poles,
 )
-from .plant import Plant
+from .plant import Plant, check_plant
+from .verify import IDENTITY_RTOL, product_bound, relative_residual
 
-__all__ = ["Condition", "ExistenceReport", "UIOExistenceError", "check_existence"]
+__all__ = [
+    "Condition",
+    "Decoupling",
+    "ExistenceReport",
+    "UIOExistenceError",
+    "boundary_note",
+    "check_existence",
+    "decoupling",
+    "detectability_conditions",
+    "rank_condition",
+    "zero_condition",
+]
 
 
 @dataclass(frozen=True)
@@ -46,8 +59,9 @@ class Condition:
     required: bool = True
     margin: float | None = None
     """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
-    rank threshold); below ``uio_teach.linalg.MARGIN`` the verdict hangs on round-off and
-    the reason says so."""
+    rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
+    threshold, that ratio (threshold / dropped value); below ``uio_teach.linalg.MARGIN`` the
+    verdict hangs on round-off and the reason says so. A rank-0 verdict carries it too."""
 
     @property
     def marginal(self) -> bool:
@@ -64,32 +78,110 @@ class Condition:
 
 @dataclass(frozen=True)
 class Decoupling:
-    """The decoupling step shared by every projection-type design (internal).
+    """The decoupling step shared by every projection-type design.
 
     ``M = [E 0][CE D]^+ + Mv (I - [CE D][CE D]^+)``, ``A1 = (I - M C) A``,
-    ``N`` annihilates ``D`` so that gains of the form ``L = L' N`` satisfy
-    ``L D = 0``; ``split`` is the observability decomposition of ``(A1, N C)``.
+    ``N`` (orthonormal rows) annihilates ``D`` so that gains of the form
+    ``L = L' N`` satisfy ``L D = 0``; ``pair`` is the pair ``(A1, N C)`` in
+    balanced units with its observability split (what a gain can move is
+    decided there, so it does not depend on the units of the data).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> dec = ut.existence.decoupling(ut.examples.missile_autopilot())
+    >>> dec.pair.movable, dec.pair.fixed_modes.round(1).tolist()
+    (2, [(-105.6-142.1j), (-105.6+142.1j)])
     """
 
     M: np.ndarray
     A1: np.ndarray
     N: np.ndarray
-    split: ObservabilitySplit
+    pair: BalancedPair
+
+    @property
+    def split(self) -> ObservabilitySplit:
+        """The observability split of the balanced pair (balanced coordinates)."""
+        return self.pair.split
 
 
-def decoupling(plant: Plant, Mv: np.ndarray | None = None) -> Decoupling:
-    """Compute ``M``, ``A1`` and the observability split (rank condition assumed)."""
-    n, p, r = plant.n, plant.p, plant.nv
-    G = np.hstack([plant.C @ plant.E, plant.D])
-    Eb = np.hstack([plant.E, np.zeros((n, r))])
-    Gp = pinv(G)
-    M = Eb @ Gp
+def decoupling(
+    plant: Plant,
+    Mv: np.ndarray | None = None,
+    scaling: Scaling | None = None,
+    zeros: np.ndarray | None = None,
+) -> Decoupling:
+    """Compute ``M``, ``A1`` and the balanced pair ``(A1, N C)`` (rank condition assumed).
+
+    Parameters
+    ----------
+    plant : Plant
+    Mv : array_like, shape (n, p), optional
+        The free matrix of the projection (no effect when ``[CE D]`` is square
+        and invertible).
+    scaling : Scaling, optional
+        The plant's balancing (:func:`uio_teach.balancing.plant_scaling`).
+    zeros : array_like, optional
+        The plant's invariant zeros (``check_existence(plant).invariant_zeros``):
+        the fixed modes of the pair are made to agree with them (see
+        :func:`uio_teach.balancing.balanced_pair`).
+
+    Returns
+    -------
+    Decoupling
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> dec = ut.existence.decoupling(ut.examples.pa9())
+    >>> dec.M.shape, dec.A1.shape
+    ((3, 2), (3, 3))
+    """
+    n, p = plant.n, plant.p
+    if scaling is None:
+        scaling = plant_scaling(plant)
+    M = projection_gain(plant, scaling)
     if Mv is not None:
-        M = M + Mv @ (np.eye(p) - G @ Gp)
+        G = np.hstack([plant.C @ plant.E, plant.D])
+        M = M + Mv @ (np.eye(p) - G @ pinv(G))
     A1 = (np.eye(n) - M @ plant.C) @ plant.A
     N = left_null(plant.D)
-    split = observability_decomposition(A1, N @ plant.C)
-    return Decoupling(M=M, A1=A1, N=N, split=split)
+    pair = balanced_pair(A1, plant.C, plant.D, scaling, zeros)
+    return Decoupling(M=M, A1=A1, N=N, pair=pair)
+
+
+def projection_gain(plant: Plant, scaling: Scaling | None = None) -> np.ndarray:
+    """``M = [E 0][CE D]^+``: the gain with ``M [CE D] = [E 0]`` (the rank condition assumed).
+
+    The Moore-Penrose inverse is taken in the plant's own units (the printed
+    designs of the course use it). When that loses the identity to round-off
+    (badly scaled data) or overflows, ``M`` is computed in balanced units
+    instead, ``M = T M_s W_y``: another generalized inverse with the same
+    identity.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.existence import projection_gain
+    >>> projection_gain(ut.examples.pa9()).round(2)
+    array([[0.94, 0.24],
+           [0.  , 0.  ],
+           [0.24, 0.06]])
+    """
+    n, nv = plant.n, plant.nv
+    with np.errstate(all="ignore"):
+        G = np.hstack([plant.C @ plant.E, plant.D])
+        Eb = np.hstack([plant.E, np.zeros((n, nv))])
+        if np.all(np.isfinite(G)):
+            M = Eb @ pinv(G)
+            bound = product_bound((M, G), Eb)
+            if np.all(np.isfinite(M)) and relative_residual(M @ G - Eb, bound) <= IDENTITY_RTOL:
+                return M
+    s = plant_scaling(plant) if scaling is None else scaling
+    bal, _ = balanced_plant(plant, s)
+    Gs = np.hstack([bal.C @ bal.E, bal.D])
+    Ms = np.hstack([bal.E, np.zeros((n, nv))]) @ pinv(Gs)
+    return s.t[:, None] * Ms * s.wy[None, :]
 
 
 @dataclass(frozen=True)
@@ -146,16 +238,16 @@ class ExistenceReport:
 
     def __str__(self) -> str:
         head = f"Existence of an unknown input observer for {self.plant!r}"
-        if len(head) > 88:
-            head = f"Existence of an unknown input observer for\n  {self.plant!r}"
+        if len(head) > LINE_WIDTH:
+            head = fit_lines(f"Existence of an unknown input observer for\n  {self.plant!r}")
         width = max(len(c.name) for c in self.conditions)
         lines = [head]
         indent = " " * (width + 6)
         for c in self.conditions:
             tag = "" if c.required else " (info)"
             text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
-            # wrap long reasons under their column so the table fits a notebook page
-            lines.extend(textwrap.wrap(text, 88, subsequent_indent=indent) or [text])
+            # wrap long reasons under their column so the table fits the book's column
+            lines.append(fit_lines(text, indent=indent))
         verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
         lines.append(f"  => {verdict}")
         return "\n".join(lines)
@@ -187,19 +279,44 @@ class UIOExistenceError(ValueError):
         super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
 
 
+RANK_RTOL = 100.0
+"""The rank condition's thresholds are ``RANK_RTOL * eps`` (``RANK_RTOL * n * eps`` for the
+product ``C E``) times the size of the balanced data: round-off stays well below them."""
+
 ZERO_MARGIN = 1e-6
-"""A zero or fixed mode closer than this (relative to ``max(1, ||A||)``) to the stability
-boundary is reported as marginal: round-off of the data could move it across."""
+"""A zero or fixed mode closer than this (relative to ``max(1, ||A||)`` in balanced units) to
+the stability boundary is reported as marginal: round-off of the data could move it across."""
 
 
-def _boundary_note(values: np.ndarray, discrete: bool, A: np.ndarray) -> str:
-    """A note for values that sit within the numerical margin of the stability boundary."""
+def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
+    """A note for values within the numerical margin of the stability boundary.
+
+    Parameters
+    ----------
+    values : array_like of complex
+        Zeros or modes.
+    discrete : bool
+        Judge against the unit circle (True) or the imaginary axis.
+    size : float
+        The size of the plant's balanced ``A``; the margin is
+        ``ZERO_MARGIN * max(1, size)``.
+
+    Returns
+    -------
+    str
+        Empty when no value is that close.
+
+    Examples
+    --------
+    >>> from uio_teach.existence import boundary_note
+    >>> boundary_note([-1e-9, -1.0], discrete=False, size=1.0)[:28]
+    ' (within the numerical margi'
+    """
     if not len(values):
         return ""
     values = np.asarray(values, complex)
     dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
-    scale = max(1.0, float(np.linalg.norm(A, 2)))
-    close = dist <= ZERO_MARGIN * scale
+    close = dist <= ZERO_MARGIN * max(1.0, float(size))
     if not np.any(close):
         return ""
     where = "unit circle" if discrete else "imaginary axis"
@@ -212,6 +329,170 @@ def _boundary_note(values: np.ndarray, discrete: bool, A: np.ndarray) -> str:
 
 def _pair_name(plant: Plant) -> str:
     return "(A1, N C)" if plant.nv else "(TA, C)"
+
+
+def _region(discrete: bool) -> str:
+    return "the open unit disk" if discrete else "the open left half-plane"
+
+
+def _margin_note(margin: float, what: str = "a singular value") -> str:
+    if margin >= MARGIN:
+        return ""
+    return (
+        f" (within the numerical margin: {what} is only {margin:.3g} times "
+        "the rank threshold, so round-off of the data could change this verdict)"
+    )
+
+
+def rank_condition(bal: Plant) -> tuple[Condition, int]:
+    """The rank condition, decided on the balanced plant ``bal``; returns it and rank(E).
+
+    Parameters
+    ----------
+    bal : Plant
+        The plant in balanced units (:func:`uio_teach.balancing.balanced_plant`):
+        ranks are then judged against factors of comparable size, whatever
+        the units of the data.
+
+    Returns
+    -------
+    (Condition, int)
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.balancing import balanced_plant
+    >>> cond, rE = rank_condition(balanced_plant(ut.examples.pa9(), time=True)[0])
+    >>> cond.holds, rE
+    (True, 1)
+    """
+    C, E, D = bal.C, bal.E, bal.D
+    nC, nE, nD = (float(np.linalg.norm(X, 2)) if X.size else 0.0 for X in (C, E, D))
+    # data known to double precision; C E is a sum of n products, so its round-off
+    # grows with n: the thresholds leave room for it (RANK_RTOL)
+    eps = np.finfo(float).eps
+    dE, dD = rank_decision(E, rtol=RANK_RTOL * eps), rank_decision(D, rtol=RANK_RTOL * eps)
+    dG = rank_decision(
+        np.hstack([C @ E, D]), scale=max(nC * nE, nD), rtol=RANK_RTOL * max(bal.n, 1) * eps
+    )
+    rE, rD, rG = dE.rank, dD.rank, dG.rank
+    margin = min(dE.margin, dD.margin, dG.margin)
+    below = min(dE.below, dD.below, dG.below)
+    if bal.nv:
+        lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
+    else:
+        lhs, rhs = f"rank(CE) = {rG}", f"rank(E) = {rE}"
+    ok = rG == rE + rD
+    if ok:
+        reason = f"{lhs} = {rhs.split(' = ')[0]}: the unknown inputs can be decoupled"
+    else:
+        reason = (
+            f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
+            "at once, so it cannot be cancelled"
+        )
+    note = _margin_note(margin)
+    if below < DROP_MARGIN:
+        note += (
+            f" (within the numerical margin: a singular value taken as 0 is only {below:.3g} "
+            "times below the rank threshold, so round-off of the data could change this "
+            "verdict)"
+        )
+        margin = min(margin, below)
+    cond = Condition("rank condition", ok, reason + note, margin=margin)
+    return cond, rE
+
+
+def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
+    """The condition "invariant zeros stable" for the given zeros.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> zero_condition(np.array([-1.0 + 0j]), discrete=False, size=1.0).holds
+    True
+    """
+    region = _region(discrete)
+    if not len(zeros):
+        return Condition("invariant zeros stable", True, "no invariant zeros")
+    bad = zeros[~is_stable(zeros, discrete)]
+    note = boundary_note(zeros, discrete, size)
+    listed = format_poles(zeros if not len(bad) else bad, braces=True, empty="none")
+    if not len(bad):
+        return Condition(
+            "invariant zeros stable", True, f"zeros {listed} all lie in {region}" + note
+        )
+    return Condition(
+        "invariant zeros stable",
+        False,
+        f"invariant zero(s) {listed} outside {region}: they are observer poles "
+        "no gain can move, so the error would not decay" + note,
+    )
+
+
+def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
+    """True when the fixed modes are the invariant zeros (same count, matched values)."""
+    if len(fixed) != len(zeros):
+        return False
+    if not len(fixed):
+        return True
+    cost = np.abs(fixed[:, None] - zeros[None, :])
+    return bool(np.all(np.min(cost, axis=1) <= 1e-5 * max(1.0, scale)))
+
+
+def detectability_conditions(
+    plant: Plant, dec: Decoupling, zeros: np.ndarray, size: float
+) -> tuple[list[Condition], np.ndarray, int]:
+    """Detectability and observability of the pair the designs use (rank condition holds).
+
+    The fixed modes are the unobservable modes of the balanced pair; in exact
+    arithmetic they are the invariant zeros. When the two computations do not
+    agree, the verdict hangs on round-off and the reasons say so.
+
+    Returns
+    -------
+    (list of Condition, numpy.ndarray, int)
+        The two conditions, the fixed modes and the number of movable poles.
+    """
+    discrete, region, pair = plant.is_discrete, _region(plant.is_discrete), _pair_name(plant)
+    fixed, movable = dec.pair.fixed_modes, dec.pair.movable
+    unstable = fixed[~is_stable(fixed, discrete)]
+    margin = dec.pair.split.margin
+    note = boundary_note(fixed, discrete, size) + _margin_note(
+        margin, "a singular value of the observability staircase"
+    )
+    if not _agreeing_modes(fixed, zeros, dec.pair.sigma):
+        margin = min(margin, 1.0)
+        note += (
+            f" (within the numerical margin: the {len(fixed)} unobservable mode(s) and the "
+            f"{len(zeros)} invariant zero(s) should coincide but do not to round-off, so "
+            "this verdict hangs on round-off)"
+        )
+    listed = format_poles(fixed if not len(unstable) else unstable, braces=True, empty="none")
+    if not len(unstable):
+        reason = (
+            f"unobservable modes {listed} lie in {region}"
+            if len(fixed)
+            else "observable, hence detectable"
+        )
+        det = Condition(f"detectable {pair}", True, reason + note, margin=margin)
+    else:
+        det = Condition(
+            f"detectable {pair}",
+            False,
+            f"unobservable mode(s) {listed} outside {region}" + note,
+            margin=margin,
+        )
+    if len(fixed):
+        reason = (
+            f"{movable} of {plant.n} poles can be placed; {listed} are fixed "
+            "(they are the invariant zeros)"
+        )
+    else:
+        reason = f"all {plant.n} observer poles can be placed"
+    obs = Condition(
+        f"observable {pair}", not len(fixed), reason + note, required=False, margin=margin
+    )
+    return [det, obs], fixed, movable
 
 
 def check_existence(plant: Plant) -> ExistenceReport:
@@ -233,6 +514,11 @@ def check_existence(plant: Plant) -> ExistenceReport:
     5. **E full column rank** (information): the unknown input can be
        reconstructed uniquely from the state estimate.
 
+    Every decision is made on the plant in balanced units
+    (:mod:`uio_teach.balancing`): the same plant with its states, outputs or
+    unknown inputs in other units gets the same verdicts, and data in the
+    overflow range are scaled before any product is formed.
+
     Parameters
     ----------
     plant : Plant
@@ -251,120 +537,29 @@ def check_existence(plant: Plant) -> ExistenceReport:
     >>> report.fixed_modes.real.round(6).tolist()
     [0.5, 0.5]
     """
-    if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+    plant = check_plant(plant)
     discrete = plant.is_discrete
-    region = "the open unit disk" if discrete else "the open left half-plane"
-    C, E, D = plant.C, plant.E, plant.D
-    # ranks decided relative to the factors (the tolerance policy of uio_teach.linalg)
-    nC, nE, nD = (float(np.linalg.norm(X, 2)) if X.size else 0.0 for X in (C, E, D))
-    dE, dD = rank_decision(E), rank_decision(D)
-    dG = rank_decision(np.hstack([C @ E, D]), scale=max(nC * nE, nD))
-    rE, rD, rG = dE.rank, dD.rank, dG.rank
-    rank_margin = min(dE.margin, dD.margin, dG.margin)
-    conds: list[Condition] = []
-
-    if plant.nv:
-        lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
-    else:
-        lhs, rhs = f"rank(CE) = {rG}", f"rank(E) = {rE}"
-    rank_ok = rG == rE + rD
-    if rank_ok:
-        reason = f"{lhs} = {rhs.split(' = ')[0]}: the unknown inputs can be decoupled"
-    else:
-        reason = (
-            f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
-            "at once, so it cannot be cancelled"
-        )
-    if rank_margin < MARGIN:
-        reason += (
-            f" (within the numerical margin: a singular value is only {rank_margin:.3g} times "
-            "the rank threshold, so round-off of the data could change this verdict)"
-        )
-    conds.append(Condition("rank condition", rank_ok, reason, margin=rank_margin))
-
-    Bz = np.hstack([E, np.zeros((plant.n, plant.nv))])
-    Dz = np.hstack([np.zeros((plant.p, plant.q)), D])
-    zeros = invariant_zeros(plant.A, Bz, C, Dz)
-    bad = zeros[~is_stable(zeros, discrete)]
-    zero_note = _boundary_note(zeros, discrete, plant.A)
-    if not len(zeros):
-        conds.append(Condition("invariant zeros stable", True, "no invariant zeros"))
-    elif not len(bad):
-        conds.append(
-            Condition(
-                "invariant zeros stable",
-                True,
-                f"zeros {format_poles(zeros, braces=True, empty='none')} all lie in {region}"
-                + zero_note,
-            )
-        )
-    else:
-        conds.append(
-            Condition(
-                "invariant zeros stable",
-                False,
-                f"invariant zero(s) {format_poles(bad, braces=True, empty='none')} outside "
-                f"{region}: they are observer poles "
-                "no gain can move, so the error would not decay" + zero_note,
-            )
-        )
-
-    pair = _pair_name(plant)
+    bal, scaling = balanced_plant(plant, time=True)
+    sigma = scaling.sigma
+    size = sigma * (float(np.linalg.norm(bal.A, 2)) if plant.n else 0.0)
+    rank_cond, rE = rank_condition(bal)
+    conds = [rank_cond]
+    Bz = np.hstack([bal.E, np.zeros((plant.n, plant.nv))])
+    Dz = np.hstack([np.zeros((plant.p, plant.q)), bal.D])
+    zeros = sort_poles(invariant_zeros(bal.A, Bz, bal.C, Dz) * sigma)
+    conds.append(zero_condition(zeros, discrete, size))
     fixed = np.zeros(0, complex)
     movable = 0
-    if rank_ok:
-        dec = decoupling(plant)
-        fixed = dec.split.unobservable_modes
-        movable = dec.split.Ao.shape[0]
-        unstable = fixed[~is_stable(fixed, discrete)]
-        obs_margin = dec.split.margin
-        note = _boundary_note(fixed, discrete, plant.A) + (
-            f" (within the numerical margin: a singular value of the observability staircase "
-            f"is only {obs_margin:.3g} times the rank threshold)"
-            if obs_margin < MARGIN
-            else ""
+    if rank_cond.holds:
+        more, fixed, movable = detectability_conditions(
+            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size
         )
-        if not len(unstable):
-            reason = (
-                f"unobservable modes {format_poles(fixed, braces=True, empty='none')} "
-                f"lie in {region}"
-                if len(fixed)
-                else "observable, hence detectable"
-            )
-            conds.append(Condition(f"detectable {pair}", True, reason + note, margin=obs_margin))
-        else:
-            conds.append(
-                Condition(
-                    f"detectable {pair}",
-                    False,
-                    f"unobservable mode(s) {format_poles(unstable, braces=True, empty='none')} "
-                    f"outside {region}" + note,
-                    margin=obs_margin,
-                )
-            )
-        if len(fixed):
-            reason = (
-                f"{movable} of {plant.n} poles can be placed; "
-                f"{format_poles(fixed, braces=True, empty='none')} are fixed "
-                "(they are the invariant zeros)"
-            )
-        else:
-            reason = f"all {plant.n} observer poles can be placed"
-        conds.append(
-            Condition(
-                f"observable {pair}",
-                not len(fixed),
-                reason + note,
-                required=False,
-                margin=obs_margin,
-            )
-        )
+        conds.extend(more)
     else:
         why = "not evaluated: the rank condition fails"
+        pair = _pair_name(plant)
         conds.append(Condition(f"detectable {pair}", None, why))
         conds.append(Condition(f"observable {pair}", None, why, required=False))
-
     if plant.q:
         full = rE == plant.q
         reason = (

@@ -24,11 +24,12 @@ from typing import Any
 
 import numpy as np
 
+from ._display import call_repr, fit_lines, format_poles
 from .detection import Threshold, detect, observer_residual, residual_threshold
 from .existence import ExistenceReport, check_existence
 from .linalg import rank
 from .observers import UIO, design_uio
-from .plant import Plant
+from .plant import Plant, check_plant
 from .simulation import UIOResponse
 
 __all__ = ["BankMember", "UIOBank", "Isolation", "design_uio_bank"]
@@ -68,6 +69,18 @@ class BankMember:
     outputs: tuple[int, ...]
     report: ExistenceReport
     observer: UIO | None
+
+    def __repr__(self) -> str:
+        state = "exists" if self.exists else "does not exist"
+        return call_repr(
+            "BankMember",
+            [
+                ("fault", self.fault),
+                ("inputs", self.inputs),
+                ("outputs", self.outputs),
+                ("observer", state),
+            ],
+        )
 
     @property
     def exists(self) -> bool:
@@ -121,6 +134,12 @@ class Isolation:
     faults: tuple[str, ...]
     fired: tuple[bool | None, ...]
     first_alarms: tuple[float | None, ...]
+
+    def __repr__(self) -> str:
+        return call_repr(
+            "Isolation",
+            [("faults", self.faults), ("fired", self.fired), ("suspect", self.suspect)],
+        )
 
     @property
     def suspect(self) -> str:
@@ -347,7 +366,7 @@ class UIOBank:
             else:
                 state = "does not exist: " + ", ".join(c.name for c in m.report.failed)
             lines.append(f"  blind to {m.fault}: {state}")
-        return "\n".join(lines)
+        return fit_lines("\n".join(lines))
 
 
 def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
@@ -362,8 +381,9 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
         read ``u_i``. ``"sensor"``: member ``j`` does not read ``y_j``.
     poles : array_like
         Candidate error poles; each member places as many of the first ones
-        as it can move (its report's ``movable``), the rest of its poles are
-        its fixed modes.
+        as it can move (its report's ``movable``), skipping candidates on its
+        fixed modes (no gain moves those); the rest of its poles are its
+        fixed modes.
 
     Returns
     -------
@@ -385,8 +405,7 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
       blind to actuator 1: does not exist: rank condition
       blind to actuator 2: residual blind
     """
-    if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+    plant = check_plant(plant)
     if kind not in ("actuator", "sensor"):
         raise ValueError(f"kind must be 'actuator' or 'sensor', got {kind!r}")
     try:
@@ -427,12 +446,23 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
         report = check_existence(model)
         observer = None
         if report.ok:
-            if cand.size < report.movable:
+            # a candidate on one of the member's fixed modes is skipped: no gain moves that
+            # mode, so a pole requested there is refused by the design
+            free = np.array(
+                [
+                    c
+                    for c in cand
+                    if np.all(np.abs(report.fixed_modes - c) > 1e-6 * max(1.0, abs(c)))
+                ],
+                dtype=complex,
+            )
+            if free.size < report.movable:
                 raise ValueError(
                     f"poles: the member blind to {kind} {i + 1} can place {report.movable} "
-                    f"poles, but only {cand.size} were given"
+                    f"poles, but only {free.size} were given away from its fixed modes "
+                    f"{format_poles(report.fixed_modes, braces=True, empty='none')}"
                 )
-            observer = design_uio(model, poles=cand[: report.movable])
+            observer = design_uio(model, poles=free[: report.movable])
         members.append(
             BankMember(
                 fault=f"{kind} {i + 1}",

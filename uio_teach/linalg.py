@@ -40,6 +40,7 @@ import scipy.linalg as sla
 
 __all__ = [
     "MARGIN",
+    "DROP_MARGIN",
     "RankDecision",
     "rank_decision",
     "rank",
@@ -57,6 +58,11 @@ __all__ = [
 MARGIN = 1e4
 """A kept singular value below ``MARGIN`` times the rank threshold makes the verdict marginal."""
 
+DROP_MARGIN = 10.0
+"""A dropped singular value above ``1 / DROP_MARGIN`` of the rank threshold makes a rank-deficient
+verdict marginal (round-off sits well below the threshold when ``rtol`` covers the data's
+precision, e.g. ``100 n eps`` for a product over ``n`` terms)."""
+
 
 class RankDecision(NamedTuple):
     """A numerical rank with the evidence for it.
@@ -72,7 +78,12 @@ class RankDecision(NamedTuple):
         rank is 0 or no singular value was dropped by a hair): how far the
         verdict is from the boundary.
     marginal : bool
-        ``margin < MARGIN``: the verdict hangs on round-off.
+        ``margin < MARGIN`` or ``below < DROP_MARGIN``: the verdict hangs on
+        round-off.
+    below : float
+        The threshold divided by the largest dropped singular value (``inf``
+        when none was dropped or it is exactly 0): how far a rank-deficient
+        verdict is from the boundary on the other side.
 
     Examples
     --------
@@ -85,6 +96,7 @@ class RankDecision(NamedTuple):
     threshold: float
     margin: float
     marginal: bool
+    below: float = np.inf
 
 
 def _threshold(shape, scale: float, rtol: float | None = None) -> float:
@@ -136,7 +148,8 @@ def rank_decision(
     tol = _threshold(M.shape, ref, rtol)
     r = int(np.sum(s > tol))
     margin = float(s[r - 1] / tol) if r and tol > 0 else np.inf
-    return RankDecision(r, tol, margin, bool(margin < MARGIN))
+    below = float(tol / s[r]) if r < s.size and s[r] > 0 else np.inf
+    return RankDecision(r, tol, margin, bool(margin < MARGIN or below < DROP_MARGIN), below)
 
 
 def rank(M: np.ndarray, *, scale: float | None = None) -> int:
@@ -271,7 +284,9 @@ class ObservabilitySplit(NamedTuple):
         return sort_poles(np.linalg.eigvals(self.Au)) if self.Au.size else np.zeros(0, complex)
 
 
-def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySplit:
+def observability_decomposition(
+    A: np.ndarray, C: np.ndarray, *, rtol: float = 1e3
+) -> ObservabilitySplit:
     """Split ``(A, C)`` into its observable and unobservable parts.
 
     The unobservable subspace is computed by a staircase of orthogonal
@@ -282,6 +297,9 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     ----------
     A : array_like, shape (n, n)
     C : array_like, shape (p, n)
+    rtol : float
+        A singular value of a staircase step counts as zero below
+        ``rtol * max(shape) * eps`` times the data's size.
 
     Returns
     -------
@@ -300,12 +318,12 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     n = A.shape[0]
     # Staircase: W spans the current candidate unobservable subspace (start: ker C).
     margins = [np.inf]
-    W = _null(C, margins=margins) if C.shape[0] else np.eye(n)
+    W = _null(C, margins=margins, rtol=rtol) if C.shape[0] else np.eye(n)
     ref = max(np.linalg.norm(A, 2), np.linalg.norm(C, 2), np.finfo(float).tiny)
     while W.shape[1]:
         # keep the part of W that A maps back into W: ker((I - W W^T) A W)
         R = A @ W - W @ (W.T @ A @ W)
-        K = _null(R, ref=ref, margins=margins)
+        K = _null(R, ref=ref, margins=margins, rtol=rtol)
         if K.shape[1] == W.shape[1]:
             break
         W = W @ K
@@ -321,7 +339,9 @@ def observability_decomposition(A: np.ndarray, C: np.ndarray) -> ObservabilitySp
     )
 
 
-def _null(M: np.ndarray, ref: float | None = None, margins: list | None = None) -> np.ndarray:
+def _null(
+    M: np.ndarray, ref: float | None = None, margins: list | None = None, rtol: float = 1e3
+) -> np.ndarray:
     """Orthonormal basis of the right null space of ``M`` (columns).
 
     With ``margins`` (a list), the ratio of the smallest kept singular value to
@@ -333,7 +353,7 @@ def _null(M: np.ndarray, ref: float | None = None, margins: list | None = None) 
         return np.eye(n)
     _, s, Vt = np.linalg.svd(M, full_matrices=True)
     scale = ref if ref is not None else (s[0] if s.size else 0.0)
-    tol = max(M.shape) * 1e3 * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
+    tol = max(M.shape) * rtol * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
     k = int(np.sum(s > tol))
     if margins is not None and k and tol > 0:
         margins.append(float(s[k - 1] / tol))

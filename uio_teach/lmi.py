@@ -12,9 +12,18 @@ import scipy.linalg as sla
 
 from ._display import format_complex
 from ._validation import as_matrix
-from .linalg import is_stable, left_null, observability_decomposition, pinv
+from .balancing import BalancedPair, balanced_pair
+from .linalg import is_stable, pinv
+from .placement import place_pair_poles
 
-__all__ = ["LMIError", "LMIInfeasibleError", "LMISolverError", "LMIResult", "lmi_gain"]
+__all__ = [
+    "LMIError",
+    "LMIInfeasibleError",
+    "LMISolverError",
+    "LMIUndecidedError",
+    "LMIResult",
+    "lmi_gain",
+]
 
 #: Relative margin of a certified gain: every pole at least this far inside the boundary
 #: (the margin of ``uio_teach.linalg.is_stable``, so a certified observer is ``is_stable``).
@@ -38,6 +47,11 @@ class LMISolverError(LMIError):
 
     This says nothing about feasibility: scale the problem, try another ``solver``.
     """
+
+
+class LMIUndecidedError(LMISolverError):
+    """The solver could not decide: only inaccurate or failed answers, and no placed gain
+    meets the bound either. Neither a gain nor a proof of infeasibility."""
 
 
 class LMIResult(NamedTuple):
@@ -112,6 +126,7 @@ def lmi_gain(
     dt: float | bool | None = None,
     decay: float | None = None,
     solver: str | None = None,
+    fixed_modes=None,
 ) -> LMIResult:
     r"""Observer gain ``L`` that makes ``A1 - L C`` stable, from an LMI.
 
@@ -146,8 +161,11 @@ def lmi_gain(
         minimum decay rate (decay >= 0).
     solver : str, optional
         An installed cvxpy solver (e.g. ``"CLARABEL"``, ``"SCS"``). By default
-        Clarabel, then SCS if Clarabel fails numerically (as it may on an
-        infeasible LMI).
+        Clarabel, then SCS when Clarabel's answer is inaccurate or fails.
+    fixed_modes : array_like, optional
+        The modes no gain can move, when known (the designs pass the
+        invariant zeros); by default the unobservable modes of the balanced
+        pair ``(A1, N C)``.
 
     Returns
     -------
@@ -205,9 +223,10 @@ def lmi_gain(
         bound = f"poles left of {-(decay or 0.0)}"
     with_d = " with L D = 0" if has_d else ""
 
-    # modes no gain can move: on or beyond the bound, the LMI is infeasible (say which)
-    N = left_null(D) if has_d else np.eye(p)
-    fixed = observability_decomposition(A1, N @ C).unobservable_modes
+    # modes no gain can move: on or beyond the bound, the LMI is infeasible (say which);
+    # decided on the balanced pair, so that the verdict does not depend on the units
+    pair = balanced_pair(A1, C, D if has_d else np.zeros((p, 0)))
+    fixed = pair.fixed_modes if fixed_modes is None else np.asarray(fixed_modes, complex)
     bad = [z for z in fixed if not _meets(np.array([z]), discrete, decay)]
     if bad:
         raise LMIInfeasibleError(
@@ -223,12 +242,30 @@ def lmi_gain(
     t = _balance(A1)
     As = A1 / t[:, None] * t[None, :]
     Cs = C * t[None, :]
-    L, P = _solve(As, Cs, D if has_d else None, discrete, decay, solvers, bound, with_d)
-    if not _meets(np.linalg.eigvals(As - L @ Cs), discrete, decay):
-        # a non-strict LMI may return a gain on the boundary: ask again with a strict margin
-        L, P = _solve(
-            As, Cs, D if has_d else None, discrete, decay, solvers, bound, with_d, strict=True
-        )
+    Dd = D if has_d else None
+    try:
+        L, P = _solve(As, Cs, Dd, discrete, decay, solvers, bound, with_d)
+        if not _meets(np.linalg.eigvals(As - L @ Cs), discrete, decay):
+            # a non-strict LMI may return a gain on the boundary: ask again with a strict margin
+            L, P = _solve(As, Cs, Dd, discrete, decay, solvers, bound, with_d, strict=True)
+        if not _meets(np.linalg.eigvals(As - L @ Cs), discrete, decay):
+            raise LMISolverError("the solver's gain misses the bound", "inaccurate")
+    except LMIError as err:
+        # cross-check: a placed gain that meets the bound, with its Lyapunov certificate,
+        # is a solution of the LMI; the solver's word is then not the last one
+        placed = placed_solution(A1, C, Dd, discrete, decay, pair=pair)
+        if placed is not None:
+            # already in the plant's units: express it in the balanced ones undone below
+            L, P = placed[0] / t[:, None], placed[1] * t[:, None] * t[None, :]
+        elif isinstance(err, LMIInfeasibleError):
+            raise
+        else:
+            raise LMIUndecidedError(
+                f"the solver could not decide whether a gain achieves {bound}{with_d} "
+                f"({err}); no placed gain meets the bound either. This is not a proof of "
+                "infeasibility: try solver='SCS', another decay, or scale the system",
+                err.status,
+            ) from None
     # undo the scaling: A1 = T As T^-1 with T = diag(t), so L = T Ls and P = T^-1 Ps T^-1
     L = t[:, None] * L
     P = P / t[:, None] / t[None, :]
@@ -291,7 +328,11 @@ def _solve(A1, C, D, discrete, decay, solvers, bound, with_d, strict=False):
     prob = cp.Problem(cp.Minimize(0), cons)
     # Clarabel is the default; on infeasible LMIs it sometimes stops with a numerical
     # failure instead of a certificate, so SCS is asked next to classify the problem.
+    # An inaccurate status ("optimal_inaccurate", "infeasible_inaccurate") decides nothing:
+    # the next solver is asked. Only an accurate "infeasible" is a proof.
     errors = []
+    inaccurate = None
+    proof = None
     for name in solvers:
         try:
             with warnings.catch_warnings():
@@ -300,19 +341,96 @@ def _solve(A1, C, D, discrete, decay, solvers, bound, with_d, strict=False):
         except cp.error.SolverError as exc:
             errors.append(f"{name}: {exc}")
             continue
-        if prob.status in ("optimal", "optimal_inaccurate", "infeasible", "infeasible_inaccurate"):
-            break
+        if prob.status == "optimal":
+            return _gain_from(P.value, Y.value)
+        if prob.status == "optimal_inaccurate" and inaccurate is None:
+            inaccurate = _gain_from(P.value, Y.value)
+        if prob.status == "infeasible":
+            proof = name
         errors.append(f"{name}: status {prob.status}")
-    else:
-        raise LMISolverError(
-            "the LMI solver failed (" + "; ".join(errors) + "): a numerical failure, not a "
-            "proof of infeasibility; try another solver= or scale the system",
-            "solver_error",
-        )
-    if prob.status not in ("optimal", "optimal_inaccurate"):
+    if inaccurate is not None:
+        return inaccurate  # verified by the caller
+    if proof is not None:
         raise LMIInfeasibleError(
-            f"the LMI is {prob.status}: no observer gain achieves {bound}{with_d}", prob.status
+            f"the LMI is infeasible ({proof}): no observer gain achieves {bound}{with_d}",
+            "infeasible",
         )
-    Pv = 0.5 * (P.value + P.value.T)
-    L = np.linalg.solve(Pv, Y.value)
-    return L, Pv
+    raise LMISolverError(
+        "the LMI solver failed (" + "; ".join(errors) + "): a numerical failure, not a "
+        "proof of infeasibility; try another solver= or scale the system",
+        "solver_error" if not any("status" in e for e in errors) else "inaccurate",
+    )
+
+
+def _gain_from(Pval: np.ndarray, Yval: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    Pv = 0.5 * (Pval + Pval.T)
+    return np.linalg.solve(Pv, Yval), Pv
+
+
+def placed_solution(
+    A1: np.ndarray,
+    C: np.ndarray,
+    D: np.ndarray | None,
+    discrete: bool,
+    decay: float | None,
+    pair: BalancedPair | None = None,
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """A solution of the LMI from a placed gain and its Lyapunov certificate, or None.
+
+    The movable poles are placed well inside the bound (distinct, real) on
+    the balanced pair (:func:`uio_teach.placement.place_pair_poles`), the
+    fixed modes are checked against it, and ``P`` solves the Lyapunov
+    equation of ``A1 - L C``, scaled to meet ``P >= 0.01 I`` and the LMI's
+    margin. Used to cross-check a solver that reports infeasibility or
+    cannot decide.
+
+    Parameters
+    ----------
+    A1, C, D : numpy.ndarray
+        As for :func:`lmi_gain` (``D`` None when absent).
+    discrete : bool
+    decay : float or None
+    pair : BalancedPair, optional
+        The balanced pair of ``(A1, C, D)``, when already computed.
+
+    Returns
+    -------
+    (L, P) or None
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.lmi import placed_solution
+    >>> L, P = placed_solution(np.array([[1.2]]), np.array([[1.0]]), None, True, None)
+    >>> bool(abs(1.2 - L[0, 0]) < 1)
+    True
+    """
+    n, p = A1.shape[0], C.shape[0]
+    if pair is None:
+        pair = balanced_pair(A1, C, D if D is not None else np.zeros((p, 0)))
+    k = pair.movable
+    if discrete:
+        rho = 1.0 if decay is None else float(decay)
+        poles = 0.5 * rho * np.linspace(0.2, 1.0, k)
+    else:
+        alpha = 0.0 if decay is None else float(decay)
+        size = max(1.0, float(np.linalg.norm(A1, 2)))
+        poles = -alpha - size * np.linspace(0.5, 1.0, k)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            L = place_pair_poles(pair, poles)[0] if k else np.zeros((n, p))
+        F = A1 - L @ C
+        if not np.all(np.isfinite(F)) or not _meets(np.linalg.eigvals(F), discrete, decay):
+            return None
+        if discrete:
+            P = sla.solve_discrete_lyapunov((F / rho).T, np.eye(n))
+        else:
+            P = sla.solve_continuous_lyapunov((F + alpha * np.eye(n)).T, -np.eye(n))
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    P = 0.5 * (P + P.T)
+    lo = float(np.min(np.linalg.eigvalsh(P))) if n else 1.0
+    if not np.isfinite(lo) or lo <= 0:
+        return None
+    return L, P * max(0.01 / lo, 0.01)

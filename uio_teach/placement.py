@@ -8,13 +8,15 @@ import control as ct
 import numpy as np
 import scipy.linalg as sla
 import scipy.signal as ssig
+from scipy.optimize import linear_sum_assignment
 
 from ._display import format_complex, format_poles
 from ._validation import as_matrix, as_poles
+from .balancing import BalancedPair
 from .linalg import ObservabilitySplit, observability_decomposition
 from .verify import POLE_RTOL, PlacementAccuracyError, check_poles
 
-__all__ = ["place_observer_poles"]
+__all__ = ["place_observer_poles", "place_pair_poles", "requested_poles", "strip_fixed"]
 
 
 def place_observer_poles(
@@ -87,7 +89,7 @@ def place_observer_poles(
     no = split.Ao.shape[0]
     fixed = split.unobservable_modes
     if len(poles) == n and len(fixed) and no != n:
-        poles = _strip_fixed(poles, fixed)
+        poles = strip_fixed(poles, fixed)
     if len(poles) != no:
         fixed_txt = (
             f"; the modes {format_poles(fixed, braces=True, empty='none')} are fixed ({fixed_name})"
@@ -144,7 +146,16 @@ def _balance(A: np.ndarray) -> np.ndarray:
     return np.asarray(t, float)
 
 
-def _strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+def strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+    """``poles`` without the fixed modes when it lists all of them, else ``poles`` unchanged.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.placement import strip_fixed
+    >>> strip_fixed(np.array([-1, -2, -3 + 0j]), np.array([-2 + 0j])).real.tolist()
+    [-1.0, -3.0]
+    """
     rest = list(poles)
     for f in fixed:
         dist = [abs(p - f) for p in rest]
@@ -157,8 +168,6 @@ def _strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
 
 def _pole_error(Ao: np.ndarray, Cr: np.ndarray, Lr: np.ndarray, poles: np.ndarray) -> float:
     """Largest relative distance between the requested and the obtained poles (matched)."""
-    from scipy.optimize import linear_sum_assignment
-
     with np.errstate(all="ignore"):
         F = Ao - Lr @ Cr
         if not np.all(np.isfinite(F)):
@@ -169,17 +178,48 @@ def _pole_error(Ao: np.ndarray, Cr: np.ndarray, Lr: np.ndarray, poles: np.ndarra
     return float(cost[r, c].max())
 
 
+# scipy's YT method sweeps over all pairs of output directions, O(n^3) work per pair and
+# sweep: above this many states it is given few sweeps (a placement of that size is
+# ill-conditioned anyway; the result is verified against the requested poles)
+_YT_MAX_STATES = 12
+_YT_SWEEPS_LARGE = 6
+
+
+def _multi_output(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> np.ndarray:
+    """Multi-output placement: scipy's YT, with fewer sweeps for large problems."""
+    n, k = Ao.shape[0], Cr.shape[0]
+    sweeps = 30 if n <= _YT_MAX_STATES else _YT_SWEEPS_LARGE
+    res = ssig.place_poles(Ao.T, Cr.T, poles, method="YT", rtol=1e-3, maxiter=sweeps)
+    return np.asarray(res.gain_matrix, float).reshape(k, -1).T
+
+
+def _cyclic(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> list[np.ndarray]:
+    """Single-output designs on ``w C`` (Ackermann): any multiplicity, e.g. deadbeat.
+
+    A combination ``w`` of the outputs that keeps the pair observable exists
+    when ``Ao`` is cyclic; a few seeded random directions are tried and the
+    gains ``L = L_w w`` returned (the caller keeps the most accurate).
+    """
+    rng = np.random.default_rng(0)
+    out = []
+    k = Cr.shape[0]
+    for trial in range(4):
+        w = np.ones(k) if trial == 0 else rng.standard_normal(k)
+        w = w / np.linalg.norm(w)
+        cw = (w @ Cr)[None, :]
+        try:
+            lw = np.asarray(ct.acker(Ao.T, cw.T, poles), float).reshape(1, -1).T
+        except Exception:  # noqa: BLE001 - another direction is tried
+            continue
+        if np.all(np.isfinite(lw)):
+            out.append(lw @ w[None, :])
+    return out
+
+
 def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndarray:
     """Gain of the observable part; python-control's and scipy's messages are translated."""
     with np.errstate(all="ignore"):
         values, counts = np.unique(np.round(poles, 9), return_counts=True)
-    if k > 1 and np.any(counts > k):
-        worst = values[np.argmax(counts)]
-        raise ValueError(
-            f"poles: {format_complex(worst)} is repeated {counts.max()} times but only {k} "
-            "independent outputs can be used; choose poles with multiplicity at most "
-            f"{k} (e.g. spread them slightly)"
-        )
     candidates = []
     failures = []
     with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -200,10 +240,15 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
                 except Exception as exc:  # noqa: BLE001 - translated below
                     failures.append(str(exc))
         else:
-            try:
-                candidates.append(np.asarray(ct.place(Ao.T, Cr.T, poles), float).reshape(k, -1).T)
-            except Exception as exc:  # noqa: BLE001 - translated below
-                failures.append(str(exc))
+            if counts.max() <= k:
+                try:
+                    candidates.append(_multi_output(Ao, Cr, poles))
+                except Exception as exc:  # noqa: BLE001 - translated below
+                    failures.append(str(exc))
+            if not candidates or counts.max() > 1:
+                # repeated poles beyond what the outputs give independently (deadbeat):
+                # a cyclic single-output design on a combination of the outputs
+                candidates.extend(_cyclic(Ao, Cr, poles))
     if not candidates:
         raise PlacementAccuracyError(
             f"poles: the pole placement failed numerically ({'; '.join(failures)}). The pair is "
@@ -213,3 +258,86 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
         )
     errors = [_pole_error(Ao, Cr, Lr, poles) for Lr in candidates]
     return candidates[int(np.argmin(errors))]
+
+
+def requested_poles(poles, fixed: np.ndarray, movable: int) -> np.ndarray:
+    """All poles the error dynamics must have: the movable ones requested plus the fixed modes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.placement import requested_poles
+    >>> requested_poles([-1, -2], np.array([-5 + 0j]), 2).real.tolist()
+    [-1.0, -2.0, -5.0]
+    """
+    req = np.atleast_1d(np.asarray(poles, complex)).ravel()
+    if len(req) == movable + len(fixed) and len(fixed):
+        return req  # all n poles were given, the fixed modes among them
+    return np.concatenate([req, fixed])
+
+
+def place_pair_poles(
+    pair: BalancedPair, poles, *, fixed_name: str = "invariant zeros"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gain ``L`` (``L D = 0``) placing ``poles`` on the balanced pair of a projection design.
+
+    The placement is computed in balanced units (see
+    :class:`uio_teach.balancing.BalancedPair`), so what can be placed and the
+    gain's accuracy do not depend on the units of the data.
+
+    Parameters
+    ----------
+    pair : BalancedPair
+    poles : array_like
+        The movable poles (or all ``n``, the fixed modes among them).
+    fixed_name : str
+        How the fixed modes are called in messages.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The gain ``L`` (n x p, in the plant's units) and all the poles the
+        error matrix must have (the requested ones and the fixed modes).
+
+    Raises
+    ------
+    ValueError
+        A wrong number of poles, or a requested pole on a fixed mode: no gain
+        moves that mode, so asking for a pole there cannot be told apart from
+        keeping the fixed mode and the design would not be verifiable.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> from uio_teach.placement import place_pair_poles
+    >>> dec = ut.existence.decoupling(ut.examples.missile_autopilot())
+    >>> L, want = place_pair_poles(dec.pair, [-10, -20])
+    >>> len(want)
+    4
+    """
+    poles = as_poles("poles", poles)
+    fixed, no = pair.fixed_modes, pair.movable
+    n = pair.A.shape[0]
+    if len(poles) == n and len(fixed) and no != n:
+        poles = strip_fixed(poles, fixed)
+    if len(poles) != no:
+        fixed_txt = (
+            f"; the modes {format_poles(fixed, braces=True, empty='none')} are fixed ({fixed_name})"
+            if len(fixed)
+            else ""
+        )
+        raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
+    for z in fixed:
+        close = np.abs(poles - z) <= 1e-6 * max(1.0, abs(z))
+        if np.any(close):
+            raise ValueError(
+                f"poles: {format_complex(poles[close][0])} is requested on the fixed mode "
+                f"{format_complex(z)} ({fixed_name}): no gain moves that mode, and a pole "
+                "requested on it cannot be told apart from it. Choose the movable poles "
+                "away from the fixed modes"
+            )
+    Lb = place_observer_poles(
+        pair.A, pair.C, poles / pair.sigma, split=pair.split, fixed_name=fixed_name, verify=False
+    )
+    return pair.gain(Lb), np.concatenate([poles, fixed])

@@ -12,7 +12,7 @@ import numpy as np
 from ._display import matrices_html, matrices_text
 from ._validation import as_matrix
 
-__all__ = ["Plant"]
+__all__ = ["Plant", "check_plant"]
 
 _ROWS = {
     "B": "n x m: one row per state",
@@ -326,7 +326,7 @@ class Plant:
             else ("discrete-time" if self.dt is True else f"discrete-time, dt={self.dt:g}")
         )
         name = f"{self.name!r}, " if self.name else ""
-        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, r={self.nv})"
+        return f"Plant({name}{kind}, n={self.n}, m={self.m}, q={self.q}, p={self.p}, nv={self.nv})"
 
     def __repr__(self) -> str:
         return self._title()
@@ -350,3 +350,21 @@ class Plant:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def check_plant(plant: Any) -> Plant:
+    """Return ``plant`` if it is a :class:`Plant`; otherwise raise a clear ``ValueError``.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.plant.check_plant(ut.examples.pa9()).n
+    3
+    >>> ut.plant.check_plant([[1.0]])
+    Traceback (most recent call last):
+    ...
+    ValueError: plant must be a uio_teach.Plant, got list
+    """
+    if not isinstance(plant, Plant):
+        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+    return plant

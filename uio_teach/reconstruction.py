@@ -101,6 +101,7 @@ class InputEstimate:
         >>> len(ut.reconstruct_input(plant, resp).plot().axes)
         1
         """
+        # deferred on purpose: matplotlib is heavy and only plotting needs it
         from .plotting import plot_input_estimate
 
         return plot_input_estimate(self, **kwargs)

@@ -52,7 +52,17 @@ from ._validation import as_seed, as_time
 from .observers import Observer
 from .plant import Plant
 
-__all__ = ["simulate", "UIOResponse", "SimulationInputs", "SimulationOverflowError"]
+__all__ = [
+    "simulate",
+    "linear_response",
+    "check_timepts",
+    "input_samples",
+    "joint_system",
+    "foh_matrices",
+    "UIOResponse",
+    "SimulationInputs",
+    "SimulationOverflowError",
+]
 
 
 class SimulationOverflowError(OverflowError):
@@ -198,6 +208,7 @@ class UIOResponse:
         >>> len(fig.axes)
         5
         """
+        # deferred on purpose: matplotlib is heavy and only plotting needs it
         from .plotting import plot_response
 
         return plot_response(self, **kwargs)
@@ -223,7 +234,12 @@ class UIOResponse:
 # validation -----------------------------------------------------------------------------
 
 
-def _check_timepts(timepts: Any) -> np.ndarray:
+def check_timepts(timepts: Any) -> np.ndarray:
+    """Time points: a read-only 1-D array, finite and strictly increasing.
+
+    >>> check_timepts([0, 1, 2]).tolist()
+    [0.0, 1.0, 2.0]
+    """
     t = as_time("timepts", timepts)
     t.setflags(write=False)
     return t
@@ -298,8 +314,14 @@ _WHAT = {
 }
 
 
-def _signal(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
-    """Sample a signal argument on the grid ``t``: a ``(k, N)`` float array, validated."""
+def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
+    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`simulate`) on the grid ``t``.
+
+    Returns a validated ``(k, N)`` float array; ``name`` names it in messages.
+
+    >>> input_samples("d", lambda t: 2 * t, 1, np.array([0.0, 1.0])).tolist()
+    [[0.0, 2.0]]
+    """
     N = t.size
     if value is None:
         return np.zeros((k, N))
@@ -562,6 +584,78 @@ def _stepwise(
     return z
 
 
+def linear_response(
+    A: np.ndarray,
+    B: np.ndarray,
+    timepts: np.ndarray,
+    inputs: np.ndarray,
+    initial_state: np.ndarray,
+    *,
+    discrete: bool = False,
+) -> np.ndarray:
+    """All states of ``z' = A z + B s`` (``z[k+1] = A z[k] + B s[k]``) on a time grid.
+
+    The one simulation engine of the package (:func:`simulate` and
+    :func:`uio_teach.detection.observer_residual` both run on it): in
+    continuous time the inputs are taken as linear between samples and the
+    system is solved exactly over each step (first-order hold, one matrix
+    exponential per step size), with the fast Schur recursion on a uniform
+    grid; in discrete time the recursion itself. BLAS is limited to one
+    thread while it runs.
+
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (nz, nz)
+    B : numpy.ndarray, shape (nz, ns)
+    timepts : numpy.ndarray, shape (N,)
+        Increasing time points (one per step in discrete time).
+    inputs : numpy.ndarray, shape (ns, N)
+        Input samples.
+    initial_state : numpy.ndarray, shape (nz,)
+    discrete : bool
+
+    Returns
+    -------
+    numpy.ndarray, shape (nz, N)
+        May contain non-finite values when the response overflows; callers
+        check the range.
+
+    Raises
+    ------
+    SimulationOverflowError
+        The one-step matrices themselves overflow (``.time`` is the second
+        time point, ``.poles`` the eigenvalues of ``A`` with positive real part).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.simulation import linear_response
+    >>> t = np.linspace(0.0, 1.0, 11)
+    >>> z = linear_response(np.array([[-1.0]]), np.zeros((1, 0)), t, np.zeros((0, 11)),
+    ...                     np.array([1.0]))
+    >>> bool(np.allclose(z[0], np.exp(-t)))
+    True
+    """
+    t = np.asarray(timepts, float)
+    S = np.asarray(inputs, float)
+    z0 = np.asarray(initial_state, float)
+    with _one_blas_thread(), np.errstate(all="ignore"):
+        if discrete:
+            return _recursion(A, B, None, S, z0)
+        h = _uniform_step(t)
+        if h is None:
+            return _stepwise(A, B, t, S, z0)
+        Phi, G0, G1 = foh_matrices(A, B, h)
+        if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
+            poles = np.linalg.eigvals(A)
+            raise SimulationOverflowError(
+                "the response leaves the floating-point range within one time step",
+                poles[poles.real > 0],
+                float(t[min(1, t.size - 1)]),
+            )
+        return _recursion(Phi, G0, G1, S, z0)
+
+
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
 
 
@@ -745,16 +839,17 @@ def simulate(
         )
 
     as_seed("seed", seed)
-    t = _check_timepts(timepts)
+    t = check_timepts(timepts)
     N = t.size
-    h = _check_discrete_grid(plant, t) if plant.is_discrete else _uniform_step(t)
+    if plant.is_discrete:
+        _check_discrete_grid(plant, t)
 
     # all inputs in one array s = [u; d; v; noise]; the recorded inputs are views of it
     m, q, r, p = plant.m, plant.q, plant.nv, plant.p
     S = np.empty((m + q + r + p, N))
-    S[:m] = _signal("u", u, m, t)
-    S[m : m + q] = _signal("d", d, q, t)
-    S[m + q : m + q + r] = _signal("v", v, r, t)
+    S[:m] = input_samples("u", u, m, t)
+    S[m : m + q] = input_samples("d", d, q, t)
+    S[m + q : m + q + r] = input_samples("v", v, r, t)
     S[m + q + r :] = _noise(noise, seed, p, N)
     S.setflags(write=False)
     inputs = SimulationInputs(u=S[:m], d=S[m : m + q], v=S[m + q : m + q + r], noise=S[m + q + r :])
@@ -768,17 +863,12 @@ def simulate(
     z0 = np.concatenate([x0, w0])
 
     Az, Bz = joint_system(plant, observer)
-    with _one_blas_thread(), np.errstate(all="ignore"):
-        # overflow is detected and explained below, not left to RuntimeWarnings and NaNs
-        if plant.is_discrete:
-            z = _recursion(Az, Bz, None, S, z0)
-        elif h is not None:
-            Phi, G0, G1 = foh_matrices(Az, Bz, h)
-            if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
-                raise _overflow(Az, plant, t, 1)
-            z = _recursion(Phi, G0, G1, S, z0)
-        else:
-            z = _stepwise(Az, Bz, t, S, z0)
+    try:
+        z = linear_response(Az, Bz, t, S, z0, discrete=plant.is_discrete)
+    except SimulationOverflowError:
+        raise _overflow(Az, plant, t, 1) from None
+    with np.errstate(all="ignore"):
+        # overflow is detected and explained here, not left to RuntimeWarnings and NaNs
         _check_range(z, Az, plant, t)
         x, w = z[: plant.n], z[plant.n :]
         y = plant.C @ x

@@ -39,6 +39,9 @@ __all__ = [
     "PlacementAccuracyError",
     "check_poles",
     "check_identity",
+    "relative_residual",
+    "product_bound",
+    "check_fixed_modes",
 ]
 
 POLE_RTOL = 1e-6
@@ -155,8 +158,78 @@ def check_poles(
     return obtained
 
 
-def check_identity(name: str, residual, scale: float, *, what: str = "the observer") -> float:
-    """Raise if ``||residual|| > IDENTITY_RTOL * scale``; return the relative residual.
+def product_bound(*terms) -> np.ndarray:
+    """Entrywise size of a sum of products, for :func:`relative_residual`.
+
+    Each term is a matrix ``X`` (its entries' sizes ``|X_ij|``) or a pair
+    ``(X, Y)`` standing for the product ``X Y``, whose entry ``(i, j)`` is at
+    most ``||X_i,:|| ||Y_:,j||`` (Cauchy-Schwarz): round-off in any entry of
+    row ``i`` of ``X`` (a computed gain) is judged against that row, not
+    against the entry alone. Rows of ``X`` and columns of ``Y`` scale with the
+    units of the states and inputs they belong to, so the bound does too.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import product_bound
+    >>> product_bound((np.array([[3.0, 4.0]]), np.eye(2)), np.array([[1.0, 0.0]])).tolist()
+    [[6.0, 5.0]]
+    """
+    total = None
+    for term in terms:
+        if isinstance(term, tuple):
+            X, Y = (np.abs(np.atleast_2d(np.asarray(a, float))) for a in term)
+            part = np.outer(np.linalg.norm(X, axis=1), np.linalg.norm(Y, axis=0))
+        else:
+            part = np.abs(np.atleast_2d(np.asarray(term, float)))
+        total = part if total is None else total + part
+    return np.zeros((0, 0)) if total is None else total
+
+
+def relative_residual(residual, bound) -> float:
+    """Largest ``|R_ij| / bound_ij``: a residual judged entry by entry against its data.
+
+    ``bound`` is the entrywise size of the terms that formed ``R``
+    (:func:`product_bound`), e.g. ``product_bound((H, |C||E|), E)`` for
+    ``R = H C E - E``. Round-off makes ``|R_ij|`` at most a few ``n eps``
+    times ``bound_ij``, and the ratio does not change when states or inputs
+    are measured in other units (diagonal scalings cancel entry by entry),
+    unlike a ratio of whole-matrix norms.
+
+    Parameters
+    ----------
+    residual : array_like
+        The matrix that should be zero.
+    bound : array_like or float
+        Entrywise size of its terms (same shape), or one number.
+
+    Returns
+    -------
+    float
+        0 for an empty or exactly zero residual; ``inf`` when it is not finite
+        or non-zero where its terms are all zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import relative_residual
+    >>> relative_residual(np.array([[1e-20, 0.0]]), np.array([[1e-4, 1e6]])) < 1e-15
+    True
+    """
+    R = np.abs(np.asarray(residual, float))
+    if R.size == 0:
+        return 0.0
+    if not np.all(np.isfinite(R)):
+        return np.inf
+    B = np.broadcast_to(np.abs(np.asarray(bound, float)), R.shape)
+    with np.errstate(all="ignore"):
+        ratio = np.where(R == 0, 0.0, R / B)
+    ratio = np.where(np.isnan(ratio), np.inf, ratio)
+    return float(np.max(ratio))
+
+
+def check_identity(name: str, residual, scale, *, what: str = "the observer") -> float:
+    """Raise if the identity's residual exceeds ``IDENTITY_RTOL`` of its data.
 
     Parameters
     ----------
@@ -164,8 +237,10 @@ def check_identity(name: str, residual, scale: float, *, what: str = "the observ
         The identity, e.g. ``"T E = 0"``.
     residual : array_like
         The matrix that should be zero.
-    scale : float
-        Product of the norms of the factors that form it.
+    scale : float or array_like
+        Either the product of the norms of the factors that form it, or,
+        preferably, the entrywise bound of :func:`relative_residual` (then the
+        check does not depend on the units of the data).
     what : str
         How the design is called in messages.
 
@@ -179,8 +254,11 @@ def check_identity(name: str, residual, scale: float, *, what: str = "the observ
     R = np.asarray(residual, float)
     if R.size == 0:
         return 0.0
-    res = float(np.linalg.norm(R, 2)) if np.all(np.isfinite(R)) else np.inf
-    rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
+    if np.ndim(scale) == 0:
+        res = float(np.linalg.norm(R, 2)) if np.all(np.isfinite(R)) else np.inf
+        rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
+    else:
+        rel = relative_residual(R, scale)
     if not rel <= IDENTITY_RTOL:
         raise PlacementAccuracyError(
             f"{what}: the identity {name} holds only to {rel:.2g} relative to its factors "
@@ -188,3 +266,53 @@ def check_identity(name: str, residual, scale: float, *, what: str = "the observ
             "too badly conditioned (scale the plant's states or outputs)"
         )
     return rel
+
+
+def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
+    """Raise unless every fixed mode is among ``values`` (the observer's error poles).
+
+    A decoupling observer cannot move the invariant zeros: they are always
+    error poles. An error matrix without them does not decouple (its error
+    depends on the unknown input), whatever its gain was meant to do.
+
+    Parameters
+    ----------
+    values : array_like of complex
+        The observer's error poles.
+    fixed : array_like of complex
+        The fixed modes (the invariant zeros).
+    what : str
+        How the design is called in messages.
+
+    Raises
+    ------
+    PlacementAccuracyError
+
+    Examples
+    --------
+    >>> from uio_teach.verify import check_fixed_modes
+    >>> check_fixed_modes([-1.0, -2.0, -3.0], [-2.0])
+    >>> try:
+    ...     check_fixed_modes([-1.0, -3.0], [-2.0])
+    ... except ValueError as err:
+    ...     print(str(err)[:50])
+    the observer: the fixed mode(s) {-2} are not error
+    """
+    w = np.asarray(values, complex).ravel()
+    z = np.asarray(fixed, complex).ravel()
+    if not z.size:
+        return
+    if w.size < z.size:
+        missing, nearest = z, np.zeros(0)
+    else:
+        cost = np.abs(z[:, None] - w[None, :])
+        rows, cols = linear_sum_assignment(cost)
+        err = cost[rows, cols] / np.maximum(1.0, np.abs(z[rows]))
+        bad = err > WARN_RTOL
+        missing, nearest = z[rows[bad]], w[cols[bad]]
+    if missing.size:
+        raise PlacementAccuracyError(
+            f"{what}: the fixed mode(s) {_fmt(missing)} are not error poles (nearest "
+            f"{_fmt(nearest)}): the error would depend on the unknown input, so the observer "
+            "is refused"
+        )

@@ -1,0 +1,122 @@
+"""The projection family: what the decoupling UIO and the PMO share, and their checks.
+
+Both observers are ``xhat = z + H y`` with ``H [CE D] = [E 0]``,
+``T = I - H C`` and ``F = T A - K1 C``; they differ in how they are written
+and designed (:mod:`uio_teach.observers.uio`, :mod:`uio_teach.observers.pmo`).
+Every design is verified on the data as given before it is returned
+(:func:`verify_projection`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from .._validation import as_matrix, read_only
+from ..existence import ExistenceReport, UIOExistenceError, check_existence
+from ..linalg import pinv
+from ..plant import Plant
+from ..verify import check_fixed_modes, check_identity, product_bound
+from .base import Observer, ObserverRealization
+
+__all__ = [
+    "ProjectionObserver",
+    "verify_projection",
+    "decoupled_gain",
+    "require_existence",
+]
+
+
+class ProjectionObserver(Observer):
+    """Shared algebra of the decoupling UIO and the PMO (they are the same observer).
+
+    Not built directly: :func:`~uio_teach.design_uio` and :func:`~uio_teach.design_pmo`.
+
+    ``xhat = z + H y`` with ``H E``-decoupling, ``T = I - H C``,
+    ``F = T A - K1 C``, ``K = K1 + F H`` and ``z' = F z + T B u + K y``.
+    """
+
+    def __init__(self, plant: Plant, H: np.ndarray, K1: np.ndarray) -> None:
+        super().__init__(plant)
+        n = plant.n
+        self._H = read_only(H)
+        self._T = read_only(np.eye(n) - H @ plant.C)
+        self._K1 = read_only(K1)
+        self._F = read_only(self._T @ plant.A - K1 @ plant.C)
+        self._K2 = read_only(self._F @ H)
+
+    @property
+    def error_matrix(self) -> np.ndarray:
+        return self._F
+
+    def realization(self) -> ObserverRealization:
+        pl = self.plant
+        return ObserverRealization(
+            A=self._F,
+            B_u=self._T @ pl.B,
+            B_y=self._K1 + self._K2,
+            C=np.eye(pl.n),
+            D_y=self._H,
+        )
+
+
+def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | None = None) -> None:
+    """Verify a UIO/PMO on the data as given; raise ``PlacementAccuracyError`` if it fails.
+
+    The identities ``H C E = E``, ``T E = 0``, ``H D = 0``, ``L D = 0``, each
+    judged entry by entry against the size of its own terms
+    (:func:`uio_teach.verify.product_bound`, the same verdict in any units),
+    and, given ``fixed``, that every fixed mode is an eigenvalue of ``F``.
+    """
+    pl = obs.plant
+    H, T, K1 = obs._H, obs._T, obs._K1
+    # each identity against the entrywise size of its terms: the same verdict in any units
+    if pl.q:
+        HCE = product_bound((H, np.abs(pl.C) @ np.abs(pl.E)), pl.E)
+        check_identity("H C E = E", H @ pl.C @ pl.E - pl.E, HCE, what=what)
+        check_identity("T E = 0", T @ pl.E, HCE, what=what)
+    if pl.nv:
+        check_identity("H D = 0", H @ pl.D, product_bound((H, pl.D)), what=what)
+        check_identity("L D = 0", K1 @ pl.D, product_bound((K1, pl.D)), what=what)
+    # the fixed modes (the invariant zeros, decided in balanced units) must be error poles:
+    # an error matrix without them does not decouple, whatever the identities say
+    if fixed is not None:
+        check_fixed_modes(obs.poles(), fixed, what=what)
+
+
+def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
+    """Check an explicit gain (shape n x p, ``gain D = 0``).
+
+    A gain that meets ``gain D = 0`` only to printed precision (copied from a
+    document, rounded to 4 decimals) is projected onto it, with a warning.
+    """
+    G = as_matrix(name, gain, plant.n, plant.p, what="n x p")
+    if not plant.nv:
+        return G
+    scale = max(1.0, float(np.abs(G).max()))
+    GD = G @ plant.D
+    residual = float(np.abs(GD).max())
+    if residual <= 1e-9 * scale:
+        return G
+    if residual <= 1e-3 * scale:
+        warnings.warn(
+            f"{name} D = {np.array2string(GD.ravel(), precision=2)} is not exactly 0 (a rounded "
+            f"gain?); using the nearest gain with {name} D = 0",
+            UserWarning,
+            stacklevel=3,
+        )
+        return G - GD @ pinv(plant.D)
+    raise ValueError(
+        f"{name} D must be 0 so that the measurement disturbance does not enter the "
+        f"error; got {name} D = {np.array2string(GD, precision=4)}"
+    )
+
+
+def require_existence(plant: Plant, what: str) -> ExistenceReport:
+    """The existence report of ``plant``; raise ``UIOExistenceError`` when no UIO exists."""
+    report = check_existence(plant)
+    if not report.ok:
+        raise UIOExistenceError(report, what)
+    return report

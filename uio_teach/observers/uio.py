@@ -1,0 +1,139 @@
+"""The decoupling unknown input observer of Practical Assignment 9 and its design."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._validation import read_only
+from ..existence import decoupling
+from ..placement import place_pair_poles
+from ..plant import Plant, check_plant
+from ..verify import check_poles
+from .projection import ProjectionObserver, decoupled_gain, require_existence, verify_projection
+
+__all__ = ["UIO", "design_uio"]
+
+
+class UIO(ProjectionObserver):
+    """Unknown-input decoupling observer of Practical Assignment 9.
+
+    ``z' = F z + T B u + K y``, ``xhat = z + H y`` with ``H = E (CE)^+``,
+    ``T = I - H C``, ``F = T A - K1 C``, ``K2 = F H``, ``K = K1 + K2``.
+    Built by :func:`design_uio`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> uio = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3])
+    >>> bool(np.allclose(uio.T @ uio.plant.E, 0))
+    True
+    """
+
+    family = "UIO"
+    _display_names = ("H", "T", "K1", "K2", "K", "F")
+    _designer = "design_uio(plant, poles=...) or design_uio(plant, K1=...)"
+
+    @property
+    def H(self) -> np.ndarray:
+        """``E (CE)^+`` (``[E 0][CE D]^+`` with a measurement disturbance)."""
+        return self._H
+
+    @property
+    def T(self) -> np.ndarray:
+        """``I - H C``."""
+        return self._T
+
+    @property
+    def K1(self) -> np.ndarray:
+        """Output-injection gain that places the poles of ``F``."""
+        return self._K1
+
+    @property
+    def K2(self) -> np.ndarray:
+        """``F H``."""
+        return self._K2
+
+    @property
+    def K(self) -> np.ndarray:
+        """``K1 + K2``."""
+        return read_only(self._K1 + self._K2)
+
+    @property
+    def F(self) -> np.ndarray:
+        """``T A - K1 C``: the error dynamics ``e' = F e``."""
+        return self._F
+
+
+def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
+    """Design the unknown-input decoupling observer of Practical Assignment 9.
+
+    ``H = E (CE)^+``, ``T = I - H C``, ``F = T A - K1 C``, ``K2 = F H``,
+    ``K = K1 + K2``; the error obeys ``e' = F e`` whatever ``d`` is.
+    With a measurement disturbance ``D``, ``H = [E 0][CE D]^+`` and ``K1 D = 0``.
+
+    Parameters
+    ----------
+    plant : Plant
+        Continuous or discrete plant.
+    poles : array_like, optional
+        The movable error poles: as many as the observable part of
+        ``(TA, C)`` has (all ``n`` when the pair is observable). The other
+        modes are fixed: they are the plant's invariant zeros (see
+        :func:`check_existence`, ``fixed_modes``).
+    K1 : array_like, shape (n, p), optional
+        An explicit gain instead of ``poles`` (to reproduce a printed design).
+
+    Returns
+    -------
+    UIO
+
+    Raises
+    ------
+    UIOExistenceError
+        A condition of :func:`check_existence` fails (rank condition, or an
+        invariant zero outside the stability region).
+    ValueError
+        Neither or both of ``poles`` and ``K1`` given, a wrong number of
+        poles, or ``K1`` of the wrong shape.
+    ValueError
+        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
+        computed design fails its own check, because the poles obtained differ
+        from those requested beyond the tolerance or a decoupling identity
+        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+
+    Warns
+    -----
+    UnstableObserverWarning
+        If the chosen poles or ``K1`` leave the error dynamics unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> plant = ut.examples.pa9()
+    >>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
+    >>> obs.H.round(2)
+    array([[0.94, 0.24],
+           [0.  , 0.  ],
+           [0.24, 0.06]])
+    """
+    plant = check_plant(plant)
+    if (poles is None) == (K1 is None):
+        raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
+    report = require_existence(plant, "an unknown input observer")
+    dec = decoupling(plant, zeros=report.invariant_zeros)
+    requested = None
+    if K1 is None:
+        K1, requested = place_pair_poles(dec.pair, poles)
+    else:
+        K1 = decoupled_gain("K1", plant, K1)
+    obs = UIO(plant, dec.M, K1)
+    verify_projection(obs, "the UIO", dec.pair.fixed_modes)
+    if requested is not None:
+        check_poles(obs.F, requested, what="the UIO", stacklevel=3)
+    obs.warn_if_unstable()
+    return obs
