@@ -19,7 +19,7 @@ figure, explorer and lab that uses it.
 Each is a frozen dataclass; :meth:`Experiment.simulate` runs an observer on it
 with :func:`uio_teach.simulate`. The numbers an instructor may change are
 fields declared once with :func:`param` (type, unit, help, bounds, range): the
-term config (:mod:`uio_teach.instructor.config`), the lab parameters
+term config (``uio_teach.instructor.config``), the lab parameters
 (:mod:`uio_teach.instructor.lab_params`) and the explorers' ranges are derived
 from these declarations (:func:`experiment_params`), so a new field is one
 line here. :func:`plant_from_params` gives a lab's plant, the course's or a
@@ -78,7 +78,7 @@ PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
 class Param:
     """What the course knows about one field of an experiment: the one declaration of it.
 
-    The term config (:mod:`uio_teach.instructor.config`), the lab parameters
+    The term config (``uio_teach.instructor.config``), the lab parameters
     (:mod:`uio_teach.instructor.lab_params`) and the explorers
     (:mod:`uio_teach.explorers.scenarios`) read their keys, types, bounds,
     help texts and ranges from these declarations, attached to the fields of
@@ -370,7 +370,7 @@ class Experiment:
 
     # the plant and the time grid ----------------------------------------------------------------
     def plant(self) -> Plant:
-        """A new copy of the experiment's plant: the course's, with :attr:`matrices` in place.
+        """A new copy of the experiment's plant: the course's, with ``matrices`` in place.
 
         Returns
         -------
@@ -394,7 +394,7 @@ class Experiment:
         samples : int, optional
             Number of time points (default: as ``timepts``).
         duration : float, optional
-            The last time point (default: :attr:`duration`).
+            The last time point (default: ``duration``).
 
         Returns
         -------
@@ -743,7 +743,7 @@ class CaseStudyExperiment(Experiment):
         samples : int, optional
             Number of steps plus one.
         duration : int, optional
-            The last step (default: :attr:`duration`).
+            The last step (default: ``duration``).
 
         Returns
         -------

@@ -14,8 +14,8 @@ a list of ✓ / ✗ messages that say what is right, what is not, and how to fix
   the same error as with the sinusoid; :func:`pa9_piecewise_plot` its figure.
 * ``case_study_*`` -- the case-study lab (module ``uio_teach.checks.case_study``).
 * ``missile_*`` -- the missile lab (module ``uio_teach.checks.missile``).
-* :mod:`uio_teach.checks.common` -- the result and the helpers every check
-  shares (reading matrices, runs and poles); :mod:`uio_teach.checks.plots`
+* ``uio_teach.checks.common`` -- the result and the helpers every check
+  shares (reading matrices, runs and poles); ``uio_teach.checks.plots``
   reads figures (time axes and their units, titles).
 
 Every graded quantity is checked by its defining property and against the
