@@ -166,9 +166,9 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
 @pytest.mark.slow
 def test_the_wheel_shows_the_pa9_explorer(installed):
     code = (
-        "import uio_teach.widgets as w, uio_teach; ex = w.pa9_explorer(); "
+        "import uio_teach as ut; ex = ut.explorers.pa9_explorer(); "
         "assert ex.frame is not None and 'text/html' in ex._repr_mimebundle_(); "
-        "print(uio_teach.__file__)"
+        "print(ut.__file__)"
     )
     proc = _run([sys.executable, "-c", code], installed)
     assert Path(proc.stdout.strip()).is_relative_to(installed[0])

@@ -196,8 +196,8 @@ def test_lazy_import():
 
     code = (
         "import sys, uio_teach as ut; assert 'ipywidgets' not in sys.modules; "
-        "ut.pa9_explorer; assert 'ipywidgets' in sys.modules; "
-        "assert ut.widgets.explorer is not None and ut.explorer.compute_frame"
+        "ut.explorers.pa9_explorer; assert 'ipywidgets' in sys.modules; "
+        "assert ut.explorers.explorer is not None and ut.explorers.compute_frame"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 
