@@ -2,7 +2,6 @@
 
 import warnings
 
-import matplotlib
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -10,8 +9,6 @@ from matplotlib.figure import Figure
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.checks import CheckResult
-
-matplotlib.use("Agg")
 
 PLANT = ut.examples.pa9()
 A, C, E = PLANT.A, PLANT.C, PLANT.E

@@ -72,21 +72,41 @@ def test_the_instructor_extra_holds_what_only_the_labs_need():
     assert not declared["instructor"] & declared[""]
 
 
-def test_requirements_pin_every_declared_dependency():
+def _pins(path: Path) -> dict[str, str]:
+    """Name -> version of every ``name==version`` line (hashes and comments skipped)."""
     pins = {}
-    for line in (ROOT / "requirements.txt").read_text(encoding="utf-8").splitlines():
-        line = line.split("#")[0].strip()
-        if line:
-            name, _, version = line.partition("==")
-            pins[_name(name)] = version
+    for line in path.read_text(encoding="utf-8").splitlines():
+        line = line.split("#")[0].strip().rstrip("\\").strip()
+        if line and not line.startswith("--"):
+            name, sep, version = line.partition("==")
+            assert sep, f"{path.name}: {line!r} is not pinned to one version"
+            pins[_name(name)] = version.split(";")[0].strip()
+    return pins
+
+
+def test_requirements_pin_every_declared_dependency():
+    pins = _pins(ROOT / "requirements.in")
     for name in set().union(*_declared().values()):
         assert pins.get(name), f"{name} is declared in pyproject.toml but not pinned"
+
+
+def test_the_lock_holds_every_pin_at_its_version_with_hashes():
+    """requirements.txt is requirements.in resolved: the same versions, and every package hashed."""
+    direct, lock = _pins(ROOT / "requirements.in"), _pins(ROOT / "requirements.txt")
+    assert {name: lock.get(name) for name in direct} == direct
+    assert len(lock) > len(direct)  # the indirect dependencies too
+    lines = (ROOT / "requirements.txt").read_text(encoding="utf-8").splitlines()
+    pinned = [i for i, line in enumerate(lines) if "==" in line and not line.startswith("#")]
+    assert len(pinned) == len(lock)
+    unhashed = [lines[i] for i in pinned if not lines[i + 1].startswith("    --hash=sha256:")]
+    assert not unhashed, f"pinned without a hash: {unhashed}"
+    assert "#    make lock" in lines[:6], "the lock names the command that refreshes it"
 
 
 # the wheel, installed away from the checkout ---------------------------------------------------
 
 SOURCES = ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]
-SOURCES += ["_toc.yml", "references.bib"]
+SOURCES += ["_toc.yml", "references.bib", "LICENSE", "LICENSE-BOOK.md"]
 
 
 @pytest.fixture(scope="module")
