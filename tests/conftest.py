@@ -19,7 +19,7 @@ marked without anyone remembering to:
 ``doctest``
     runs the examples in the package's docstrings; the long ones are also ``slow``;
 ``slow``
-    any other test that takes long.
+    any other test that takes long (listed in ``SLOW``).
 
 ``make check`` runs what needs none of kernel, browser, book, wheel or slow; ``make test`` runs
 everything.
@@ -42,9 +42,41 @@ MODULE_MARKS = {
     "test_grade": {"kernel"},
     "test_book": {"book"},
 }
-# What a fixture of a test module needs (every test that uses it needs it too).
+# What a fixture or a test of a test module needs (a fixture's marks go to every test using it).
 FIXTURE_MARKS = {
     ("test_packaging", "installed"): {"wheel", "slow"},
+}
+# The tests (or fixtures) that take over 10 s each on a busy 2-core machine: every course figure
+# drawn, every lab written, exhaustive sweeps of the explorers' controls, all static frames of an
+# explorer pre-computed, hypothesis searches over scaled plants. They are `slow`, run by
+# `make test`; the quick loop keeps the cheaper tests of the same code.
+SLOW = {
+    "test_cli": {"two_runs", "test_vector_formats_are_deterministic_too"},
+    "test_explorers": {
+        "test_every_setting_gives_a_picture_or_a_message",
+        "test_fast_draw_matches_a_full_draw",
+    },
+    "test_widgets": {
+        "test_every_control_value_gives_a_picture_or_a_message",
+        "test_mimebundle_has_the_widget_and_the_static_frames",
+        "pa9_static",
+        "test_static_missile_page_is_light",
+        "test_static_ids_are_unique_and_frames_differ",
+        "test_missile_filter_slider_redraws_the_reconstruction",
+        "test_drag_uses_an_ipympl_canvas_and_redraws_after_a_resize",
+        "test_rerunning_a_cell_frees_the_previous_explorer",
+        "test_case_study_pole_and_lmi_mode",
+    },
+    "test_scaled_properties": {"test_uio_on_scaled_plants_decouples_or_refuses"},
+    "test_lab_variants": {
+        "variants",
+        "test_another_seed_gives_other_numbers",
+        "test_the_same_seed_gives_byte_identical_files",
+    },
+    "test_instructor_output": {
+        "test_a_good_run_over_last_term_leaves_only_this_terms_files",
+        "test_the_same_run_gives_the_same_manifest",
+    },
 }
 # Names whose use in a test, its fixtures or the module's helpers they call says what it needs.
 CALL_MARKS = {
@@ -55,6 +87,8 @@ CALL_MARKS = {
 # Package modules whose docstring examples take long (over 5 s on a busy 2-core machine:
 # explorers built, lab notebooks written, figures drawn).
 SLOW_DOCTESTS = {
+    "uio_teach.explorers._drag",
+    "uio_teach.explorers._figure",
     "uio_teach.explorers.widgets",
     "uio_teach.explorers.static",
     "uio_teach.instructor.labs",
@@ -97,9 +131,11 @@ def marks_for(item: pytest.Item) -> set[str]:
     module = Path(str(item.fspath))
     stem = module.stem
     marks = set(MODULE_MARKS.get(stem, ()))
+    function = getattr(item, "originalname", item.name)
     for fixture in getattr(item, "fixturenames", ()):
         marks |= FIXTURE_MARKS.get((stem, fixture), set())
-    function = getattr(item, "originalname", item.name)
+    if SLOW.get(stem, set()) & {function, *getattr(item, "fixturenames", ())}:
+        marks.add("slow")
     reached = _module_names(module).get(function, set())
     for name, needs in CALL_MARKS.items():
         if name in reached:

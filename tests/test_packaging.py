@@ -14,6 +14,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
@@ -192,3 +193,33 @@ def test_the_wheel_shows_the_pa9_explorer(installed):
     )
     proc = _run([sys.executable, "-c", code], installed)
     assert Path(proc.stdout.strip()).is_relative_to(installed[0])
+
+
+@pytest.mark.slow
+def test_the_wheel_carries_both_licences(installed):
+    target = installed[0]
+    (info,) = target.glob("uio_teach-*.dist-info")
+    metadata = (info / "METADATA").read_text(encoding="utf-8")
+    assert "License-Expression: BSD-3-Clause AND CC-BY-4.0" in metadata
+    assert {p.name for p in (info / "licenses").iterdir()} == {"LICENSE", "LICENSE-BOOK.md"}
+
+
+# licences ---------------------------------------------------------------------------------------
+
+
+def test_the_code_and_the_book_have_their_licences():
+    project = PYPROJECT["project"]
+    assert project["license"] == "BSD-3-Clause AND CC-BY-4.0"
+    for name in project["license-files"]:
+        assert (ROOT / name).is_file(), name
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("BSD 3-Clause License")
+    book = (ROOT / "LICENSE-BOOK.md").read_text(encoding="utf-8")
+    assert "Creative Commons Attribution 4.0 International" in book
+    assert "https://creativecommons.org/licenses/by/4.0/" in book
+
+
+def test_every_page_of_the_book_names_its_licence():
+    config = yaml.safe_load((ROOT / "_config.yml").read_text(encoding="utf-8"))
+    footer = config["html"]["extra_footer"]
+    assert "https://creativecommons.org/licenses/by/4.0/" in footer
+    assert "BSD 3-Clause" in footer
