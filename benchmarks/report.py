@@ -99,12 +99,12 @@ def read_simulate(text: str) -> list[list[str]]:
 def read_widgets(text: str) -> list[list[str]]:
     rows, memory = [], []
     for cells in _table_rows(text, "explorer"):
-        label, changes, median, p95, rebuild, ratio = cells[:6]
+        label, changes, median, p95, rebuild, ratio, cpu_median, cpu_p95 = cells[:8]
         rows.append(
             [
                 f"explorer {label}: every control over its range, "
                 f"median / p95 of {changes} changes",
-                f"{median} / {p95} ms",
+                f"{median} / {p95} ms (CPU {cpu_median} / {cpu_p95} ms)",
                 f"rebuilding {rebuild} ms",
                 f"p95 {ratio} of a rebuild",
             ]
@@ -299,13 +299,20 @@ def main(argv: list[str] | None = None) -> int:
         if unknown:
             parser.error(f"unknown benchmark(s) {unknown}; known: {sorted(scripts)}")
         scripts = {name: scripts[name] for name in args.only}
+    failed = []
     if not args.render:
         for name, command in scripts.items():
             print(f"running {command[0]} ...", flush=True)
-            run(name, command)
+            try:
+                run(name, command)
+            except ReportError as err:  # the others still run; their results are still written
+                print(err, file=sys.stderr)
+                failed.append(command[0])
     render()
     print(f"wrote {RESULTS.relative_to(ROOT)} and the table of {README.name}")
-    return 0
+    if failed:
+        print(f"failed, results kept from an earlier run: {', '.join(failed)}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
