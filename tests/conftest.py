@@ -97,7 +97,7 @@ SLOW_DOCTESTS = {
 
 
 @functools.cache
-def _module_names(path: Path) -> dict[str, set[str]]:
+def reached_names(path: Path) -> dict[str, set[str]]:
     """Each top-level function of a test module -> the names its code uses (and its arguments).
 
     The names a function reaches through the module's other functions are included, so a test
@@ -136,7 +136,7 @@ def marks_for(item: pytest.Item) -> set[str]:
         marks |= FIXTURE_MARKS.get((stem, fixture), set())
     if SLOW.get(stem, set()) & {function, *getattr(item, "fixturenames", ())}:
         marks.add("slow")
-    reached = _module_names(module).get(function, set())
+    reached = reached_names(module).get(function, set())
     for name, needs in CALL_MARKS.items():
         if name in reached:
             marks |= needs

@@ -356,3 +356,30 @@ def test_the_clock_check_follows_values_through_fixtures(tmp_path):
         "test_fast, line 7",
         "test_rows, line 18",
     ]
+
+
+# markers ----------------------------------------------------------------------------------------
+
+
+def test_a_test_that_reaches_a_kernel_through_a_helper_or_fixture_is_found(tmp_path):
+    import conftest
+
+    path = tmp_path / "test_x.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            import nbclient
+            def execute(nb):
+                nbclient.NotebookClient(nb).execute()
+            def solved():
+                return execute({})
+            def test_runs(solved):
+                assert solved
+            def test_pure():
+                assert 1 + 1 == 2
+            """
+        )
+    )
+    reach = conftest.reached_names(path)
+    assert "nbclient" in reach["test_runs"]
+    assert "nbclient" not in reach["test_pure"]
