@@ -187,7 +187,8 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
 @pytest.mark.slow
 def test_the_wheel_shows_the_pa9_explorer(installed):
     code = (
-        "import uio_teach as ut; ex = ut.explorers.pa9_explorer(); "
+        "import uio_teach as ut; from uio_teach.explorers.widgets import pa9_explorer; "
+        "ex = pa9_explorer(); "
         "assert ex.frame is not None and 'text/html' in ex._repr_mimebundle_(); "
         "print(ut.__file__)"
     )

@@ -192,8 +192,9 @@ def test_lazy_import():
 
     code = (
         "import sys, uio_teach as ut; assert 'ipywidgets' not in sys.modules; "
-        "ut.explorers.pa9_explorer; assert 'ipywidgets' in sys.modules; "
-        "assert ut.explorers.explorer is not None and ut.explorers.compute_frame"
+        "ut.explorers.compute_frame; assert 'ipywidgets' not in sys.modules; "
+        "from uio_teach.explorers.widgets import pa9_explorer; "
+        "assert 'ipywidgets' in sys.modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 

@@ -65,15 +65,3 @@ __all__ = [
     "error_grows",
     "render",
 ]
-
-# The live explorers need ipywidgets: `explorers.pa9_explorer` and the others load
-# :mod:`uio_teach.explorers.widgets` on first use, not with the package.
-_WIDGETS = ("Explorer", "pa9_explorer", "case_study_explorer", "missile_explorer", "explorer")
-
-
-def __getattr__(name: str):
-    if name not in _WIDGETS:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    from . import widgets  # deferred on purpose: ipywidgets only when an explorer is asked for
-
-    return getattr(widgets, name)
