@@ -13,7 +13,7 @@ STAMP  := $(VENV)/.installed
 export PATH := $(abspath $(BIN)):$(PATH)
 
 .DEFAULT_GOAL := help
-.PHONY: help venv book test check lint lock bench clean
+.PHONY: help venv book test lint clean
 
 # What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
 # build the book or the wheel, or take long (markers set in tests/conftest.py).
@@ -47,6 +47,8 @@ lint: $(STAMP)
 
 test: lint
 	$(BIN)/pytest
+
+.PHONY: check lock bench
 
 check: lint
 	$(BIN)/pytest -q -m "$(QUICK)"
