@@ -1,5 +1,5 @@
-# The two commands of the README: `make book` and `make test`.
-# Both create the virtual environment .venv from requirements.txt on first use.
+# The two commands of the README: `make book` and `make test`; `make check` is the quick loop.
+# Each creates the virtual environment .venv from the lock, requirements.txt, on first use.
 # Override the interpreter used to create it with, e.g., `make test PYTHON=python3.12`.
 
 PYTHON ?= python3
@@ -15,19 +15,26 @@ export PATH := $(abspath $(BIN)):$(PATH)
 .DEFAULT_GOAL := help
 .PHONY: help venv book book-instructor test lint clean
 
+# What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
+# build the book or the wheel, or take long (markers set in tests/conftest.py).
+QUICK := not kernel and not browser and not book and not wheel and not slow
+
 help:
 	@echo "make book   build the HTML book into _build/html (warnings are errors)"
 	@echo "make book-instructor  the instructor edition (lab solutions, tutors' notes)"
 	@echo "            into _build/instructor/_build/html"
 	@echo "make test   lint, then run every test (package, chapters, book build, browser)"
-	@echo "make venv   create or update $(VENV) from requirements.txt"
+	@echo "make check  lint, then the tests that need no kernel, browser, book or wheel build"
+	@echo "make venv   create or update $(VENV) from the lock, requirements.txt"
 	@echo "make lint   ruff check and ruff format --check"
+	@echo "make lock   regenerate requirements.txt from requirements.in (pip-tools)"
+	@echo "make bench  run the benchmarks; write benchmarks/RESULTS.md and the README table"
 	@echo "make clean  remove build outputs and caches (keeps $(VENV))"
 
 $(STAMP): requirements.txt pyproject.toml setup.py $(wildcard uio_teach/__init__.py)
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --disable-pip-version-check -q -r requirements.txt
-	$(BIN)/python -m pip install --disable-pip-version-check -q -e . --no-deps
+	$(BIN)/python -m pip install --disable-pip-version-check -q -e . --no-deps --no-build-isolation
 	@touch $@
 
 venv: $(STAMP)
@@ -49,6 +56,22 @@ lint: $(STAMP)
 
 test: lint
 	$(BIN)/pytest
+
+.PHONY: check lock bench
+
+check: lint
+	$(BIN)/pytest -q -m "$(QUICK)"
+
+# The lock: every package, direct (requirements.in) or not, at one version with its hashes.
+# After changing a pin in requirements.in run `make lock`; `make lock LOCK_FLAGS=--upgrade`
+# also moves the indirect dependencies to their newest versions.
+lock: $(STAMP)
+	CUSTOM_COMPILE_COMMAND="make lock" $(BIN)/python -m piptools compile --quiet \
+		--generate-hashes --allow-unsafe --strip-extras --no-emit-index-url \
+		--no-emit-find-links --no-emit-trusted-host $(LOCK_FLAGS) -o requirements.txt requirements.in
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/report.py
 
 clean:
 	rm -rf _build .pytest_cache .hypothesis .ruff_cache build *.egg-info

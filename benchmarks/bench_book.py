@@ -23,7 +23,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-COPY = ["_config.yml", "_toc.yml", "references.bib", "book", "uio_teach", "pyproject.toml"]
+COPY = ["_config.yml", "_toc.yml", "references.bib", "book", "_ext", "_static", "uio_teach"]
+COPY += ["pyproject.toml"]
 
 
 def build(src: Path) -> float:

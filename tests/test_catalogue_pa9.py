@@ -8,7 +8,6 @@ the check must give. The right answer passes every check.
 from __future__ import annotations
 
 import control as ct
-import matplotlib
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -16,8 +15,6 @@ from matplotlib.figure import Figure
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.instructor.lab_params import PA9Params
-
-matplotlib.use("Agg")
 
 P = PA9Params().to_params()
 POLES = P["poles"]

@@ -4,7 +4,6 @@ import re
 import warnings
 from pathlib import Path
 
-import matplotlib
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -13,8 +12,6 @@ import uio_teach as ut
 from uio_teach import checks
 from uio_teach.checks import CheckResult
 from uio_teach.checks.common import likely_cause, never_raises
-
-matplotlib.use("Agg")
 
 PLANT = ut.examples.pa9()
 A, C, E = PLANT.A, PLANT.C, PLANT.E

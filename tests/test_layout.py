@@ -1,36 +1,27 @@
-"""The package's layout: algorithms below, explorers and instructor tooling above, small modules,
-and every former import path still working."""
+"""The package's layout: algorithms below, explorers and instructor tooling above; each module
+uses only the public names of the others and imports at its top; no test reads the clock to
+decide whether it passed."""
 
 from __future__ import annotations
 
 import ast
-import importlib
-import subprocess
-import sys
+import textwrap
 from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "uio_teach"
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "uio_teach"
+TESTS = ROOT / "tests"
 
 # What sits above it: nothing of the algorithm layer may import these.
-ABOVE = {
-    "explorers",
-    "instructor",
-    "checks",
-    "widgets",
-    "explorer",
-    "static_explorer",
-    "figures",
-    "labs",
-    "cli",
-    "__main__",
-}
+ABOVE = {"explorers", "instructor", "checks", "__main__"}
 # The algorithm layer (with the worked examples and plotting): every other top-level module.
 ALGORITHMS = sorted(
     [p.stem for p in PACKAGE.glob("*.py") if p.stem not in ABOVE and p.stem != "__init__"]
     + [p.parent.name for p in PACKAGE.glob("*/__init__.py") if p.parent.name not in ABOVE]
 )
+MODULES = sorted(PACKAGE.rglob("*.py"))
 
 
 def _module_name(path: Path, root: Path = PACKAGE) -> str:
@@ -38,27 +29,39 @@ def _module_name(path: Path, root: Path = PACKAGE) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(path: Path, root: Path = PACKAGE) -> set[str]:
-    """Every module ``path`` imports (relative imports resolved), at any depth of the code."""
+def _resolve(node: ast.ImportFrom, path: Path, root: Path) -> str:
+    """The absolute module name of ``from ... import`` in ``path`` (relative imports resolved)."""
+    if not node.level:
+        return node.module or ""
     name = _module_name(path, root)
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    base = package.split(".")
+    base = base[: len(base) - node.level + 1]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _imports(path: Path, root: Path = PACKAGE) -> set[str]:
+    """Every module ``path`` imports (relative imports resolved), at any depth of the code."""
     found: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[: len(base) - node.level + 1]
-                module = ".".join(base + ([node.module] if node.module else []))
-            else:
-                module = node.module or ""
+            module = _resolve(node, path, root)
             found.add(module)
             found.update(f"{module}.{alias.name}" for alias in node.names)
     return found
 
 
-MODULES = sorted(PACKAGE.rglob("*.py"))
+def _private(name: str) -> bool:
+    return name.startswith("_") and not (name.startswith("__") and name.endswith("__"))
+
+
+def _ids(path: Path) -> str:
+    return _module_name(path)
+
+
+# layers -----------------------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("name", ALGORITHMS)
@@ -83,112 +86,322 @@ def test_the_layout_check_sees_a_forbidden_import(tmp_path):
     assert "uio_teach.instructor.cli" in _imports(root / "explorers" / "deep.py", root)
 
 
-@pytest.mark.parametrize("path", MODULES, ids=lambda p: _module_name(p))
-def test_no_module_over_900_lines(path):
-    lines = len(path.read_text(encoding="utf-8").splitlines())
-    assert lines <= 900, f"{_module_name(path)} has {lines} lines"
-
-
 def test_algorithm_layer_is_found():
     assert {"linalg", "observers", "simulation", "experiments", "luenberger"} <= set(ALGORITHMS)
-    assert not {"figures", "widgets", "labs"} & set(ALGORITHMS)
+    assert not {"explorers", "instructor", "checks"} & set(ALGORITHMS)
 
 
-def test_explorers_instructor_and_checks_use_public_names_of_linalg():
-    above = [p for p in MODULES if p.parent != PACKAGE or p.stem in ABOVE | {"plotting"}]
-    assert any("explorers" in str(p) for p in above)
-    users = [
-        _module_name(p)
-        for p in above
-        if any(m.endswith("linalg._sort") for m in _imports(p)) or "_sort(" in p.read_text()
-    ]
-    assert not users, f"use uio_teach.linalg.sort_poles in {users}"
+def test_each_thing_has_one_name():
+    """The former module names are gone: one import path for each module."""
+    gone = {"widgets", "explorer", "static_explorer", "figures", "labs", "cli"}
+    assert not {p.stem for p in PACKAGE.glob("*.py")} & gone
 
 
-# former import paths --------------------------------------------------------------------------
-
-FORMER = {
-    "uio_teach.widgets": ["Explorer", "pa9_explorer", "case_study_explorer", "missile_explorer"],
-    "uio_teach.explorer": [
-        "DISTURBANCES",
-        "FAMILIES",
-        "Channel",
-        "Settings",
-        "Scenario",
-        "Frame",
-        "ExplorerFigure",
-        "pa9_scenario",
-        "case_study_scenario",
-        "missile_scenario",
-        "make_scenario",
-        "expand_poles",
-        "format_poles",
-        "disturbance_signals",
-        "luenberger_poles",
-        "compute_frame",
-        "render",
-    ],
-    "uio_teach.static_explorer": ["StaticFrame", "StaticExplorer", "static_html"],
-    "uio_teach.figures": [
-        "FORMATS",
-        "FIGURES",
-        "FigureSpec",
-        "FigureResult",
-        "FigureConfig",
-        "ConfigError",
-        "OutputError",
-        "load_config",
-        "default_config_toml",
-        "prepare_output_dir",
-        "save_figure",
-        "generate",
-    ],
-    "uio_teach.labs": ["VERSIONS", "BookIndex", "LabResult", "find_labs", "make_notebook"],
-    "uio_teach.cli": ["main", "build_parser"],
-}
-NEW_HOME = {
-    "uio_teach.widgets": "uio_teach.explorers.widgets",
-    "uio_teach.explorer": "uio_teach.explorers",
-    "uio_teach.static_explorer": "uio_teach.explorers.static",
-    "uio_teach.figures": "uio_teach.instructor.figures",
-    "uio_teach.labs": "uio_teach.instructor.labs",
-    "uio_teach.cli": "uio_teach.instructor.cli",
-}
+# private names stay in their module -------------------------------------------------------------
 
 
-@pytest.mark.parametrize("former", sorted(FORMER))
-def test_former_modules_give_the_same_objects(former):
-    old, new = importlib.import_module(former), importlib.import_module(NEW_HOME[former])
-    for name in FORMER[former]:
-        assert name in old.__all__, f"{former}.{name} is no longer listed"
-        if name == "format_poles":
-            continue  # the former explorer formatter: three digits of _display.format_poles
-        if name == "luenberger_poles":
-            algorithm = importlib.import_module("uio_teach.luenberger")
-            assert old.luenberger_poles is algorithm.luenberger_poles
-            continue
-        assert getattr(old, name) is getattr(new, name), f"{former}.{name}"
+def private_imports(path: Path, root: Path = PACKAGE) -> list[str]:
+    """Where ``path`` uses a private name (``_name``) of another module of the package.
+
+    Both ``from .module import _name`` and ``module._name`` (``module`` bound by an import of a
+    package module) count; a private module's public names (``from ._display import
+    format_poles``) do not.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    top = root.name
+    found, modules = [], set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            module = _resolve(node, path, root)
+            if module.split(".")[0] != top:
+                continue
+            for alias in node.names:
+                dotted = f"{module}.{alias.name}"
+                if _is_module(root, dotted):
+                    modules.add(alias.asname or alias.name)
+                elif _private(alias.name):
+                    found.append(f"line {node.lineno}: from {module} import {alias.name}")
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == top:
+                    modules.add(alias.asname or alias.name.split(".")[0])
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and _private(node.attr):
+            base = node.value
+            if isinstance(base, ast.Name) and base.id in modules:
+                found.append(f"line {node.lineno}: {base.id}.{node.attr}")
+    return found
 
 
-def test_former_format_poles_is_the_one_formatter_with_three_digits():
-    from uio_teach._display import format_poles
-    from uio_teach.explorer import format_poles as former
-
-    values = [8.9e-16, 0.123456, -1 + 2.34567j, -1 - 2.34567j]
-    assert former(values) == format_poles(values, 3) == "0, 0.123, -1 + 2.35j, -1 - 2.35j"
-
-
-def test_package_level_names_of_the_explorers_stay():
-    import uio_teach as ut
-
-    assert ut.pa9_explorer is ut.widgets.pa9_explorer
-    assert ut.explorer.compute_frame is ut.explorers.compute_frame
-    assert ut.static_explorer.static_html is ut.explorers.static.static_html
+def _is_module(root: Path, dotted: str) -> bool:
+    """Whether ``dotted`` (``uio_teach.x._y``) names a module or package of the tree at ``root``."""
+    relative = Path(*dotted.split(".")[1:])
+    return (root / relative).with_suffix(".py").exists() or (
+        root / relative / "__init__.py"
+    ).exists()
 
 
-def test_python_dash_m_uio_teach_still_runs():
-    proc = subprocess.run(
-        [sys.executable, "-m", "uio_teach", "--help"], capture_output=True, text=True, timeout=120
+@pytest.mark.xfail(strict=False, reason="some modules still share private helpers")
+@pytest.mark.parametrize("path", MODULES, ids=_ids)
+def test_no_module_uses_a_private_name_of_another(path):
+    found = private_imports(path)
+    assert not found, f"{_module_name(path)} uses private names of other modules: {found}"
+
+
+def test_the_private_name_check_sees_both_forms(tmp_path):
+    root = tmp_path / "uio_teach"
+    (root / "sub").mkdir(parents=True)
+    (root / "_display.py").write_text("def format_poles(p): ...\n")
+    (root / "sub" / "book.py").write_text("_HEADING = 1\n")
+    (root / "sub" / "labs.py").write_text(
+        "from . import book\nfrom .._display import format_poles\nfrom .book import _HEADING\n"
+        "x = book._HEADING\ny = format_poles.__name__\n"
     )
-    assert proc.returncode == 0, proc.stderr
-    assert "figures" in proc.stdout and "labs" in proc.stdout
+    found = private_imports(root / "sub" / "labs.py", root)
+    assert found == ["line 3: from uio_teach.sub.book import _HEADING", "line 4: book._HEADING"]
+
+
+# imports at the top -----------------------------------------------------------------------------
+
+
+def deferred_imports(path: Path) -> list[str]:
+    """Imports below the module's top level with no comment on their line or above their block.
+
+    Imports under a top-level ``if``/``try`` (``TYPE_CHECKING``, an optional dependency) are at
+    the top; one inside a function or class is deferred and must say why in a comment.
+    """
+    text = path.read_text(encoding="utf-8")
+    lines = text.splitlines()
+    tree = ast.parse(text)
+    top: set[int] = set()
+    stack = list(tree.body)
+    while stack:
+        node = stack.pop()
+        top.add(id(node))
+        if isinstance(node, ast.If | ast.Try):
+            stack.extend(node.body + node.orelse + getattr(node, "finalbody", []))
+            for handler in getattr(node, "handlers", []):
+                stack.extend(handler.body)
+    imports = [n for n in ast.walk(tree) if isinstance(n, ast.Import | ast.ImportFrom)]
+    starts = {line: n.lineno for n in imports for line in range(n.lineno, n.end_lineno + 1)}
+
+    def says_why(lineno: int) -> bool:
+        """A comment on the import's line, or above the block of imports it belongs to."""
+        if "#" in lines[lineno - 1]:
+            return True
+        above = lineno - 1
+        while above in starts:  # the import just above: the same block
+            if "#" in lines[starts[above] - 1]:
+                return True
+            above = starts[above] - 1
+        return above >= 1 and lines[above - 1].strip().startswith("#")
+
+    return [
+        f"line {node.lineno}: {lines[node.lineno - 1].strip()}"
+        for node in imports
+        if id(node) not in top and not says_why(node.lineno)
+    ]
+
+
+@pytest.mark.xfail(strict=False, reason="some modules still import inside functions")
+@pytest.mark.parametrize("path", MODULES, ids=_ids)
+def test_imports_are_at_the_top_unless_deferred_on_purpose(path):
+    found = deferred_imports(path)
+    assert not found, (
+        f"{_module_name(path)} imports inside functions without saying why "
+        f"(move them to the top, or add a comment on the line): {found}"
+    )
+
+
+def test_the_import_check_accepts_a_deferral_that_says_why(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            from typing import TYPE_CHECKING
+            if TYPE_CHECKING:
+                import numpy
+            def f():
+                import json
+                import cvxpy  # heavy: only for the LMI gain
+                # ipywidgets only when an explorer is shown
+                import ipywidgets
+                from ipywidgets import (
+                    Image,
+                )
+                import io
+            def g():
+                import yaml
+            """
+        )
+    )
+    assert deferred_imports(path) == ["line 5: import json", "line 14: import yaml"]
+
+
+# tests do not watch the clock -------------------------------------------------------------------
+
+CLOCKS = {"time", "perf_counter", "monotonic", "perf_counter_ns", "monotonic_ns", "time_ns"}
+
+
+def _reads_clock(node: ast.AST, tainted: set[str]) -> bool:
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Call):
+            func = sub.func
+            if (
+                isinstance(func, ast.Attribute)
+                and func.attr in CLOCKS
+                and isinstance(func.value, ast.Name)
+                and func.value.id == "time"
+            ):
+                return True
+            if isinstance(func, ast.Name) and func.id in CLOCKS - {"time"}:
+                return True
+        if isinstance(sub, ast.Name) and sub.id in tainted:
+            return True
+    return False
+
+
+def _targets(node: ast.AST) -> set[str]:
+    names = set()
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Name):
+            names.add(sub.id)
+    return names
+
+
+def _clock_targets(target: ast.AST, value: ast.AST, tainted: set[str]) -> set[str]:
+    """The names an assignment of a clock-derived ``value`` to ``target`` makes clock-derived.
+
+    Unpacking follows a literal tuple element by element; unpacking anything else (a row of a
+    fixture's result, say) is left alone, as which element holds the time is not known.
+    """
+    if isinstance(target, ast.Tuple | ast.List):
+        if isinstance(value, ast.Tuple | ast.List) and len(value.elts) == len(target.elts):
+            names = set()
+            for sub_target, sub_value in zip(target.elts, value.elts, strict=True):
+                if _reads_clock(sub_value, tainted):
+                    names |= _clock_targets(sub_target, sub_value, tainted)
+            return names
+        return set()
+    return _targets(target)
+
+
+def clock_assertions(path: Path) -> list[str]:
+    """Comparisons (``<``, ``<=``, ``>``, ``>=``) in ``path`` that depend on a wall-clock reading.
+
+    A value is clock-derived when it comes from ``time.time``/``perf_counter``/``monotonic``, or
+    from a name assigned such a value, or from a fixture or helper of the module that returns
+    one. Comparisons in a ``while`` condition (waiting for an event, with a safety net) do not
+    decide whether a test passes and do not count.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    functions = [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)]
+    sources: set[str] = set()  # functions and fixtures that hand out clock-derived values
+    tainted_in: dict[str, set[str]] = {f.name: set() for f in functions}
+    changed = True
+    while changed:
+        changed = False
+        for func in functions:
+            tainted = tainted_in[func.name]
+            before = (len(tainted), func.name in sources)
+            tainted |= {a.arg for a in func.args.args if a.arg in sources}
+            for node in ast.walk(func):
+                if isinstance(node, ast.Assign | ast.AugAssign | ast.AnnAssign):
+                    value = node.value
+                    if value is not None and _reads_clock(value, tainted | sources):
+                        targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                        for target in targets:
+                            tainted |= _clock_targets(target, value, tainted | sources)
+                elif isinstance(node, ast.Return | ast.Yield) and node.value is not None:
+                    if _reads_clock(node.value, tainted | sources):
+                        sources.add(func.name)
+            if (len(tainted), func.name in sources) != before:
+                changed = True
+    found = []
+    for func in functions:
+        tainted = tainted_in[func.name] | sources
+        in_while = {
+            id(sub) for n in ast.walk(func) if isinstance(n, ast.While) for sub in ast.walk(n.test)
+        }
+        for node in ast.walk(func):
+            if isinstance(node, ast.Compare) and id(node) not in in_while:
+                ordered = any(
+                    isinstance(op, ast.Lt | ast.LtE | ast.Gt | ast.GtE) for op in node.ops
+                )
+                if ordered and _reads_clock(node, tainted):
+                    found.append(f"{func.name}, line {node.lineno}")
+    return sorted(set(found))
+
+
+@pytest.mark.xfail(strict=False, reason="three tests still compare durations")
+@pytest.mark.parametrize("path", sorted(TESTS.glob("test_*.py")), ids=lambda p: p.name)
+def test_no_test_asserts_a_wall_clock_duration(path):
+    found = clock_assertions(path)
+    assert not found, (
+        f"{path.name} decides on wall-clock time (a benchmark's job, in benchmarks/): {found}"
+    )
+
+
+def test_the_clock_check_follows_values_through_fixtures(tmp_path):
+    path = tmp_path / "test_x.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            import time
+            def timed():
+                start = time.perf_counter()
+                run()
+                return {"seconds": time.perf_counter() - start}
+            def test_fast(timed):
+                assert timed["seconds"] < 30
+            def test_direct():
+                t0 = time.monotonic()
+                elapsed = time.monotonic() - t0
+                if elapsed > 5:
+                    raise AssertionError
+            def rows():
+                return {"first": (0, "folder", time.time())}
+            def test_rows(rows):
+                code, folder, seconds = rows["first"]
+                assert code == 0 and len(folder) > 3
+                assert max(row[2] for row in rows.values()) < 30
+            def test_waits_for_an_event():
+                deadline = time.monotonic() + 600
+                while not done() and time.monotonic() < deadline:
+                    pass
+                assert done()
+            """
+        )
+    )
+    assert clock_assertions(path) == [
+        "test_direct, line 11",
+        "test_fast, line 7",
+        "test_rows, line 18",
+    ]
+
+
+# markers ----------------------------------------------------------------------------------------
+
+
+def test_a_test_that_reaches_a_kernel_through_a_helper_or_fixture_is_found(tmp_path):
+    import conftest
+
+    path = tmp_path / "test_x.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            import nbclient
+            def execute(nb):
+                nbclient.NotebookClient(nb).execute()
+            def solved():
+                return execute({})
+            def test_runs(solved):
+                assert solved
+            def test_pure():
+                assert 1 + 1 == 2
+            """
+        )
+    )
+    reach = conftest.reached_names(path)
+    assert "nbclient" in reach["test_runs"]
+    assert "nbclient" not in reach["test_pure"]

@@ -14,6 +14,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
@@ -72,21 +73,41 @@ def test_the_instructor_extra_holds_what_only_the_labs_need():
     assert not declared["instructor"] & declared[""]
 
 
-def test_requirements_pin_every_declared_dependency():
+def _pins(path: Path) -> dict[str, str]:
+    """Name -> version of every ``name==version`` line (hashes and comments skipped)."""
     pins = {}
-    for line in (ROOT / "requirements.txt").read_text(encoding="utf-8").splitlines():
-        line = line.split("#")[0].strip()
-        if line:
-            name, _, version = line.partition("==")
-            pins[_name(name)] = version
+    for line in path.read_text(encoding="utf-8").splitlines():
+        line = line.split("#")[0].strip().rstrip("\\").strip()
+        if line and not line.startswith("--"):
+            name, sep, version = line.partition("==")
+            assert sep, f"{path.name}: {line!r} is not pinned to one version"
+            pins[_name(name)] = version.split(";")[0].strip()
+    return pins
+
+
+def test_requirements_pin_every_declared_dependency():
+    pins = _pins(ROOT / "requirements.in")
     for name in set().union(*_declared().values()):
         assert pins.get(name), f"{name} is declared in pyproject.toml but not pinned"
+
+
+def test_the_lock_holds_every_pin_at_its_version_with_hashes():
+    """requirements.txt is requirements.in resolved: the same versions, and every package hashed."""
+    direct, lock = _pins(ROOT / "requirements.in"), _pins(ROOT / "requirements.txt")
+    assert {name: lock.get(name) for name in direct} == direct
+    assert len(lock) > len(direct)  # the indirect dependencies too
+    lines = (ROOT / "requirements.txt").read_text(encoding="utf-8").splitlines()
+    pinned = [i for i, line in enumerate(lines) if "==" in line and not line.startswith("#")]
+    assert len(pinned) == len(lock)
+    unhashed = [lines[i] for i in pinned if not lines[i + 1].startswith("    --hash=sha256:")]
+    assert not unhashed, f"pinned without a hash: {unhashed}"
+    assert "#    make lock" in lines[:6], "the lock names the command that refreshes it"
 
 
 # the wheel, installed away from the checkout ---------------------------------------------------
 
 SOURCES = ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]
-SOURCES += ["_toc.yml", "references.bib"]
+SOURCES += ["_toc.yml", "references.bib", "LICENSE", "LICENSE-BOOK.md"]
 
 
 @pytest.fixture(scope="module")
@@ -166,9 +187,40 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
 @pytest.mark.slow
 def test_the_wheel_shows_the_pa9_explorer(installed):
     code = (
-        "import uio_teach.widgets as w, uio_teach; ex = w.pa9_explorer(); "
+        "import uio_teach as ut; from uio_teach.explorers.widgets import pa9_explorer; "
+        "ex = pa9_explorer(); "
         "assert ex.frame is not None and 'text/html' in ex._repr_mimebundle_(); "
-        "print(uio_teach.__file__)"
+        "print(ut.__file__)"
     )
     proc = _run([sys.executable, "-c", code], installed)
     assert Path(proc.stdout.strip()).is_relative_to(installed[0])
+
+
+@pytest.mark.slow
+def test_the_wheel_carries_both_licences(installed):
+    target = installed[0]
+    (info,) = target.glob("uio_teach-*.dist-info")
+    metadata = (info / "METADATA").read_text(encoding="utf-8")
+    assert "License-Expression: BSD-3-Clause AND CC-BY-4.0" in metadata
+    assert {p.name for p in (info / "licenses").iterdir()} == {"LICENSE", "LICENSE-BOOK.md"}
+
+
+# licences ---------------------------------------------------------------------------------------
+
+
+def test_the_code_and_the_book_have_their_licences():
+    project = PYPROJECT["project"]
+    assert project["license"] == "BSD-3-Clause AND CC-BY-4.0"
+    for name in project["license-files"]:
+        assert (ROOT / name).is_file(), name
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("BSD 3-Clause License")
+    book = (ROOT / "LICENSE-BOOK.md").read_text(encoding="utf-8")
+    assert "Creative Commons Attribution 4.0 International" in book
+    assert "https://creativecommons.org/licenses/by/4.0/" in book
+
+
+def test_every_page_of_the_book_names_its_licence():
+    config = yaml.safe_load((ROOT / "_config.yml").read_text(encoding="utf-8"))
+    footer = config["html"]["extra_footer"]
+    assert "https://creativecommons.org/licenses/by/4.0/" in footer
+    assert "BSD 3-Clause" in footer

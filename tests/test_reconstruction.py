@@ -5,16 +5,12 @@ References are closed forms or plain loops written here; no stored simulation ou
 
 from __future__ import annotations
 
-import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
 import uio_teach as ut
 from uio_teach import examples, signals
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
 
 X0 = np.asarray(examples.MISSILE_PUBLISHED.x0)
 

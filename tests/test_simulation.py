@@ -11,7 +11,7 @@ import math
 import warnings
 
 import control as ct
-import matplotlib
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -19,10 +19,6 @@ from scipy.integrate import solve_ivp
 
 import uio_teach as ut
 from uio_teach import examples, signals
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt  # noqa: E402
 
 X0_PA9 = np.array([1.0, -0.5, 2.0])
 X0_CASE = np.array([1.0, -1.0, 2.0])

@@ -14,10 +14,6 @@ import re
 from html.parser import HTMLParser
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -196,8 +192,9 @@ def test_lazy_import():
 
     code = (
         "import sys, uio_teach as ut; assert 'ipywidgets' not in sys.modules; "
-        "ut.pa9_explorer; assert 'ipywidgets' in sys.modules; "
-        "assert ut.widgets.explorer is not None and ut.explorer.compute_frame"
+        "ut.explorers.compute_frame; assert 'ipywidgets' not in sys.modules; "
+        "from uio_teach.explorers.widgets import pa9_explorer; "
+        "assert 'ipywidgets' in sys.modules"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
 

@@ -13,7 +13,9 @@ True
 [-3.0, -2.0, -1.0]
 """
 
-from . import checks, examples, linalg, plotting, signals
+import importlib
+
+from . import examples, linalg, signals
 from .detection import (
     Detection,
     Fault,
@@ -52,27 +54,17 @@ from .verify import PlacementAccuracyError, PlacementAccuracyWarning
 
 __version__ = "0.1.0"
 
-# The explorers need ipywidgets and matplotlib: loaded on first use, not by `import uio_teach`.
-# The worked experiments (`ut.experiments`) are found the same way if nothing imported them yet.
-_LAZY = {
-    "widgets": None,
-    "explorer": None,
-    "static_explorer": None,
-    "explorers": None,
-    "experiments": None,
-    "pa9_explorer": "widgets",
-    "case_study_explorer": "widgets",
-    "missile_explorer": "widgets",
-}
+# Loaded on first use, not by `import uio_teach`, so that a script (or `uio-teach figures`)
+# that needs only the algorithms does not pay for them: the lab checks (`ut.checks`, which
+# build the worked experiments and their figures), the plotting layer and the explorers
+# (matplotlib figures; ipywidgets for the live explorers) and the worked experiments.
+_LAZY = ("checks", "experiments", "explorers", "plotting")
 
 
 def __getattr__(name: str):
     if name not in _LAZY:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-
-    module = importlib.import_module(f".{_LAZY[name] or name}", __name__)
-    return module if _LAZY[name] is None else getattr(module, name)
+    return importlib.import_module(f".{name}", __name__)
 
 
 def __dir__() -> list[str]:
@@ -133,11 +125,5 @@ __all__ = [
     "UIOBank",
     "BankMember",
     "Isolation",
-    "widgets",
-    "explorer",
-    "static_explorer",
     "explorers",
-    "pa9_explorer",
-    "case_study_explorer",
-    "missile_explorer",
 ]

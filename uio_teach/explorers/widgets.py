@@ -2,11 +2,11 @@
 
 One explorer per example of the course, and one for any plant::
 
-    import uio_teach as ut
-    ut.widgets.pa9_explorer()            # PA9 decoupling UIO, three movable poles
-    ut.widgets.case_study_explorer()     # discrete case study: one pole, or the LMI bound
-    ut.widgets.missile_explorer()        # missile autopilot: PMO, reconstructed inputs
-    ut.widgets.explorer(plant, "pmo")    # your own plant
+    from uio_teach.explorers import widgets
+    widgets.pa9_explorer()            # PA9 decoupling UIO, three movable poles
+    widgets.case_study_explorer()     # discrete case study: one pole, or the LMI bound
+    widgets.missile_explorer()        # missile autopilot: PMO, reconstructed inputs
+    widgets.explorer(plant, "pmo")    # your own plant
 
 Each shows the unknown input observer next to a plain Luenberger observer with
 the same poles: the error, the residual (and, for the missile, the

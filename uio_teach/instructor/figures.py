@@ -591,7 +591,7 @@ def generate(
     Examples
     --------
     >>> import tempfile
-    >>> from uio_teach import figures
+    >>> from uio_teach.instructor import figures
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     res = figures.generate(tmp, ["case_error"], dpi=40)
     ...     res[0].ok, res[0].paths[0].name
