@@ -116,6 +116,13 @@ class ConfigKey:
         The comment of ``--print-config``.
     minimum, maximum, positive, length, optional, discrete
         The bounds of :class:`~uio_teach.experiments.Param`.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import config_schema
+    >>> key = config_schema()["pa9.duration"]
+    >>> key.kind, key.positive
+    ('float', True)
     """
 
     key: str

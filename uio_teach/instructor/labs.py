@@ -112,6 +112,12 @@ UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (
         "the noise exercise states its noise level and seed in its text (noise=0.01, seed=1), "
         "and its question and model answer are written for them",
     ),
+    UnreadKeys(
+        ("style",),
+        tuple(LABS),
+        "the notebooks draw with the matplotlib settings of the Jupyter they run in, the "
+        "student's own",
+    ),
 )
 """What ``labs --config`` puts into PARAMS but the notebooks do not read, and why.
 
