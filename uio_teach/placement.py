@@ -193,26 +193,42 @@ def _multi_output(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> np.ndarr
     return np.asarray(res.gain_matrix, float).reshape(k, -1).T
 
 
-def _cyclic(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> list[np.ndarray]:
+def _cyclic(
+    Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, failures: list[str]
+) -> list[np.ndarray]:
     """Single-output designs on ``w C`` (Ackermann): any multiplicity, e.g. deadbeat.
 
     A combination ``w`` of the outputs that keeps the pair observable exists
-    when ``Ao`` is cyclic; a few seeded random directions are tried and the
-    gains ``L = L_w w`` returned (the caller keeps the most accurate).
+    when ``Ao`` is cyclic (one Jordan block per eigenvalue). When it is not
+    (an eigenvalue with two independent eigenvectors, as in a plant with two
+    identical modes), a preliminary output injection ``L0`` makes
+    ``Ao - L0 C`` cyclic -- a random ``L0`` does so with probability one for an
+    observable pair -- and the single-output design is made on that matrix:
+    ``L = L0 + L_w w``. Seeded random ``w`` and ``L0`` are tried and the gains
+    returned (the caller keeps the most accurate); why a try failed is
+    appended to ``failures``.
     """
     rng = np.random.default_rng(0)
+    n, k = Cr.shape[1], Cr.shape[0]
+    size = max(float(np.linalg.norm(Ao, 2)), float(np.max(np.abs(poles), initial=0.0)), 1e-300)
+    gain_size = size / max(float(np.linalg.norm(Cr, 2)), 1e-300)
     out = []
-    k = Cr.shape[0]
-    for trial in range(4):
+    for trial in range(8):
         w = np.ones(k) if trial == 0 else rng.standard_normal(k)
         w = w / np.linalg.norm(w)
+        # trials 0-3: Ao as it is; 4-7: a preliminary injection L0 making it cyclic
+        L0 = np.zeros((n, k)) if trial < 4 else gain_size * rng.standard_normal((n, k)) / k
+        A0 = Ao - L0 @ Cr
         cw = (w @ Cr)[None, :]
         try:
-            lw = np.asarray(ct.acker(Ao.T, cw.T, poles), float).reshape(1, -1).T
-        except Exception:  # noqa: BLE001 - another direction is tried
+            lw = np.asarray(ct.acker(A0.T, cw.T, poles), float).reshape(1, -1).T
+        except Exception as exc:  # noqa: BLE001 - another direction is tried
+            failures.append(f"single output w C: {exc}")
             continue
         if np.all(np.isfinite(lw)):
-            out.append(lw @ w[None, :])
+            out.append(L0 + lw @ w[None, :])
+        else:
+            failures.append("single output w C: a gain that is not finite")
     return out
 
 
@@ -221,7 +237,7 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
     with np.errstate(all="ignore"):
         values, counts = np.unique(np.round(poles, 9), return_counts=True)
     candidates = []
-    failures = []
+    failures: list[str] = []
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # scipy warns "Convergence was not reached" and numpy about overflow; the result is
         # verified below instead, and the user gets one plain message
@@ -232,26 +248,30 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
             try:
                 candidates.append(np.asarray(ct.acker(Ao.T, Cr.T, poles), float).reshape(1, -1).T)
             except Exception as exc:  # noqa: BLE001 - translated below
-                failures.append(str(exc))
+                failures.append(f"Ackermann: {exc}")
             if counts.max() == 1:
                 try:
                     res = ssig.place_poles(Ao.T, Cr.T, poles)
                     candidates.append(np.asarray(res.gain_matrix, float).reshape(1, -1).T)
                 except Exception as exc:  # noqa: BLE001 - translated below
-                    failures.append(str(exc))
+                    failures.append(f"scipy place_poles: {exc}")
         else:
             if counts.max() <= k:
                 try:
                     candidates.append(_multi_output(Ao, Cr, poles))
                 except Exception as exc:  # noqa: BLE001 - translated below
-                    failures.append(str(exc))
+                    failures.append(f"scipy place_poles (YT): {exc}")
             if not candidates or counts.max() > 1:
                 # repeated poles beyond what the outputs give independently (deadbeat):
                 # a cyclic single-output design on a combination of the outputs
-                candidates.extend(_cyclic(Ao, Cr, poles))
+                candidates.extend(_cyclic(Ao, Cr, poles, failures))
+    candidates = [Lr for Lr in candidates if np.all(np.isfinite(Lr))]
     if not candidates:
+        reasons = (
+            "; ".join(dict.fromkeys(failures)) or "every method gave a gain that is not finite"
+        )
         raise PlacementAccuracyError(
-            f"poles: the pole placement failed numerically ({'; '.join(failures)}). The pair is "
+            f"poles: the pole placement failed numerically ({reasons}). The pair is "
             "observable to the rank tolerance, but so badly conditioned that the gain cannot "
             "be computed in double precision: place fewer poles per output, spread them "
             "apart, or scale the plant's states"
