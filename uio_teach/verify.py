@@ -136,10 +136,11 @@ def check_poles(
     tight = err <= POLE_RTOL * size
     # a pole requested m times forms a Jordan block: round-off delta moves it by about
     # (delta ||F||^(m-1))^(1/m), far more than kappa (computed from nearby eigenvectors) says
-    _, inverse, mult = np.unique(np.round(req, 9), return_inverse=True, return_counts=True)
-    m = mult[inverse.ravel()].astype(float)
-    scale = np.maximum(normF, np.abs(req))
-    holder = (10 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m)
+    with np.errstate(all="ignore"):  # huge poles overflow the rounding: they are not repeated
+        _, inverse, mult = np.unique(np.round(req, 9), return_inverse=True, return_counts=True)
+        m = mult[inverse.ravel()].astype(float)
+        scale = np.maximum(normF, np.abs(req))
+        holder = (10 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m)
     round_off = np.where(m > 1, np.maximum(round_off, holder), round_off)
     explained = err <= 10 * round_off
     for i in np.flatnonzero(~tight & ~explained & (err <= WARN_RTOL * size)):
