@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import warnings
 
-import control as ct
 import numpy as np
 import scipy.linalg as sla
-import scipy.signal as ssig
 from scipy.optimize import linear_sum_assignment
 
 from ._display import format_complex, format_poles
@@ -187,6 +185,8 @@ _YT_SWEEPS_LARGE = 6
 
 def _multi_output(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> np.ndarray:
     """Multi-output placement: scipy's YT, with fewer sweeps for large problems."""
+    import scipy.signal as ssig  # deferred on purpose: scipy.signal takes a second to import
+
     n, k = Ao.shape[0], Cr.shape[0]
     sweeps = 30 if n <= _YT_MAX_STATES else _YT_SWEEPS_LARGE
     res = ssig.place_poles(Ao.T, Cr.T, poles, method="YT", rtol=1e-3, maxiter=sweeps)
@@ -208,6 +208,8 @@ def _cyclic(
     returned (the caller keeps the most accurate); why a try failed is
     appended to ``failures``.
     """
+    import control as ct  # deferred on purpose: python-control takes a second to import
+
     rng = np.random.default_rng(0)
     n, k = Cr.shape[1], Cr.shape[0]
     size = max(float(np.linalg.norm(Ao, 2)), float(np.max(np.abs(poles), initial=0.0)), 1e-300)
@@ -234,6 +236,10 @@ def _cyclic(
 
 def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndarray:
     """Gain of the observable part; python-control's and scipy's messages are translated."""
+    # deferred on purpose: python-control and scipy.signal take a second to import
+    import control as ct
+    import scipy.signal as ssig
+
     with np.errstate(all="ignore"):
         values, counts = np.unique(np.round(poles, 9), return_counts=True)
     candidates = []
