@@ -399,6 +399,7 @@ def _one_blas_thread() -> Iterator[None]:
     global _CONTROLLER
     if _CONTROLLER is None:
         try:
+            # deferred on purpose: optional, and only needed once a simulation runs
             from threadpoolctl import ThreadpoolController
         except ImportError:  # pragma: no cover - threadpoolctl is optional
             _CONTROLLER = False
