@@ -106,7 +106,7 @@ def _check_solver(solver) -> list[str]:
     if not isinstance(solver, str) or solver.upper() not in installed:
         raise ValueError(
             "solver must be an installed cvxpy solver for semidefinite programs "
-            f"({', '.join(installed)}), got {solver!r}"
+            f"({', '.join(installed) or 'none installed'}), got {solver!r}"
         )
     return [solver.upper()]
 
