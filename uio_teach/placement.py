@@ -30,7 +30,12 @@ def place_observer_poles(
 
     Only the observable part of ``(A, C)`` can be moved; ``poles`` lists those
     poles only. For convenience a list of all ``n`` poles that contains the
-    fixed modes is accepted too.
+    fixed modes is accepted too. Poles may be repeated any number of times
+    (deadbeat included): beyond what the outputs give independently, a
+    single-output design on a combination ``w C`` is made, after a preliminary
+    injection ``L0`` that makes ``A - L0 C`` cyclic when ``A`` is not. A
+    pole repeated ``m`` times is found to about ``eps^(1/m)`` only, as any
+    Jordan block's.
 
     Parameters
     ----------
@@ -55,8 +60,7 @@ def place_observer_poles(
     ------
     ValueError
         Wrong number of poles (the message says how many can be placed and
-        which modes are fixed), unpaired complex poles, or a multiplicity the
-        outputs cannot produce.
+        which modes are fixed) or unpaired complex poles.
     PlacementAccuracyError
         The computed gain does not give the requested poles (a badly
         conditioned problem: many states per output, close poles, a badly
@@ -75,6 +79,13 @@ def place_observer_poles(
     >>> L = place_observer_poles(A, C, [-5, -6])
     >>> np.sort(np.linalg.eigvals(A - L @ C).real).round(6).tolist()
     [-6.0, -5.0]
+
+    Two equal modes and two outputs, a triple pole:
+
+    >>> A = np.diag([-1.0, -2.0, -2.0]); C = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> L = place_observer_poles(A, C, [-4, -4, -4])
+    >>> np.linalg.eigvals(A - L @ C).real.round(3).tolist()
+    [-4.0, -4.0, -4.0]
     """
     A = as_matrix("A", A, what="n x n")
     n = A.shape[0]
