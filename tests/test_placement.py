@@ -175,3 +175,25 @@ def test_a_failed_placement_says_why(monkeypatch):
     text = str(info.value)
     assert "()" not in text
     assert "single output w C: the controllability matrix is singular" in text
+
+
+def jordan_block(pole: float, m: int, delta: float) -> np.ndarray:
+    """An m x m Jordan block of ``pole`` with ``delta`` in the corner: poles move by delta^(1/m)."""
+    J = pole * np.eye(m) + np.diag(np.ones(m - 1), 1)
+    J[-1, 0] = delta
+    return J
+
+
+@pytest.mark.filterwarnings("error::uio_teach.verify.PlacementAccuracyWarning")
+def test_a_triple_pole_off_by_round_off_is_accepted():
+    # the poles sit 7e-5 from -2, as a triple pole computed from a gain with round-off
+    # (a perturbation of F of a few hundred eps ||F||) lands
+    J = jordan_block(-2.0, 3, 3e-13)
+    assert np.abs(np.linalg.eigvals(J) + 2).max() > 5e-5
+    check_poles(J, [-2, -2, -2])
+
+
+def test_a_triple_pole_off_by_more_than_round_off_is_refused():
+    J = jordan_block(-2.0, 3, 1e-6)  # poles 1e-2 away: a real error, not round-off
+    with pytest.raises(PlacementAccuracyError, match="requested"):
+        check_poles(J, [-2, -2, -2])
