@@ -269,7 +269,10 @@ BAD_CONFIGS = {
     "not TOML": ("[pa9\n", "not valid TOML"),
     "negative seed": ("seed = -1\n", "seed: must be >= 0, got -1"),
     "too many samples": ("[pa9]\nsamples = 1000000000000\n", "pa9.samples: must be <= 200000"),
-    "pole repeated too often": ("[pa9]\npoles = [-1, -1, -1]\n", "-1 is repeated 3 times"),
+    "pole on the imaginary axis": (
+        "[pa9]\npoles = [-1, 0, -3]\n",
+        "pa9.poles: the pole 0 is unstable",
+    ),
     "table as value": ("pa9 = 3\n", "pa9: expected a table"),
 }
 
@@ -287,6 +290,15 @@ def test_a_bad_config_gives_one_line_and_exit_2(case, tmp_path, capsys):
     assert expected in err
     assert "Traceback" not in err
     assert not out_dir.exists()  # nothing is made before the configuration is known good
+
+
+def test_a_triple_pole_makes_every_figure(tmp_path, capsys):
+    # repeated poles are valid: the designs place them (a single-output design on w C)
+    config = write(tmp_path, "[pa9]\npoles = [-1, -1, -1]\n")
+    out_dir = tmp_path / "out"
+    code, _, err = run(["figures", "--out", str(out_dir), "--config", str(config), "-q"], capsys)
+    assert code == 0, err
+    assert {p.name for p in out_dir.iterdir()} == expected_files(ALL)
 
 
 def test_a_missing_config_file_is_a_config_error(tmp_path, capsys):

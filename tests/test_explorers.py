@@ -158,7 +158,7 @@ def test_lmi_mode_feasible_and_infeasible():
     "changes, expected",
     [
         ({"poles": (-1.0, -2.0)}, "3 pole(s) can be placed, got 2"),
-        ({"poles": (-2.0, -2.0, -2.0)}, "repeated 3 times"),
+        ({"poles": (-1.0, 0.0, -3.0)}, "pole 0 on the imaginary axis"),
         ({"poles": (math.nan, -2.0, -3.0)}, "finite"),
         ({"disturbance": "thunder"}, "unknown disturbance type"),
         ({"disturbance": "random steps", "period": 0.0}, "switching period must be positive"),
@@ -171,6 +171,19 @@ def test_bad_values_become_messages(changes, expected):
     frame = compute_frame(sc, sc.defaults.replace(**changes))
     assert expected in " ".join(frame.all_messages)
     assert frame.curves["lb.error"] is not None  # the comparison still shows
+
+
+@pytest.mark.filterwarnings("error::uio_teach.verify.PlacementAccuracyWarning")
+def test_a_triple_pole_is_placed():
+    sc = pa9_scenario()
+    frame = compute_frame(sc, sc.defaults.replace(poles=(-2.0, -2.0, -2.0)))
+    assert frame.observer is not None and frame.observer_message == ""
+    for obs in (frame.observer, frame.luenberger):
+        F = obs.F
+        # a triple pole moves by about (eps ||F||)^(1/3) under round-off: the conditioning
+        bound = 100 * (np.finfo(float).eps * np.linalg.norm(F, 2)) ** (1 / 3)
+        assert np.abs(np.linalg.eigvals(F) + 2.0).max() <= bound
+        ut.verify.check_poles(F, [-2.0, -2.0, -2.0])  # neither warns (an error here) nor raises
 
 
 def test_plant_without_uio_explains_why():

@@ -80,7 +80,7 @@ def test_late_failures_of_old_are_config_errors_before_anything_is_written(
         ("[pa9.sine]\namplitude = 1e300\n", "pa9.sine.amplitude: must be between"),
         ("[pa9.sine]\nfrequency = 1000.0\n", "pa9.sine.frequency: 1000 rad/s is too fast"),
         ("[pa9.piecewise]\ntimes = [0, 2, 5, 12]\n", "not before the end of the run"),
-        ("[pa9]\npoles = [-1, -1, -1]\n", "pa9.poles: -1 is repeated 3 times but only 2"),
+        ("[pa9]\npoles = [-1, -2, -3, -4]\n", "pa9.poles: expected 3 poles"),
         ("[pa9]\npoles = [-1, -2, -1e7]\n", "faster than"),
         ("[missile]\npmo_poles = [-100, nan]\n", "missile.pmo_poles[1]: expected a finite"),
         ("[case_study]\nsteps = 100001\n", "case_study.steps: must be <= 100000"),

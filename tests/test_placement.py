@@ -2,6 +2,7 @@
 
 import warnings
 
+import control
 import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
@@ -134,3 +135,65 @@ def test_every_design_meets_its_decoupling_identities():
     g = ut.design_ginverse(ut.examples.missile_autopilot())
     P, K, pl = g.projection, g.K, g.plant
     np.testing.assert_allclose((P - P @ K @ pl.C) @ pl.E, 0, atol=1e-9)
+
+
+# repeated poles on a matrix that is not cyclic ----------------------------------------------
+
+TWO_EQUAL_MODES = (np.diag([-1.0, -2.0, -2.0]), np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+
+
+@pytest.mark.filterwarnings("error::uio_teach.verify.PlacementAccuracyWarning")
+@pytest.mark.parametrize("poles", [[-4, -4, -4], [-4, -4, -5], [-1, -1, -1]])
+def test_repeated_poles_beyond_the_outputs_on_two_equal_modes(poles):
+    A, C = TWO_EQUAL_MODES
+    L = place_observer_poles(A, C, poles)  # verified inside: no error, no warning (an error)
+    F = A - L @ C
+    m = max(poles.count(p) for p in poles)
+    # a pole repeated m times moves by about (eps ||F||)^(1/m) under round-off
+    bound = 100 * (np.finfo(float).eps * np.linalg.norm(F, 2)) ** (1 / m) * max(map(abs, poles))
+    got = np.sort_complex(np.linalg.eigvals(F))
+    assert np.abs(got - np.sort_complex(np.array(poles, complex))).max() <= bound
+
+
+@pytest.mark.filterwarnings("error::uio_teach.verify.PlacementAccuracyWarning")
+def test_deadbeat_on_two_equal_modes_in_discrete_time():
+    A, C = TWO_EQUAL_MODES
+    Ad = np.diag(np.exp(np.diag(A) * 0.1))
+    L = place_observer_poles(Ad, C, [0, 0, 0])
+    F = Ad - L @ C
+    assert np.linalg.norm(np.linalg.matrix_power(F, 3), 2) <= 1e-9 * np.linalg.norm(F, 2) ** 3
+
+
+def test_a_failed_placement_says_why(monkeypatch):
+    def broken(*args, **kwargs):
+        raise ValueError("the controllability matrix is singular")
+
+    monkeypatch.setattr(control, "acker", broken)
+    A, C = TWO_EQUAL_MODES
+    with pytest.raises(PlacementAccuracyError) as info:
+        place_observer_poles(A, C, [-1, -1, -1])
+    text = str(info.value)
+    assert "()" not in text
+    assert "single output w C: the controllability matrix is singular" in text
+
+
+def jordan_block(pole: float, m: int, delta: float) -> np.ndarray:
+    """An m x m Jordan block of ``pole`` with ``delta`` in the corner: poles move by delta^(1/m)."""
+    J = pole * np.eye(m) + np.diag(np.ones(m - 1), 1)
+    J[-1, 0] = delta
+    return J
+
+
+@pytest.mark.filterwarnings("error::uio_teach.verify.PlacementAccuracyWarning")
+def test_a_triple_pole_off_by_round_off_is_accepted():
+    # the poles sit 7e-5 from -2, as a triple pole computed from a gain with round-off
+    # (a perturbation of F of a few hundred eps ||F||) lands
+    J = jordan_block(-2.0, 3, 3e-13)
+    assert np.abs(np.linalg.eigvals(J) + 2).max() > 5e-5
+    check_poles(J, [-2, -2, -2])
+
+
+def test_a_triple_pole_off_by_more_than_round_off_is_refused():
+    J = jordan_block(-2.0, 3, 1e-6)  # poles 1e-2 away: a real error, not round-off
+    with pytest.raises(PlacementAccuracyError, match="requested"):
+        check_poles(J, [-2, -2, -2])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -59,8 +60,6 @@ def as_real_number(
     name: str, value: Any, *, low: float | None = None, strict: bool = False
 ) -> float:
     """A finite real number (not a bool, not text), optionally ``>= low`` (``> low``)."""
-    from numbers import Real
-
     if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
         raise ValueError(f"{name} must be a real number, got {value!r}")
     x = float(value)

@@ -6,7 +6,6 @@ import warnings
 from numbers import Real
 from typing import NamedTuple
 
-import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 
@@ -101,11 +100,13 @@ _SDP_SOLVERS = ("CLARABEL", "SCS", "MOSEK", "CVXOPT", "COPT", "SDPA")
 def _check_solver(solver) -> list[str]:
     if solver is None:
         return ["CLARABEL", "SCS"]
+    import cvxpy as cp  # deferred on purpose: cvxpy takes half a second to import
+
     installed = [s for s in cp.installed_solvers() if s in _SDP_SOLVERS]
     if not isinstance(solver, str) or solver.upper() not in installed:
         raise ValueError(
             "solver must be an installed cvxpy solver for semidefinite programs "
-            f"({', '.join(installed)}), got {solver!r}"
+            f"({', '.join(installed) or 'none installed'}), got {solver!r}"
         )
     return [solver.upper()]
 
@@ -308,6 +309,8 @@ def _meets(z: np.ndarray, discrete: bool, decay: float | None) -> bool:
 
 def _solve(A1, C, D, discrete, decay, solvers, bound, with_d, strict=False):
     """One cvxpy solve of the LMI; returns ``(L, P)`` or raises an LMI error."""
+    import cvxpy as cp  # deferred on purpose: cvxpy takes half a second to import
+
     n, p = C.shape[1], C.shape[0]
     P = cp.Variable((n, n), symmetric=True)
     Y = cp.Variable((n, p))

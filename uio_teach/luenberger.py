@@ -10,8 +10,8 @@ list; if the list is then longer than the number of poles ``(A, C)`` lets us
 place, the fastest poles are dropped; if it is shorter (the g-inverse observer
 has only ``n - rank(C)`` poles), extra real poles are added, faster than the
 fastest one (1.5, 2, 2.5, ... times its real part in continuous time; half, a
-quarter, ... of the smallest radius in discrete time). Poles repeated more
-often than there are independent outputs are spread by a few percent.
+quarter, ... of the smallest radius in discrete time). Repeated poles stay
+repeated: the placement takes any multiplicity.
 
 Examples
 --------
@@ -28,37 +28,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .linalg import observability_decomposition, rank, sort_poles
+from .linalg import observability_decomposition, sort_poles
 from .plant import Plant
 
 __all__ = ["luenberger_poles"]
-
-
-def _spread(poles: list[complex], discrete: bool) -> list[complex]:
-    """Move the repeated copies of a pole apart by a few percent (conjugate pairs stay pairs)."""
-    out: list[complex] = []
-    seen: dict[complex, int] = {}
-    for p in poles:
-        if p.imag < 0:
-            continue  # follows its upper partner
-        key = complex(round(p.real, 9), round(p.imag, 9))
-        j = seen.get(key, 0)
-        seen[key] = j + 1
-        if j:
-            if discrete:
-                re = p.real * (1 - 0.04 * j) if p.real else 0.02 * j
-            else:
-                re = p.real - 0.02 * j * max(1.0, abs(p))
-            p = complex(re, p.imag)
-        out += [p, p.conjugate()] if p.imag else [p]
-    return out
-
-
-def _too_repeated(poles: Sequence[complex], k: int) -> bool:
-    if k < 2 or not len(poles):
-        return False  # one output: Ackermann's formula takes any multiplicity
-    _, counts = np.unique(np.round(np.asarray(poles, complex), 9), return_counts=True)
-    return bool(np.any(counts > k))
 
 
 def luenberger_poles(plant: Plant, observer_poles: Sequence[complex]) -> np.ndarray:
@@ -67,8 +40,7 @@ def luenberger_poles(plant: Plant, observer_poles: Sequence[complex]) -> np.ndar
     The rule (see :mod:`uio_teach.luenberger`): start from the unknown input
     observer's error poles, movable and fixed; take out the modes that stay fixed in the
     Luenberger observer (unobservable for ``(A, C)``); drop the fastest poles
-    if there are too many, add faster real poles if there are too few; spread
-    poles repeated more often than there are independent outputs.
+    if there are too many, add faster real poles if there are too few.
 
     Parameters
     ----------
@@ -128,7 +100,4 @@ def luenberger_poles(plant: Plant, observer_poles: Sequence[complex]) -> np.ndar
             extra = base * (1 + 0.5 * k)
         target.append(complex(extra, 0.0))
         k += 1
-    outputs = rank(plant.C)
-    if _too_repeated(target, outputs):
-        target = _spread(target, discrete)
     return sort_poles(np.array(target, dtype=complex))

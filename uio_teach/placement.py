@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import warnings
 
-import control as ct
 import numpy as np
 import scipy.linalg as sla
-import scipy.signal as ssig
 from scipy.optimize import linear_sum_assignment
 
 from ._display import format_complex, format_poles
@@ -32,7 +30,12 @@ def place_observer_poles(
 
     Only the observable part of ``(A, C)`` can be moved; ``poles`` lists those
     poles only. For convenience a list of all ``n`` poles that contains the
-    fixed modes is accepted too.
+    fixed modes is accepted too. Poles may be repeated any number of times
+    (deadbeat included): beyond what the outputs give independently, a
+    single-output design on a combination ``w C`` is made, after a preliminary
+    injection ``L0`` that makes ``A - L0 C`` cyclic when ``A`` is not. A
+    pole repeated ``m`` times is found to about ``eps^(1/m)`` only, as any
+    Jordan block's.
 
     Parameters
     ----------
@@ -57,8 +60,7 @@ def place_observer_poles(
     ------
     ValueError
         Wrong number of poles (the message says how many can be placed and
-        which modes are fixed), unpaired complex poles, or a multiplicity the
-        outputs cannot produce.
+        which modes are fixed) or unpaired complex poles.
     PlacementAccuracyError
         The computed gain does not give the requested poles (a badly
         conditioned problem: many states per output, close poles, a badly
@@ -77,6 +79,13 @@ def place_observer_poles(
     >>> L = place_observer_poles(A, C, [-5, -6])
     >>> np.sort(np.linalg.eigvals(A - L @ C).real).round(6).tolist()
     [-6.0, -5.0]
+
+    Two equal modes and two outputs, a triple pole:
+
+    >>> A = np.diag([-1.0, -2.0, -2.0]); C = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    >>> L = place_observer_poles(A, C, [-4, -4, -4])
+    >>> np.linalg.eigvals(A - L @ C).real.round(3).tolist()
+    [-4.0, -4.0, -4.0]
     """
     A = as_matrix("A", A, what="n x n")
     n = A.shape[0]
@@ -187,41 +196,65 @@ _YT_SWEEPS_LARGE = 6
 
 def _multi_output(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> np.ndarray:
     """Multi-output placement: scipy's YT, with fewer sweeps for large problems."""
+    import scipy.signal as ssig  # deferred on purpose: scipy.signal takes a second to import
+
     n, k = Ao.shape[0], Cr.shape[0]
     sweeps = 30 if n <= _YT_MAX_STATES else _YT_SWEEPS_LARGE
     res = ssig.place_poles(Ao.T, Cr.T, poles, method="YT", rtol=1e-3, maxiter=sweeps)
     return np.asarray(res.gain_matrix, float).reshape(k, -1).T
 
 
-def _cyclic(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> list[np.ndarray]:
+def _cyclic(
+    Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, failures: list[str]
+) -> list[np.ndarray]:
     """Single-output designs on ``w C`` (Ackermann): any multiplicity, e.g. deadbeat.
 
     A combination ``w`` of the outputs that keeps the pair observable exists
-    when ``Ao`` is cyclic; a few seeded random directions are tried and the
-    gains ``L = L_w w`` returned (the caller keeps the most accurate).
+    when ``Ao`` is cyclic (one Jordan block per eigenvalue). When it is not
+    (an eigenvalue with two independent eigenvectors, as in a plant with two
+    identical modes), a preliminary output injection ``L0`` makes
+    ``Ao - L0 C`` cyclic -- a random ``L0`` does so with probability one for an
+    observable pair -- and the single-output design is made on that matrix:
+    ``L = L0 + L_w w``. Seeded random ``w`` and ``L0`` are tried and the gains
+    returned (the caller keeps the most accurate); why a try failed is
+    appended to ``failures``.
     """
+    import control as ct  # deferred on purpose: python-control takes a second to import
+
     rng = np.random.default_rng(0)
+    n, k = Cr.shape[1], Cr.shape[0]
+    size = max(float(np.linalg.norm(Ao, 2)), float(np.max(np.abs(poles), initial=0.0)), 1e-300)
+    gain_size = size / max(float(np.linalg.norm(Cr, 2)), 1e-300)
     out = []
-    k = Cr.shape[0]
-    for trial in range(4):
+    for trial in range(8):
         w = np.ones(k) if trial == 0 else rng.standard_normal(k)
         w = w / np.linalg.norm(w)
+        # trials 0-3: Ao as it is; 4-7: a preliminary injection L0 making it cyclic
+        L0 = np.zeros((n, k)) if trial < 4 else gain_size * rng.standard_normal((n, k)) / k
+        A0 = Ao - L0 @ Cr
         cw = (w @ Cr)[None, :]
         try:
-            lw = np.asarray(ct.acker(Ao.T, cw.T, poles), float).reshape(1, -1).T
-        except Exception:  # noqa: BLE001 - another direction is tried
+            lw = np.asarray(ct.acker(A0.T, cw.T, poles), float).reshape(1, -1).T
+        except Exception as exc:  # noqa: BLE001 - another direction is tried
+            failures.append(f"single output w C: {exc}")
             continue
         if np.all(np.isfinite(lw)):
-            out.append(lw @ w[None, :])
+            out.append(L0 + lw @ w[None, :])
+        else:
+            failures.append("single output w C: a gain that is not finite")
     return out
 
 
 def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndarray:
     """Gain of the observable part; python-control's and scipy's messages are translated."""
+    # deferred on purpose: python-control and scipy.signal take a second to import
+    import control as ct
+    import scipy.signal as ssig
+
     with np.errstate(all="ignore"):
         values, counts = np.unique(np.round(poles, 9), return_counts=True)
     candidates = []
-    failures = []
+    failures: list[str] = []
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         # scipy warns "Convergence was not reached" and numpy about overflow; the result is
         # verified below instead, and the user gets one plain message
@@ -232,26 +265,30 @@ def _place(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray, k: int) -> np.ndar
             try:
                 candidates.append(np.asarray(ct.acker(Ao.T, Cr.T, poles), float).reshape(1, -1).T)
             except Exception as exc:  # noqa: BLE001 - translated below
-                failures.append(str(exc))
+                failures.append(f"Ackermann: {exc}")
             if counts.max() == 1:
                 try:
                     res = ssig.place_poles(Ao.T, Cr.T, poles)
                     candidates.append(np.asarray(res.gain_matrix, float).reshape(1, -1).T)
                 except Exception as exc:  # noqa: BLE001 - translated below
-                    failures.append(str(exc))
+                    failures.append(f"scipy place_poles: {exc}")
         else:
             if counts.max() <= k:
                 try:
                     candidates.append(_multi_output(Ao, Cr, poles))
                 except Exception as exc:  # noqa: BLE001 - translated below
-                    failures.append(str(exc))
+                    failures.append(f"scipy place_poles (YT): {exc}")
             if not candidates or counts.max() > 1:
                 # repeated poles beyond what the outputs give independently (deadbeat):
                 # a cyclic single-output design on a combination of the outputs
-                candidates.extend(_cyclic(Ao, Cr, poles))
+                candidates.extend(_cyclic(Ao, Cr, poles, failures))
+    candidates = [Lr for Lr in candidates if np.all(np.isfinite(Lr))]
     if not candidates:
+        reasons = (
+            "; ".join(dict.fromkeys(failures)) or "every method gave a gain that is not finite"
+        )
         raise PlacementAccuracyError(
-            f"poles: the pole placement failed numerically ({'; '.join(failures)}). The pair is "
+            f"poles: the pole placement failed numerically ({reasons}). The pair is "
             "observable to the rank tolerance, but so badly conditioned that the gain cannot "
             "be computed in double precision: place fewer poles per output, spread them "
             "apart, or scale the plant's states"

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from numbers import Real
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import control as ct
 import numpy as np
 
 from ._display import matrices_html, matrices_text
 from ._validation import as_matrix
+
+if TYPE_CHECKING:  # python-control is imported where a conversion needs it
+    import control as ct
 
 __all__ = ["Plant", "check_plant"]
 
@@ -242,6 +244,8 @@ class Plant:
         >>> plant.B.ravel().tolist(), plant.E.ravel().tolist()
         ([0.0, 1.0], [1.0, 0.0])
         """
+        import control as ct  # deferred on purpose: python-control takes a second to import
+
         if not isinstance(sys, ct.StateSpace):
             raise ValueError(f"sys must be a control.StateSpace, got {type(sys).__name__}")
         labels = list(sys.input_labels)
@@ -305,6 +309,8 @@ class Plant:
         kwargs = {"dt": self.dt if self.dt is not None else 0}
         if self.name:
             kwargs["name"] = self.name
+        import control as ct  # deferred on purpose: python-control takes a second to import
+
         return ct.ss(self.A, Bfull, self.C, Dfull, inputs=inputs, **kwargs)
 
     # display --------------------------------------------------------------

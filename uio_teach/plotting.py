@@ -274,7 +274,7 @@ def new_figure(width: float = 8.0, height: float = 5.0) -> Figure:
     >>> new_figure(6, 4).get_size_inches().tolist()
     [6.0, 4.0]
     """
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # deferred on purpose: matplotlib only when drawing
 
     return Figure(figsize=(width, height), layout="constrained")
 
@@ -441,7 +441,7 @@ def _figure_and_axes(
             )
         return axes[0].figure, axes
     if fig is None:
-        import matplotlib.pyplot as plt
+        import matplotlib.pyplot as plt  # deferred on purpose: pyplot only for a new figure
 
         fig = plt.figure(figsize=(FIGURE_WIDTH, height), layout="constrained")
     else:

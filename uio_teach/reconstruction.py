@@ -16,7 +16,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ._validation import as_real_array, as_real_number, as_time
 from .linalg import pinv, rank
@@ -152,6 +151,8 @@ def _lowpass_coefficients(h: float, tau: float) -> tuple[float, float, float]:
 
 def _lowpass(t: np.ndarray, x: np.ndarray, tau: float, y0: np.ndarray) -> np.ndarray:
     """Exact solution of ``tau y' = x - y``, ``y(t0) = y0``, for ``x`` linear between samples."""
+    from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
+
     steps = np.diff(t)
     h = (t[-1] - t[0]) / (t.size - 1)
     y = np.empty_like(x)
@@ -249,6 +250,8 @@ def reconstruct_input(
     >>> ut.reconstruct_input(plant, resp, method="filtered", tau=1e-3).method
     'filtered'
     """
+    from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
+
     if not isinstance(plant, Plant):
         raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
     if method not in ("derivative", "filtered"):

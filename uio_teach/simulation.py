@@ -45,7 +45,6 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.signal import lfilter
 
 from ._display import format_complex
 from ._validation import as_seed, as_time
@@ -400,6 +399,7 @@ def _one_blas_thread() -> Iterator[None]:
     global _CONTROLLER
     if _CONTROLLER is None:
         try:
+            # deferred on purpose: optional, and only needed once a simulation runs
             from threadpoolctl import ThreadpoolController
         except ImportError:  # pragma: no cover - threadpoolctl is optional
             _CONTROLLER = False
@@ -528,6 +528,8 @@ def _recursion(
     overwrites with its solution, followed by the inputs; complex
     coordinates take two real rows (real and imaginary part).
     """
+    from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
+
     nz, ns, N = Phi.shape[0], S.shape[0], S.shape[1]
     T, Z = _schur(Phi)
     cplx = np.iscomplexobj(T)

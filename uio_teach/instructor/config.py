@@ -432,7 +432,7 @@ class FigureConfig(Mapping[str, Any]):
         ------
         ConfigError
             An unknown key, a value of the wrong type or out of its range, a
-            bad length, an unstable or repeated pole, or poles an observer
+            bad length, an unstable pole, or poles an observer
             cannot have (wrong count, missing conjugate, ...). One line per
             problem, all of them (``err.problems``).
 

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import warnings
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
-import control as ct
 import numpy as np
 
 from .._display import fit_lines, format_complex, matrices_html, matrices_text
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
+
+if TYPE_CHECKING:  # python-control is imported where a conversion needs it
+    import control as ct
 
 __all__ = ["Observer", "ObserverRealization", "UnstableObserverWarning"]
 
@@ -124,6 +126,8 @@ class Observer:
         Do = np.hstack([np.zeros((pl.n, pl.m)), real.D_y])
         inputs = [f"u[{i}]" for i in range(pl.m)] + [f"y[{i}]" for i in range(pl.p)]
         outputs = [f"xhat[{i}]" for i in range(pl.n)]
+        import control as ct  # deferred on purpose: python-control takes a second to import
+
         return ct.ss(
             real.A,
             Bo,
