@@ -184,26 +184,32 @@ def _caption(frame: Frame) -> str:
     return text
 
 
-def _ends(err: np.ndarray | None) -> tuple[float, float] | None:
-    if err is None or not np.size(err):
-        return None
-    size = np.max(np.abs(err), axis=0)
-    return float(size[0]), float(size[-1])
-
-
 def _alt(frame: Frame, label: str, value: str) -> str:
-    """What the picture shows, in a sentence: how each observer's error ends."""
+    """What the picture shows, in a few sentences: what each observer's error does.
+
+    The words come from the frame's verdicts on the simulated errors, as do the
+    messages in the caption and the footer, so the three never disagree.
+    """
     sc = frame.scenario
     parts = [f"{sc.title} explorer at {label} {value}."]
-    pairs = ((sc.observer_name, frame.response), ("Luenberger observer", frame.luenberger_response))
-    for who, resp in pairs:
-        ends = _ends(None if resp is None else resp.error)
-        if ends is None:
+    rows = (
+        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message),
+        (
+            "Luenberger observer",
+            frame.luenberger,
+            frame.luenberger_verdict,
+            frame.luenberger_message,
+        ),
+    )
+    for who, observer, verdict, message in rows:
+        if verdict is not None:
+            parts.append(f"{who}: the error size |e| {verdict.words()}.")
+        elif observer is None:
             parts.append(f"{who}: no curve (no design).")
-            continue
-        a, b = ends
-        verb = "grows" if b > 1.5 * a else "decays" if b < 0.05 * a else "stays about as large"
-        parts.append(f"{who}: the largest error {verb}, from {a:.2g} to {b:.2g}.")
+        elif "overflows" in message:
+            parts.append(f"{who}: no curve (the error overflows).")
+        else:
+            parts.append(f"{who}: no curve (the simulation failed).")
     if frame.poles.size:
         parts.append(f"Pole map: {sc.observer_name} poles {format_poles(frame.poles, 3)}.")
     return " ".join(parts)
