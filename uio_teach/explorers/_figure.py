@@ -222,8 +222,9 @@ class ExplorerFigure:
         self.footer = self.fig.text(
             0.01, 0.005, "", fontsize=_FOOTER_PT * k, ha="left", va="bottom", color="C3"
         )
-        width_pt = self.fig.get_figwidth() * 72 * 0.98
-        self._wrap = max(30, int(width_pt / (0.5 * _FOOTER_PT * k)))
+        width_pt = self.fig.get_figwidth() * 72 * 0.97
+        self._wrap = max(30, int(width_pt / (0.56 * _FOOTER_PT * k)))
+        self._title_wrap = max(30, int(width_pt / (0.55 * 10 * k)))
         self.frame: Frame | None = None
         self.full_draws = 0
         self.partial_draws = 0
@@ -248,10 +249,16 @@ class ExplorerFigure:
         footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.04
         top_in = (10 * k * 1.3 + 6.5 * k * 2.6 + 8) / 72  # the title and the pole map's legend
         if self.narrow:
-            mosaic = [[f"uio.{r}", f"lb.{r}"] for r in rows] + [["poles", "signals"]]
-            panel_in = 1.55 * len(mosaic) + 0.45 * k * (len(mosaic) - 1)
+            top_in = (10 * k * 1.3 + 9 * k * 1.3 + 10) / 72  # the title and the panel titles
+        if self.narrow:
+            # a spacer row keeps room for the time axis above the pole map and its legend; the
+            # observers' rows share their time axis and sit close together
+            gap = (2 * 8 * k * 1.3 + 6.5 * k * 1.6 + 12) / 72
+            mosaic = [[f"uio.{r}", f"lb.{r}"] for r in rows] + [[".", "."], ["poles", "signals"]]
+            heights = [1.45] * len(rows) + [gap] + [1.45]
+            panel_in = sum(heights) + 0.14 * 1.45 * (len(mosaic) - 1)
             width = 4.6 if figsize is None else figsize[0]
-            ratios = {"width_ratios": [1.0, 1.0]}
+            ratios = {"width_ratios": [1.0, 1.0], "height_ratios": heights}
         else:
             side = ["poles"] * (len(rows) - 1) + ["signals"]
             mosaic = [[f"uio.{r}", f"lb.{r}", s] for r, s in zip(rows, side, strict=True)]
@@ -269,8 +276,8 @@ class ExplorerFigure:
                 "right": 1 - 0.3 / width,
                 "top": 1 - top_in / height,
                 "bottom": (axis_in + footer_in) / height,
-                "wspace": 0.42 if not self.narrow else 0.5,
-                "hspace": (0.5 if not self.narrow else 0.62) * k,
+                "wspace": 0.42 if not self.narrow else 0.45,
+                "hspace": 0.5 if not self.narrow else 0.14,
             },
         )
         self.fig = fig
@@ -385,7 +392,7 @@ class ExplorerFigure:
         pz.legend(
             loc="lower center",
             bbox_to_anchor=(0.5, 1.0),
-            ncol=2,
+            ncol=3 if self.narrow else 2,
             fontsize=6.5 * k,
             frameon=False,
             handlelength=1.0,
@@ -469,10 +476,10 @@ class ExplorerFigure:
         self.lines["poles"][0].set_data(frame.poles.real, frame.poles.imag)
         lp = frame.luenberger_poles
         self.lines["luenberger poles"][0].set_data(lp.real, lp.imag)
-        self.title.set_text(
-            f"{self.scenario.title}: {frame.disturbance}"
-            + (f", noise {frame.settings.noise:.3g}" if frame.settings.noise else "")
+        title = f"{self.scenario.title}: {frame.disturbance}" + (
+            f", noise {frame.settings.noise:.3g}" if frame.settings.noise else ""
         )
+        self.title.set_text(textwrap.shorten(title, self._title_wrap, placeholder=" …"))
         self.footer.set_text(self._footer_text(frame.all_messages))
         rows = {name.split(".")[1] for name in self.axes if name.startswith("uio.")}
         fresh = self._fresh or not self.sticky

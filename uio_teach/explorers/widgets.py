@@ -35,6 +35,7 @@ Examples
 from __future__ import annotations
 
 import cmath
+import dataclasses
 import html
 import math
 from collections.abc import Iterator
@@ -675,8 +676,6 @@ def missile_explorer(
         raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
     scenario = missile_scenario()
     if observer_family == "ginverse":
-        import dataclasses
-
         scenario = dataclasses.replace(
             scenario,
             family="ginverse",
