@@ -226,8 +226,10 @@ def test_every_control_value_gives_a_picture_or_a_message(name):
             out.append((key, draw(_choices(ex.controls[key]))))
         return out
 
+    # a sample: the edges and a seeded random subset of every control's range are swept, word
+    # by word, in test_explorers.py::test_sweep_no_word_contradicts_the_simulated_error
     @settings(
-        max_examples=20,
+        max_examples=8,
         derandomize=True,
         deadline=None,
         suppress_health_check=[HealthCheck.too_slow],
@@ -259,7 +261,7 @@ class _Links(HTMLParser):
     def handle_starttag(self, tag, attrs):
         self.tags.append(tag)
         for key, value in attrs:
-            if key in ("src", "href", "data-src", "action"):
+            if key in ("src", "href", "data-src", "data-narrow", "srcset", "action"):
                 self.urls.append(value or "")
 
 
@@ -355,6 +357,8 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
                 assert tab.inner_text(f"#{eid} output") == "-4"
                 assert tab.inner_text(f"#{eid} .uio-caption") == frames[(1, 0)].caption
                 assert tab.get_attribute(img, "alt") == frames[(1, 0)].alt
+                source = f"#{eid} source"  # the phone picture follows the slider too
+                assert tab.get_attribute(source, "srcset") == frames[(1, 0)].narrow_url
 
                 tab.select_option(f"#{eid} select", "1")  # random steps
                 assert tab.get_attribute(img, "src") == frames[(1, 1)].data_url

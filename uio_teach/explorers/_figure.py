@@ -28,6 +28,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from matplotlib.text import Text
 from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter
 from matplotlib.transforms import Bbox, IdentityTransform
 from PIL import Image
@@ -146,7 +147,7 @@ class ExplorerFigure:
     dpi : float
         Resolution.
     figsize : tuple of float, optional
-        Size in inches; by default 9 inches wide (4.6 when ``narrow``) and as
+        Size in inches; by default 9 inches wide (4.4 when ``narrow``) and as
         tall as the panels, the title and the footer's reserved lines need.
     sticky : bool
         Keep an axis range while the new data fit it and fill at least a
@@ -209,6 +210,8 @@ class ExplorerFigure:
         self.narrow = bool(narrow)
         self.lmi = scenario.decay_limits is not None if lmi is None else bool(lmi)
         self.footer_lines = int(footer_lines)
+        # the legends: the smallest text (on a phone as large as the tick labels)
+        self.legend_pt = (7.0 if self.narrow else 6.5) * k
         self.lines: dict[str, list] = {}
         self.notes: dict[str, Any] = {}  # texts drawn over the curves (none by default)
         self._layout(figsize, dpi)
@@ -235,6 +238,22 @@ class ExplorerFigure:
         self.sticky = sticky
         self._legend_boxes: list[tuple[int, int, int, int]] = []
 
+    def smallest_text_pt(self) -> float:
+        """The size of the smallest text drawn in the figure, in points.
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
+        >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
+        6.5
+        """
+        texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+        return float(min(t.get_fontsize() for t in texts))
+
     @property
     def rows(self) -> list[str]:
         """The kinds of curve, one row of panels each: error, residual (and input)."""
@@ -253,11 +272,11 @@ class ExplorerFigure:
         if self.narrow:
             # a spacer row keeps room for the time axis above the pole map and its legend; the
             # observers' rows share their time axis and sit close together
-            gap = (2 * 8 * k * 1.3 + 6.5 * k * 1.6 + 12) / 72
+            gap = (2 * 8 * k * 1.3 + self.legend_pt * 1.6 + 12) / 72
             mosaic = [[f"uio.{r}", f"lb.{r}"] for r in rows] + [[".", "."], ["poles", "signals"]]
             heights = [1.45] * len(rows) + [gap] + [1.45]
             panel_in = sum(heights) + 0.14 * 1.45 * (len(mosaic) - 1)
-            width = 4.6 if figsize is None else figsize[0]
+            width = 4.4 if figsize is None else figsize[0]
             ratios = {"width_ratios": [1.0, 1.0], "height_ratios": heights}
         else:
             side = ["poles"] * (len(rows) - 1) + ["signals"]
@@ -331,9 +350,11 @@ class ExplorerFigure:
                     if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
                         shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
                         if shown:
-                            ax.legend(handles=shown, **{**_LEGEND, "fontsize": 6.5 * k, "ncol": 1})
+                            ax.legend(
+                                handles=shown, **{**_LEGEND, "fontsize": self.legend_pt, "ncol": 1}
+                            )
                     else:
-                        ax.legend(**{**_LEGEND, "fontsize": 6.5 * k})
+                        ax.legend(**{**_LEGEND, "fontsize": self.legend_pt})
             axes[f"{who}.{rows[-1]}"].set_xlabel(self._xlabel(), fontsize=8 * k)
         short = self.narrow
         axes["uio.error"].set_title(
@@ -393,7 +414,7 @@ class ExplorerFigure:
             loc="lower center",
             bbox_to_anchor=(0.5, 1.0),
             ncol=3 if self.narrow else 2,
-            fontsize=6.5 * k,
+            fontsize=self.legend_pt,
             frameon=False,
             handlelength=1.0,
             columnspacing=0.8,
@@ -418,7 +439,7 @@ class ExplorerFigure:
             for i in range(plant.nv)
         ]
         if plant.q + plant.nv:
-            sig.legend(**{**_LEGEND, "fontsize": 6.5 * k})
+            sig.legend(**{**_LEGEND, "fontsize": self.legend_pt})
         sig.set_xlabel(self._xlabel(), fontsize=8 * k)
         sig.grid(True, alpha=0.3)
         sig.yaxis.set_major_locator(MaxNLocator(4 if self.narrow else 5))
@@ -520,7 +541,8 @@ class ExplorerFigure:
             lines += textwrap.wrap(m, self._wrap) or [""]
         if len(lines) > self.footer_lines:
             keep = lines[: self.footer_lines]
-            keep[-1] = keep[-1][: self._wrap - 20].rstrip() + " … (all in the text)"
+            keep[-1] = textwrap.shorten(keep[-1], self._wrap - 18, placeholder=" …")
+            keep[-1] += " (all in the text)"
             lines = keep
         return "\n".join(lines)
 

@@ -212,14 +212,14 @@ def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list
                 obs: Observer = design_ginverse(plant)
             elif lmi:
                 key = ("lmi", float(s.decay))
-                if key not in scenario._cache:
+                if key not in scenario.cache:
                     try:
-                        scenario._cache[key] = design_pmo(plant, method="lmi", decay=s.decay)
+                        scenario.cache[key] = design_pmo(plant, method="lmi", decay=s.decay)
                     except (LMIInfeasibleError, LMISolverError) as exc:
-                        scenario._cache[key] = exc
-                if isinstance(scenario._cache[key], Exception):
-                    raise scenario._cache[key]
-                obs = scenario._cache[key]
+                        scenario.cache[key] = exc
+                if isinstance(scenario.cache[key], Exception):
+                    raise scenario.cache[key]
+                obs = scenario.cache[key]
             else:
                 poles = expand_poles(s.poles)
                 design = design_uio if scenario.family == "uio" else design_pmo

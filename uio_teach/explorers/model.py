@@ -234,6 +234,9 @@ class Scenario:
     input_symbol : str
         The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
         the missile paper).
+    cache : dict
+        Designs kept between frames (the LMI's gain for each bound, which
+        takes a solver run); empty at first.
 
     Examples
     --------
@@ -265,7 +268,7 @@ class Scenario:
     static_values: tuple[float, ...]
     static_control: str
     input_symbol: str = "d"
-    _cache: dict = field(default_factory=dict, repr=False)
+    cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def movable(self) -> int:

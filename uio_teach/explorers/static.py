@@ -234,7 +234,7 @@ def static_explorer(
     values: Sequence[float] | None = None,
     disturbances: Sequence[str] | None = None,
     dpi: float = 144,
-    colors: int = 64,
+    colors: int = 32,
     element_id: str | None = None,
     narrow: bool = True,
 ) -> StaticExplorer:
@@ -259,7 +259,8 @@ def static_explorer(
         Resolution of the pictures (144: about 1300 pixels wide, twice the
         density at which they are shown).
     colors : int
-        Palette size of the PNGs (smaller files).
+        Palette size of the PNGs (smaller files; 32 keeps the curves' colours and the
+        text's antialiasing).
     element_id : str, optional
         The id of the outer element; a unique ``uio-explorer-<name>-<k>``
         by default.
@@ -369,7 +370,7 @@ def static_html(
     values: Sequence[float] | None = None,
     disturbances: Sequence[str] | None = None,
     dpi: float = 144,
-    colors: int = 64,
+    colors: int = 32,
     element_id: str | None = None,
     narrow: bool = True,
 ) -> str:
@@ -436,11 +437,11 @@ NARROW_PX = 700
 WIDE_FONTSCALE = 1.45
 """Font scale of the wide pictures (shown at most 780 px wide, drawn 1296 px wide)."""
 
-NARROW_FONTSCALE = 1.2
-"""Font scale of the phone pictures: 4.6 inches shown about 360 px wide keep text >= 9 px."""
+NARROW_FONTSCALE = 1.25
+"""Font scale of the phone pictures: 4.4 inches shown 330 px wide or more keep text >= 9 px."""
 
-NARROW_DPI = 150
-"""Resolution of the phone pictures (about twice the CSS pixels of a phone's column)."""
+NARROW_DPI = 136
+"""Resolution of the phone pictures (about 1.6 times the CSS pixels of a phone's column)."""
 
 # The layout: on a wide screen the controls share a row above a picture at most 780 px wide; on a
 # narrow one each control takes a row of its own, the slider the full width, and the picture drawn

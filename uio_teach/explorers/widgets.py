@@ -47,11 +47,12 @@ import numpy as np
 
 from .._display import format_poles
 from ..plant import Plant
-from ._drag import DragPoles, _in_kernel, drag_available
+from ._drag import DragPoles, drag_available, in_kernel
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+from .static import static_html
 
 __all__ = [
     "Explorer",
@@ -193,7 +194,7 @@ class Explorer(DragPoles):
         self.canvas: Any = None
         self._dragging: tuple[int, str] | None = None
         if drag is None:
-            drag = _in_kernel() and drag_available() and scenario.movable > 0
+            drag = in_kernel() and drag_available() and scenario.movable > 0
         if drag:
             self.canvas = self._make_canvas()
         fig = self.figure.fig
@@ -531,8 +532,6 @@ class Explorer(DragPoles):
         18
         """
         if self._static_html is None:
-            from .static import static_html
-
             self._static_html = static_html(self.scenario, self._base)
         return self._static_html
 
@@ -681,7 +680,7 @@ def missile_explorer(
             family="ginverse",
             static_control="amplitude",
             static_values=(0.0, 5.0, 10.0, 20.0, 40.0),
-            _cache={},
+            cache={},
         )
     return Explorer(scenario, static=static, drag=drag)
 
