@@ -573,13 +573,13 @@ def _largest_gain(frame, idx):
 
 @pytest.mark.parametrize("name", sorted(SWEEP))
 def test_sweep_no_word_contradicts_the_simulated_error(name):
-    from uio_teach.explorers.static import _alt, _caption
+    from uio_teach.explorers.static import frame_alt, frame_caption
 
     sc = SWEEP[name]()
     for s in _sweep_settings(sc):
         frame = compute_frame(sc, s)
-        alt = _alt(frame, "pole", "x")
-        caption = _caption(frame)
+        alt = frame_alt(frame, "pole", "x")
+        caption = frame_caption(frame)
         lb_alt = alt.split("Luenberger observer:")[1]
         for observer, resp, message, words in (
             (frame.observer, frame.response, frame.observer_message, alt.split("Luenberger")[0]),
@@ -648,9 +648,9 @@ def test_overflow_is_one_line():
     assert frame.response is None
     assert frame.observer_message.startswith("unstable (pole 0.9 in the right half-plane)")
     assert frame.luenberger_message == "its error overflows too, no curve"
-    from uio_teach.explorers.static import _alt
+    from uio_teach.explorers.static import frame_alt
 
-    alt = _alt(frame, "pole", "0.9")
+    alt = frame_alt(frame, "pole", "0.9")
     assert alt.count("no curve (the error overflows)") == 2 and "no design" not in alt
 
 

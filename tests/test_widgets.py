@@ -284,8 +284,9 @@ def test_static_frames_count_size_and_no_external_url(pa9_static):
 
 
 def test_static_ids_are_unique_and_frames_differ():
-    a = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
-    b = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
+    grid = {"values": (0.0, 0.9), "disturbances": ("sinusoid",), "narrow": False}
+    a = static_explorer(case_study_scenario(), **grid)
+    b = static_explorer(case_study_scenario(), **grid)
     assert a.element_id != b.element_id
     assert a.frames[0].png != a.frames[1].png
     assert a.frames[0].settings.poles == (0.0,) and a.frames[1].settings.poles == (0.9,)

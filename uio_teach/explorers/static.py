@@ -46,7 +46,15 @@ from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, Scenario, Settings
 
-__all__ = ["StaticFrame", "StaticExplorer", "frame_settings", "static_explorer", "static_html"]
+__all__ = [
+    "StaticFrame",
+    "StaticExplorer",
+    "frame_settings",
+    "frame_caption",
+    "frame_alt",
+    "static_explorer",
+    "static_html",
+]
 
 _IDS = itertools.count(1)
 
@@ -184,7 +192,25 @@ def frame_settings(
     return settings.replace(poles=poles, disturbance=disturbance, mode="poles")
 
 
-def _caption(frame: Frame) -> str:
+def frame_caption(frame: Frame) -> str:
+    """The caption of a static frame: the disturbance, the poles, every message, the explanation.
+
+    Parameters
+    ----------
+    frame : Frame
+        The frame.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers.static import frame_caption
+    >>> frame_caption(compute_frame(pa9_scenario()))[:38]
+    'Disturbance: sinusoid, amplitude 1, fr'
+    """
     name = frame.scenario.observer_name
     parts = [f"disturbance: {frame.disturbance}"] if frame.disturbance else []
     if frame.poles.size:
@@ -196,11 +222,31 @@ def _caption(frame: Frame) -> str:
     return text
 
 
-def _alt(frame: Frame, label: str, value: str) -> str:
-    """What the picture shows, in a few sentences: what each observer's error does.
+def frame_alt(frame: Frame, label: str, value: str) -> str:
+    """The text alternative of a static frame: what each observer's error does, in a few sentences.
 
     The words come from the frame's verdicts on the simulated errors, as do the
-    messages in the caption and the footer, so the three never disagree.
+    messages in the caption and the footer, so the three never disagree. A
+    curve that is missing says why in one line: no design, an overflow, or a
+    failed simulation.
+
+    Parameters
+    ----------
+    frame : Frame
+        The frame.
+    label, value : str
+        The main control's name and value.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers.static import frame_alt
+    >>> frame_alt(compute_frame(pa9_scenario()), "UIO pole", "-1").split(". ")[1]
+    'UIO: the error size |e| decays from 1.5 to 1.5e-05'
     """
     sc = frame.scenario
     parts = [f"{sc.title} explorer at {label} {value}."]
@@ -333,9 +379,9 @@ def static_explorer(
                     index=(i, j),
                     settings=s,
                     png=_png(figure, colors),
-                    caption=_caption(frame),
+                    caption=frame_caption(frame),
                     label=f"{value:g}",
-                    alt=_alt(frame, main_control_label(scenario, base), f"{value:g}"),
+                    alt=frame_alt(frame, main_control_label(scenario, base), f"{value:g}"),
                     png_narrow=small,
                 )
             )
