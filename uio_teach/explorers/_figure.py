@@ -220,7 +220,8 @@ class ExplorerFigure:
         self._signal_panel()
         for ax in self.axes.values():
             ax.tick_params(labelsize=7 * k)
-        self.title = self.fig.suptitle("", fontsize=10 * k)
+        top = 1 - 4 / 72 / self.fig.get_figheight()
+        self.title = self.fig.suptitle("", fontsize=10 * k, y=top, va="top")
         # the observers' messages go under the panels (the footer), in space kept for them
         self.footer = self.fig.text(
             0.01, 0.005, "", fontsize=_FOOTER_PT * k, ha="left", va="bottom", color="C3"
@@ -266,9 +267,11 @@ class ExplorerFigure:
         # under the bottom panels: tick labels, the axis label, then the footer's lines
         axis_in = (15 * k * 1.3 + 8) / 72
         footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.04
-        top_in = (10 * k * 1.3 + 6.5 * k * 2.6 + 8) / 72  # the title and the pole map's legend
+        # above the panels: the title (its top 4 pt under the edge), then the pole map's legend
+        # (two rows) or, on a phone, the panel titles; bands apart, so each redraws alone
+        top_in = (4 + 10 * k * 1.35 + 4 + self.legend_pt * 3.4 + 6) / 72
         if self.narrow:
-            top_in = (10 * k * 1.3 + 9 * k * 1.3 + 10) / 72  # the title and the panel titles
+            top_in = (4 + 10 * k * 1.35 + 4 + 9 * k * 1.4 + 6) / 72
         if self.narrow:
             # a spacer row keeps room for the time axis above the pole map and its legend; the
             # observers' rows share their time axis and sit close together
