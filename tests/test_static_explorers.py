@@ -1,7 +1,8 @@
 """The static explorers in a browser: every position of the slider and the menu shows another
 picture, caption and text alternative; the pictures are HiDPI; each explorer page stays small; on
-a 390 px phone the explorer fits the column (the picture scaled, the controls stacked and usable,
-the picture enlarged on a tap), and at 1280 px it keeps its one-row layout.
+a 390 px phone the explorer fits the column (the picture drawn for the phone, its text at least
+9 CSS pixels, the controls stacked and usable), at 1280 px it keeps its one-row layout, and the
+explorer keeps its height while the slider moves.
 
 Each explorer's static HTML (what the book embeds) is opened from a file in headless Chromium
 (Debian's ``/usr/bin/chromium``, driven by Playwright), with every request that leaves the page
@@ -19,8 +20,19 @@ from pathlib import Path
 import pytest
 
 import uio_teach as ut
-from uio_teach.explorers import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
-from uio_teach.explorers.static import static_explorer
+from uio_teach.explorers import (
+    ExplorerFigure,
+    case_study_scenario,
+    make_scenario,
+    missile_scenario,
+    pa9_scenario,
+)
+from uio_teach.explorers.static import (
+    NARROW_DPI,
+    NARROW_FONTSCALE,
+    WIDE_FONTSCALE,
+    static_explorer,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
@@ -80,6 +92,7 @@ def _in_chromium(work) -> None:
 _STATE_JS = """() => {
   const img = document.querySelector('img.uio-frame');
   return {src: img.src, alt: img.alt, width: img.naturalWidth,
+          shown: img.getBoundingClientRect().width, current: img.currentSrc,
           caption: document.querySelector('.uio-caption').textContent,
           live: document.querySelector('.uio-caption').getAttribute('aria-live')};
 }"""
@@ -113,14 +126,14 @@ def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
                 page.evaluate(_SET_JS, [i, j])
                 page.wait_for_function("() => document.querySelector('img.uio-frame').complete")
                 state = page.evaluate(_STATE_JS)
-                assert state["width"] >= 1200, state["width"]
+                assert state["width"] >= 1.5 * state["shown"], state["width"]  # HiDPI
                 assert state["live"] == "polite"
                 seen.append(state)
         page.close()
 
     _in_chromium(work)
     assert len(seen) == values * kinds
-    for key in ("src", "alt", "caption"):
+    for key in ("src", "current", "alt", "caption"):
         assert len({s[key] for s in seen}) == len(seen), f"{key} repeats between positions"
 
 
@@ -154,7 +167,7 @@ _LAYOUT_JS = """(k) => {
   const column = parent.clientWidth - parseFloat(ps.paddingLeft) - parseFloat(ps.paddingRight);
   const picture = root.querySelector('.uio-picture'), img = root.querySelector('img.uio-frame');
   const parts = {slider: 'input[type=range]', value: 'output', select: 'select',
-                 caption: '.uio-caption', zoom: '.uio-zoom-label'};
+                 caption: '.uio-caption'};
   const controls = {};
   for (const [name, sel] of Object.entries(parts)) {
     const e = root.querySelector(sel);
@@ -164,8 +177,10 @@ _LAYOUT_JS = """(k) => {
           box: rect(root), column, img: rect(img),
           natural: img.naturalWidth, naturalHeight: img.naturalHeight,
           picture: {client: picture.clientWidth, scroll: picture.scrollWidth},
-          zoomed: root.classList.contains('uio-zoomed'), controls,
-          state: {src: img.src, alt: img.alt, value: root.querySelector('input[type=range]').value,
+          captions: rect(root.querySelector('.uio-captions')), height: rect(root).height,
+          controls, current: img.currentSrc,
+          state: {src: img.currentSrc, alt: img.alt,
+                  value: root.querySelector('input[type=range]').value,
                   caption: root.querySelector('.uio-caption').textContent}};
 }"""
 
@@ -174,9 +189,21 @@ def _block_the_network(page) -> None:
     page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file:") else r.abort())
 
 
+def _smallest_text_px(m: dict, narrow: bool) -> float:
+    """The smallest text of the shown picture in CSS pixels (its size in points is the figure's)."""
+    scenario = pa9_scenario()  # the same fonts in every explorer
+    if narrow:
+        figure = ExplorerFigure(scenario, dpi=NARROW_DPI, fontscale=NARROW_FONTSCALE, narrow=True)
+    else:
+        figure = ExplorerFigure(scenario, dpi=144, fontscale=WIDE_FONTSCALE)
+    points = figure.smallest_text_pt()
+    return points * figure.fig.dpi / 72 * m["img"]["width"] / m["natural"]
+
+
 def _check_phone_layout(m: dict, where: str) -> None:
-    """The explorer fits a 390 px screen: nothing wider than the viewport, the picture scaled to
-    the column, every control on screen and stacked."""
+    """The explorer fits a 390 px screen: nothing wider than the viewport, the picture drawn for
+    the phone fills the column with text of at least 9 CSS pixels, every control on screen and
+    stacked."""
     inner = m["inner"]
     assert m["box"]["left"] >= -0.5 and m["box"]["right"] <= inner + 0.5, (where, m["box"])
     assert m["box"]["width"] <= m["column"] + 0.5, (where, m["box"], m["column"])
@@ -184,7 +211,9 @@ def _check_phone_layout(m: dict, where: str) -> None:
     assert m["img"]["width"] <= min(m["column"], m["box"]["width"]) + 0.5, (where, m["img"])
     assert m["img"]["width"] > 300, (where, m["img"])
     assert m["picture"]["scroll"] <= m["picture"]["client"], (where, m["picture"])
-    assert m["natural"] >= 1200
+    assert m["natural"] >= 1.5 * m["img"]["width"], (where, m["natural"])  # HiDPI
+    assert m["natural"] < m["naturalHeight"], f"{where}: not the phone picture"
+    assert _smallest_text_px(m, narrow=True) >= 9, (where, m["img"])
     for name, c in m["controls"].items():
         if name == "select" and not c["shown"]:
             continue  # one disturbance type only: no menu
@@ -194,11 +223,8 @@ def _check_phone_layout(m: dict, where: str) -> None:
     assert slider["width"] >= 0.7 * m["box"]["width"], (where, slider)  # the whole row: easy to hit
     assert slider["height"] >= 30, (where, slider)  # a finger-sized target
     c = m["controls"]
-    assert c["zoom"]["height"] >= 30, (where, c["zoom"])
-    # stacked: the menu below the slider, the enlarge box below both, the picture below all
-    rows = (
-        [c["slider"], c["select"], c["zoom"]] if c["select"]["shown"] else [c["slider"], c["zoom"]]
-    )
+    # stacked: the menu below the slider, the picture below both
+    rows = [c["slider"], c["select"]] if c["select"]["shown"] else [c["slider"]]
     for upper, lower in itertools.pairwise([*rows, m["img"]]):
         assert lower["top"] >= upper["bottom"] - 0.5, (where, upper, lower)
     _check_aspect(m, where)
@@ -212,8 +238,8 @@ def _check_aspect(m: dict, where: str) -> None:
 
 
 def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
-    """Drive the k-th explorer as a reader would, by mouse, touch and keyboard: slider to either
-    end, the other disturbance type, the picture enlarged and back. Returns the states seen."""
+    """Drive the k-th explorer as a reader would, by mouse and keyboard: slider to either end,
+    the other disturbance type. Returns the states seen."""
     root = page.locator(".uio-static-explorer").nth(k)
     root.scroll_into_view_if_needed()
     slider = root.locator("input[type=range]")
@@ -240,16 +266,10 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
     for a, b in itertools.pairwise(seen[1:]):
         for key in ("src", "alt", "caption"):
             assert a["state"][key] != b["state"][key], (where, key, a["state"]["value"])
-    # a tap on the picture enlarges it to half its pixel width; it scrolls inside its own box
-    root.locator("img.uio-frame").tap()
-    big = page.evaluate(_LAYOUT_JS, k)
-    assert big["zoomed"], where
-    assert big["img"]["width"] >= big["natural"] / 2 - 0.5, (where, big["img"], big["natural"])
-    assert big["picture"]["scroll"] > big["picture"]["client"], (where, big["picture"])
-    assert big["box"]["right"] <= big["inner"] + 0.5 and big["doc"] <= big["inner"], where
-    root.locator(".uio-zoom").click()  # the check box clears it again
-    back = page.evaluate(_LAYOUT_JS, k)
-    assert not back["zoomed"] and back["img"]["width"] == seen[-1]["img"]["width"], where
+    # the explorer keeps its height while the slider and the menu move: the page never jumps
+    heights = {round(m["height"], 1) for m in seen}
+    assert len(heights) == 1, (where, heights)
+    assert len({round(m["captions"]["height"], 1) for m in seen}) == 1, where
     return seen
 
 
@@ -287,7 +307,8 @@ def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
 def test_wide_layout_is_kept(name, tmp_path):
-    """At 1280 px the controls share one row above a 780 px picture; no enlarge box."""
+    """At 1280 px the controls share one row above a 780 px picture, drawn wide, with text of at
+    least 9 CSS pixels."""
     path, kinds = _standalone(name, tmp_path)
     measured = {}
 
@@ -302,7 +323,8 @@ def test_wide_layout_is_kept(name, tmp_path):
     _in_chromium(work)
     m = measured["m"]
     assert m["box"]["width"] == 780 and m["img"]["width"] == 780, m
-    assert not m["controls"]["zoom"]["shown"]
+    assert m["natural"] > m["naturalHeight"]  # the wide picture
+    assert _smallest_text_px(m, narrow=False) >= 9
     c = m["controls"]
     if kinds > 1:  # one row: the menu right of the slider, on the same middle line
         assert c["slider"]["right"] < c["select"]["left"], c

@@ -223,8 +223,10 @@ def test_every_control_value_gives_a_picture_or_a_message(name):
             out.append((key, draw(_choices(ex.controls[key]))))
         return out
 
+    # a sample: the edges and a seeded random subset of every control's range are swept, word
+    # by word, in test_explorers.py::test_sweep_no_word_contradicts_the_simulated_error
     @settings(
-        max_examples=20,
+        max_examples=8,
         derandomize=True,
         deadline=None,
         suppress_health_check=[HealthCheck.too_slow],
@@ -256,7 +258,7 @@ class _Links(HTMLParser):
     def handle_starttag(self, tag, attrs):
         self.tags.append(tag)
         for key, value in attrs:
-            if key in ("src", "href", "data-src", "action"):
+            if key in ("src", "href", "data-src", "data-narrow", "srcset", "action"):
                 self.urls.append(value or "")
 
 
@@ -279,8 +281,9 @@ def test_static_frames_count_size_and_no_external_url(pa9_static):
 
 
 def test_static_ids_are_unique_and_frames_differ():
-    a = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
-    b = static_explorer(case_study_scenario(), values=(0.0, 0.9), disturbances=("sinusoid",))
+    grid = {"values": (0.0, 0.9), "disturbances": ("sinusoid",), "narrow": False}
+    a = static_explorer(case_study_scenario(), **grid)
+    b = static_explorer(case_study_scenario(), **grid)
     assert a.element_id != b.element_id
     assert a.frames[0].png != a.frames[1].png
     assert a.frames[0].settings.poles == (0.0,) and a.frames[1].settings.poles == (0.9,)
@@ -352,6 +355,8 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
                 assert tab.inner_text(f"#{eid} output") == "-4"
                 assert tab.inner_text(f"#{eid} .uio-caption") == frames[(1, 0)].caption
                 assert tab.get_attribute(img, "alt") == frames[(1, 0)].alt
+                source = f"#{eid} source"  # the phone picture follows the slider too
+                assert tab.get_attribute(source, "srcset") == frames[(1, 0)].narrow_url
 
                 tab.select_option(f"#{eid} select", "1")  # random steps
                 assert tab.get_attribute(img, "src") == frames[(1, 1)].data_url

@@ -10,6 +10,10 @@ same poles, for one plant, and let a student move the poles and the disturbance:
   :func:`make_scenario` for any plant;
 * :mod:`~uio_teach.explorers.frames` -- :func:`compute_frame`: design, simulate and
   prepare one picture (:class:`Frame`), never raising for a value a student can set;
+* :mod:`~uio_teach.explorers.modes` -- the error's modes: which the start excites
+  (:func:`excited_modes`), which the controls move, how fast they shrink the error;
+* :mod:`~uio_teach.explorers.messages` -- the words, all derived from one
+  :class:`ErrorVerdict` on the simulated error;
 * :class:`ExplorerFigure` and :func:`render` -- the figure, updated in place;
 * :mod:`~uio_teach.explorers.widgets` -- the live explorers (ipywidgets, loaded on first
   use): :func:`~uio_teach.explorers.widgets.pa9_explorer` and the others;
@@ -31,7 +35,8 @@ Examples
 
 from ..luenberger import luenberger_poles
 from ._figure import ExplorerFigure, render
-from .frames import Frame, compute_frame, error_grows, excited_modes
+from .frames import Frame, compute_frame
+from .messages import ErrorVerdict, error_grows
 from .model import (
     DISTURBANCES,
     FAMILIES,
@@ -39,9 +44,12 @@ from .model import (
     Channel,
     Scenario,
     Settings,
+    default_poles,
+    default_timepts,
     disturbance_signals,
     expand_poles,
 )
+from .modes import excited_modes
 from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
 
 __all__ = [
@@ -63,5 +71,8 @@ __all__ = [
     "compute_frame",
     "excited_modes",
     "error_grows",
+    "ErrorVerdict",
+    "default_poles",
+    "default_timepts",
     "render",
 ]

@@ -40,15 +40,26 @@ def drag_available() -> bool:
     >>> isinstance(drag_available(), bool)
     True
     """
-    try:
+    try:  # deferred on purpose: ipympl is optional, and probing it loads a widget backend
         import ipympl.backend_nbagg  # noqa: F401
     except Exception:  # not installed, or an incompatible version: sliders only
         return False
     return True
 
 
-def _in_kernel() -> bool:
-    """True inside a Jupyter kernel (where a canvas widget can be shown)."""
+def in_kernel() -> bool:
+    """True inside a Jupyter kernel (where a canvas widget can be shown).
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> from uio_teach.explorers._drag import in_kernel
+    >>> in_kernel()
+    False
+    """
     ipython = sys.modules.get("IPython")  # loaded in every Jupyter kernel
     shell = ipython.get_ipython() if ipython is not None else None
     return shell is not None and hasattr(shell, "kernel")
@@ -80,7 +91,7 @@ class DragPoles:
     # dragging poles on the pole map -------------------------------------------------------
     def _make_canvas(self) -> Any:
         """An ipympl canvas for the figure, or None when the widget backend does not load."""
-        try:
+        try:  # deferred on purpose: ipympl is optional (drag_available said it loads)
             from ipympl.backend_nbagg import Canvas, FigureManager
 
             canvas = Canvas(self.figure.fig)

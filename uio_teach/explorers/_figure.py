@@ -17,20 +17,26 @@ True
 
 from __future__ import annotations
 
+import io
 import itertools
 import math
 import textwrap
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+from matplotlib.text import Text
+from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter
+from matplotlib.transforms import Bbox, IdentityTransform
+from PIL import Image
 
 from ..plotting import axis_label, symbol, time_label
-from .frames import Frame, compute_frame
+from .frames import Frame, compute_frame, finite_max
+from .messages import ROUNDING
 from .model import Scenario, Settings
-
-if TYPE_CHECKING:  # pragma: no cover
-    from matplotlib.figure import Figure
 
 __all__ = ["ExplorerFigure", "render"]
 
@@ -44,6 +50,8 @@ _LEGEND = {
     "framealpha": 1.0,
     "fancybox": False,
 }
+
+_FOOTER_PT = 7.5  # the footer's font size (points, before ``fontscale``)
 
 
 def _nice_range(arrays: Sequence[np.ndarray | None]) -> tuple[float, float]:
@@ -104,18 +112,6 @@ def _keep_range(
     return current
 
 
-def _finite_max(*arrays: np.ndarray | None) -> float:
-    best = 0.0
-    for a in arrays:
-        if a is None or not np.size(a):
-            continue
-        a = np.abs(np.asarray(a, dtype=float))
-        a = a[np.isfinite(a)]
-        if a.size:
-            best = max(best, float(a.max()))
-    return best
-
-
 def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
     return bool(
         inner.x0 >= outer.x0 - slack
@@ -151,13 +147,25 @@ class ExplorerFigure:
     dpi : float
         Resolution.
     figsize : tuple of float, optional
-        Size in inches; (9, 4.8), or (9, 6.2) with the reconstruction row.
+        Size in inches; by default 9 inches wide (4.4 when ``narrow``) and as
+        tall as the panels, the title and the footer's reserved lines need.
     sticky : bool
         Keep an axis range while the new data fit it and fill at least a
         third of it (fewer redraws, for live use); ``False`` gives every frame
         its own range (for pictures that must not depend on the previous one).
     fontscale : float
         Multiplies every font size (larger for pictures shown scaled down).
+    narrow : bool
+        The layout for a phone: the two observers side by side, one row per
+        kind of curve, the pole map and the unknown signals in a last row.
+    lmi : bool, optional
+        Whether the certified LMI envelope can be drawn (and is listed in the
+        legend); by default when the scenario has an LMI mode.
+    footer_lines : int
+        The lines kept free under the panels for the messages: the footer
+        never overlaps the tick labels, and the figure's size does not depend
+        on the messages. Longer messages end in an ellipsis (all of them are
+        in the text beside the figure).
 
     Attributes
     ----------
@@ -193,175 +201,34 @@ class ExplorerFigure:
         figsize: tuple[float, float] | None = None,
         sticky: bool = True,
         fontscale: float = 1.0,
+        narrow: bool = False,
+        lmi: bool | None = None,
+        footer_lines: int = 3,
     ) -> None:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
-        from matplotlib.ticker import MaxNLocator
-
         self.scenario = scenario
-        plant = scenario.plant
-        rows = ["error", "residual"] + (["input"] if scenario.reconstruct else [])
-        side = ["poles"] * (len(rows) - 1) + ["signals"]
-        mosaic = [[f"uio.{r}", f"lb.{r}", s] for r, s in zip(rows, side, strict=True)]
-        if figsize is None:
-            figsize = (9.0, 6.2) if scenario.reconstruct else (9.0, 4.8)
-        fig = Figure(figsize=figsize, dpi=dpi)
-        k = float(fontscale)
-        self.fontscale = k
-        FigureCanvasAgg(fig)
-        axes = fig.subplot_mosaic(
-            mosaic,
-            gridspec_kw={
-                "width_ratios": [1.0, 1.0, 0.85],
-                "left": 0.075,
-                "right": 0.965,
-                "top": 0.84,
-                "bottom": 0.21 if not scenario.reconstruct else 0.16,
-                "wspace": 0.42,
-                "hspace": 0.5,
-            },
-        )
-        self.fig = fig
-        self.axes = axes
+        self.fontscale = k = float(fontscale)
+        self.narrow = bool(narrow)
+        self.lmi = scenario.decay_limits is not None if lmi is None else bool(lmi)
+        self.footer_lines = int(footer_lines)
+        # the legends: the smallest text (on a phone as large as the tick labels)
+        self.legend_pt = (7.0 if self.narrow else 6.5) * k
         self.lines: dict[str, list] = {}
-        discrete = scenario.discrete
-        style = {"drawstyle": "steps-post"} if discrete else {}
-        unit_step = plant.dt is True or (discrete and float(plant.dt) == 1.0)
-        xlabel = "step k" if unit_step else time_label(plant.dt)
-        sym = scenario.input_symbol
-        for who in ("uio", "lb"):
-            axes[f"{who}.error"].set_yscale("log")
-        counts = {"error": plant.n, "residual": plant.p, "input": plant.q}
-        labels = {
-            "error": lambda i: symbol("e", i),
-            "residual": lambda i: symbol("r", i),
-            "input": lambda i: symbol(sym, i, hat=True),
-        }
-        ylabels = {r: axis_label(r, sym) for r in ("error", "residual", "input")}
-        for who in ("uio", "lb"):
-            for r in rows:
-                ax = axes[f"{who}.{r}"]
-                if r == "input":
-                    self.lines[f"{who}.actual"] = [
-                        ax.plot(
-                            [],
-                            [],
-                            color="0.25",
-                            lw=2.4,
-                            alpha=0.45,
-                            label=f"{symbol(sym, i)} true",
-                            **style,
-                        )[0]
-                        for i in range(plant.q)
-                    ]
-                self.lines[f"{who}.{r}"] = [
-                    ax.plot([], [], color=f"C{i}", lw=1.1, label=labels[r](i), **style)[0]
-                    for i in range(counts[r])
-                ]
-                ax.grid(True, alpha=0.3)
-                if r != "error":
-                    ax.yaxis.set_major_locator(MaxNLocator(5))
-                    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
-                else:
-                    from matplotlib.ticker import LogLocator, NullFormatter
-
-                    ax.yaxis.set_major_locator(LogLocator(base=100.0, numticks=6))
-                    ax.yaxis.set_minor_locator(LogLocator(base=10.0, numticks=12))
-                    ax.yaxis.set_minor_formatter(NullFormatter())
-                if r != rows[-1]:
-                    ax.tick_params(labelbottom=False)
-                if r == "error" and who == "uio":
-                    self.lines["guides"] = [
-                        ax.plot([], [], color=c, lw=1.3, ls=ls, label=lab)[0]
-                        for c, ls, lab in (
-                            ("k", "-.", "certified" if scenario.decay_limits else "_certified"),
-                            ("C3", "--", "slowest moved"),
-                            ("C2", ":", "slowest fixed" if scenario.fixed_poles.size else "_f"),
-                        )
-                    ]
-                if who == "uio":
-                    ax.set_ylabel(ylabels[r] if r != "error" else "|error| (log)", fontsize=8 * k)
-                if counts[r] and (who == "uio" or r == "input"):
-                    # the log error axis reaches a decade above the clipping bound, so its
-                    # top band is free of curves: a wide, flat legend sits there
-                    if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
-                        shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
-                        ax.legend(handles=shown, **{**_LEGEND, "fontsize": 6.5 * k, "ncol": 1})
-                    else:
-                        ax.legend(**{**_LEGEND, "fontsize": 6.5 * k})
-            axes[f"{who}.{rows[-1]}"].set_xlabel(xlabel, fontsize=8 * k)
-        axes["uio.error"].set_title(
-            f"{scenario.observer_name} (decouples {sym})", fontsize=9 * k, fontweight="bold"
-        )
-        axes["lb.error"].set_title(
-            f"Luenberger observer (ignores {sym})", fontsize=9 * k, fontweight="bold"
-        )
-        # the observers' messages go under the panels (the footer), never over the curves
-        self.notes: dict[str, Any] = {}
-
-        # side column: pole map and unknown signals
-        pz = axes["poles"]
-        pz.set_xlabel("real part", fontsize=8 * k)
-        pz.set_ylabel("imaginary part", fontsize=8 * k)
-        pz.grid(True, alpha=0.3)
-        if discrete:
-            theta = np.linspace(0, 2 * np.pi, 181)
-            pz.plot(np.cos(theta), np.sin(theta), color="0.5", lw=0.8)
-        else:
-            pz.axvline(0.0, color="0.5", lw=0.8)
-        pz.axhline(0.0, color="0.8", lw=0.6)
-        zeros = scenario.invariant_zeros
-        pz.plot(
-            zeros.real,
-            zeros.imag,
-            "o",
-            ms=9,
-            mfc="none",
-            mec="C2",
-            mew=1.5,
-            label="fixed" if zeros.size else "_fixed",
-        )
-        self.lines["poles"] = pz.plot(
-            [], [], "x", ms=8, mew=1.8, color="C3", label=scenario.observer_name
-        )
-        self.lines["luenberger poles"] = pz.plot(
-            [], [], "+", ms=9, mew=1.2, color="C0", label="Luenberger"
-        )
-        pz.legend(
-            loc="lower center",
-            bbox_to_anchor=(0.5, 1.0),
-            ncol=2,
-            fontsize=6.5 * k,
-            frameon=False,
-            handlelength=1.0,
-            columnspacing=0.8,
-            borderaxespad=0.2,
-        )
-        sig = axes["signals"]
-        sig.set_ylabel("unknown inputs", fontsize=8 * k)
-        self.lines["d"] = [
-            sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sym, i), **style)[0]
-            for i in range(plant.q)
-        ]
-        self.lines["v"] = [
-            sig.plot(
-                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
-            )[0]
-            for i in range(plant.nv)
-        ]
-        if plant.q + plant.nv:
-            sig.legend(**{**_LEGEND, "fontsize": 6.5 * k})
-        sig.set_xlabel(xlabel, fontsize=8 * k)
-        sig.grid(True, alpha=0.3)
-        sig.yaxis.set_major_locator(MaxNLocator(5))
-        sig.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
-        for ax in axes.values():
+        self.notes: dict[str, Any] = {}  # texts drawn over the curves (none by default)
+        self._layout(figsize, dpi)
+        self._observer_panels()
+        self._pole_map()
+        self._signal_panel()
+        for ax in self.axes.values():
             ax.tick_params(labelsize=7 * k)
-        self.title = fig.suptitle("", fontsize=10 * k)
-        self.footer = fig.text(
-            0.01, 0.005, "", fontsize=7.5 * k, ha="left", va="bottom", color="C3"
+        top = 1 - 4 / 72 / self.fig.get_figheight()
+        self.title = self.fig.suptitle("", fontsize=10 * k, y=top, va="top")
+        # the observers' messages go under the panels (the footer), in space kept for them
+        self.footer = self.fig.text(
+            0.01, 0.005, "", fontsize=_FOOTER_PT * k, ha="left", va="bottom", color="C3"
         )
-        self._wrap = int(150 / k)
+        width_pt = self.fig.get_figwidth() * 72 * 0.97
+        self._wrap = max(30, int(width_pt / (0.56 * _FOOTER_PT * k)))
+        self._title_wrap = max(30, int(width_pt / (0.55 * 10 * k)))
         self.frame: Frame | None = None
         self.full_draws = 0
         self.partial_draws = 0
@@ -371,6 +238,215 @@ class ExplorerFigure:
         self._fresh = True
         self.sticky = sticky
         self._legend_boxes: list[tuple[int, int, int, int]] = []
+
+    def smallest_text_pt(self) -> float:
+        """The size of the smallest text drawn in the figure, in points.
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
+        >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
+        6.5
+        """
+        texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+        return float(min(t.get_fontsize() for t in texts))
+
+    @property
+    def rows(self) -> list[str]:
+        """The kinds of curve, one row of panels each: error, residual (and input)."""
+        return ["error", "residual"] + (["input"] if self.scenario.reconstruct else [])
+
+    def _layout(self, figsize: tuple[float, float] | None, dpi: float) -> None:
+        """Step 1: the figure and its grid of panels, with room kept for the footer's lines."""
+        k = self.fontscale
+        rows = self.rows
+        # under the bottom panels: tick labels, the axis label, then the footer's lines
+        axis_in = (15 * k * 1.3 + 8) / 72
+        footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.04
+        # above the panels: the title (its top 4 pt under the edge), then the pole map's legend
+        # (two rows) or, on a phone, the panel titles; bands apart, so each redraws alone
+        top_in = (4 + 10 * k * 1.35 + 4 + self.legend_pt * 3.4 + 6) / 72
+        if self.narrow:
+            top_in = (4 + 10 * k * 1.35 + 4 + 9 * k * 1.4 + 6) / 72
+        if self.narrow:
+            # a spacer row keeps room for the time axis above the pole map and its legend; the
+            # observers' rows share their time axis and sit close together
+            gap = (2 * 8 * k * 1.3 + self.legend_pt * 1.6 + 12) / 72
+            mosaic = [[f"uio.{r}", f"lb.{r}"] for r in rows] + [[".", "."], ["poles", "signals"]]
+            heights = [1.45] * len(rows) + [gap] + [1.45]
+            panel_in = sum(heights) + 0.14 * 1.45 * (len(mosaic) - 1)
+            width = 4.4 if figsize is None else figsize[0]
+            ratios = {"width_ratios": [1.0, 1.0], "height_ratios": heights}
+        else:
+            side = ["poles"] * (len(rows) - 1) + ["signals"]
+            mosaic = [[f"uio.{r}", f"lb.{r}", s] for r, s in zip(rows, side, strict=True)]
+            panel_in = 4.4 if self.scenario.reconstruct else 3.0
+            width = 9.0 if figsize is None else figsize[0]
+            ratios = {"width_ratios": [1.0, 1.0, 0.85]}
+        height = top_in + panel_in + axis_in + footer_in if figsize is None else figsize[1]
+        fig = Figure(figsize=(width, height), dpi=dpi)
+        FigureCanvasAgg(fig)
+        self.axes = fig.subplot_mosaic(
+            mosaic,
+            gridspec_kw={
+                **ratios,
+                "left": (0.62 if self.narrow else 0.68) * k / width,
+                "right": 1 - 0.3 / width,
+                "top": 1 - top_in / height,
+                "bottom": (axis_in + footer_in) / height,
+                "wspace": 0.42 if not self.narrow else 0.45,
+                "hspace": 0.5 if not self.narrow else 0.14,
+            },
+        )
+        self.fig = fig
+
+    def _observer_panels(self) -> None:
+        """Step 2: the two observers' columns: |e| (log), the residual, the input."""
+        sc, axes, k = self.scenario, self.axes, self.fontscale
+        plant, rows = sc.plant, self.rows
+        style = {"drawstyle": "steps-post"} if sc.discrete else {}
+        sym = sc.input_symbol
+        counts = {"error": plant.n, "residual": plant.p, "input": plant.q}
+        labels = {
+            "error": lambda i: symbol("e", i),
+            "residual": lambda i: symbol("r", i),
+            "input": lambda i: symbol(sym, i, hat=True),
+        }
+        for who in ("uio", "lb"):
+            for r in rows:
+                ax = axes[f"{who}.{r}"]
+                if r == "input":
+                    self.lines[f"{who}.actual"] = [
+                        ax.plot(
+                            [], [], color="0.25", lw=2.4, alpha=0.45,
+                            label=f"{symbol(sym, i)} true", **style,
+                        )[0]
+                        for i in range(plant.q)
+                    ]  # fmt: skip
+                self.lines[f"{who}.{r}"] = [
+                    ax.plot([], [], color=f"C{i}", lw=1.1, label=labels[r](i), **style)[0]
+                    for i in range(counts[r])
+                ]
+                ax.grid(True, alpha=0.3)
+                if r == "error":
+                    ax.set_yscale("log")
+                    ax.yaxis.set_major_locator(LogLocator(base=100.0, numticks=6))
+                    ax.yaxis.set_minor_locator(LogLocator(base=10.0, numticks=12))
+                    ax.yaxis.set_minor_formatter(NullFormatter())
+                else:
+                    ax.yaxis.set_major_locator(MaxNLocator(4 if self.narrow else 5))
+                    ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+                if r != rows[-1]:
+                    ax.tick_params(labelbottom=False)
+                if r == "error" and who == "uio":
+                    self._guide_lines(ax)
+                if who == "uio" or self.narrow:
+                    text = axis_label(r, sym) if r != "error" else "|error| (log)"
+                    ax.set_ylabel(text if who == "uio" else "", fontsize=8 * k)
+                if counts[r] and (who == "uio" or r == "input"):
+                    # the log error axis reaches a decade above the clipping bound, so its
+                    # top band is free of curves: a wide, flat legend sits there
+                    if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
+                        shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
+                        if shown:
+                            ax.legend(
+                                handles=shown, **{**_LEGEND, "fontsize": self.legend_pt, "ncol": 1}
+                            )
+                    else:
+                        ax.legend(**{**_LEGEND, "fontsize": self.legend_pt})
+            axes[f"{who}.{rows[-1]}"].set_xlabel(self._xlabel(), fontsize=8 * k)
+        short = self.narrow
+        axes["uio.error"].set_title(
+            sc.observer_name if short else f"{sc.observer_name} (decouples {sym})",
+            fontsize=9 * k,
+            fontweight="bold",
+        )
+        axes["lb.error"].set_title(
+            "Luenberger" if short else f"Luenberger observer (ignores {sym})",
+            fontsize=9 * k,
+            fontweight="bold",
+        )
+
+    def _guide_lines(self, ax: Any) -> None:
+        """The guides over |e|; the legend lists only those this figure can draw."""
+        sc = self.scenario
+        moved = sc.movable > 0
+        self.lines["guides"] = [
+            ax.plot([], [], color=c, lw=1.3, ls=ls, label=lab if shown else f"_{lab}")[0]
+            for c, ls, lab, shown in (
+                ("k", "-.", "certified", self.lmi),
+                ("C3", "--", "slowest moved", moved),
+                ("C2", ":", "slowest fixed", bool(sc.fixed_poles.size)),
+            )
+        ]
+
+    def _xlabel(self) -> str:
+        plant = self.scenario.plant
+        unit_step = plant.dt is True or (self.scenario.discrete and float(plant.dt) == 1.0)
+        return "step k" if unit_step else time_label(plant.dt)
+
+    def _pole_map(self) -> None:
+        """Step 3: the pole map: x observer poles, + Luenberger poles, o invariant zeros."""
+        sc, k = self.scenario, self.fontscale
+        pz = self.axes["poles"]
+        pz.set_xlabel("real part", fontsize=8 * k)
+        pz.set_ylabel("imaginary part", fontsize=8 * k)
+        pz.grid(True, alpha=0.3)
+        if sc.discrete:
+            theta = np.linspace(0, 2 * np.pi, 181)
+            pz.plot(np.cos(theta), np.sin(theta), color="0.5", lw=0.8)
+        else:
+            pz.axvline(0.0, color="0.5", lw=0.8)
+        pz.axhline(0.0, color="0.8", lw=0.6)
+        zeros = sc.invariant_zeros
+        pz.plot(
+            zeros.real, zeros.imag, "o", ms=9, mfc="none", mec="C2", mew=1.5,
+            label="fixed" if zeros.size else "_fixed",
+        )  # fmt: skip
+        self.lines["poles"] = pz.plot(
+            [], [], "x", ms=8, mew=1.8, color="C3", label=sc.observer_name
+        )
+        self.lines["luenberger poles"] = pz.plot(
+            [], [], "+", ms=9, mew=1.2, color="C0", label="Luenberger"
+        )
+        pz.legend(
+            loc="lower center",
+            bbox_to_anchor=(0.5, 1.0),
+            ncol=3 if self.narrow else 2,
+            fontsize=self.legend_pt,
+            frameon=False,
+            handlelength=1.0,
+            columnspacing=0.8,
+            borderaxespad=0.2,
+        )
+
+    def _signal_panel(self) -> None:
+        """Step 4: the applied unknown signals (d solid, v dashed)."""
+        sc, k = self.scenario, self.fontscale
+        plant = sc.plant
+        style = {"drawstyle": "steps-post"} if sc.discrete else {}
+        sig = self.axes["signals"]
+        sig.set_ylabel("unknown inputs", fontsize=8 * k)
+        self.lines["d"] = [
+            sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sc.input_symbol, i), **style)[0]
+            for i in range(plant.q)
+        ]
+        self.lines["v"] = [
+            sig.plot(
+                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
+            )[0]
+            for i in range(plant.nv)
+        ]
+        if plant.q + plant.nv:
+            sig.legend(**{**_LEGEND, "fontsize": self.legend_pt})
+        sig.set_xlabel(self._xlabel(), fontsize=8 * k)
+        sig.grid(True, alpha=0.3)
+        sig.yaxis.set_major_locator(MaxNLocator(4 if self.narrow else 5))
+        sig.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
 
     def update(self, frame: Frame) -> None:
         """Show a frame: new data in the existing lines and texts, axes rescaled.
@@ -424,13 +500,11 @@ class ExplorerFigure:
         self.lines["poles"][0].set_data(frame.poles.real, frame.poles.imag)
         lp = frame.luenberger_poles
         self.lines["luenberger poles"][0].set_data(lp.real, lp.imag)
-        self.title.set_text(
-            f"{self.scenario.title}: {frame.disturbance}"
-            + (f", noise {frame.settings.noise:.3g}" if frame.settings.noise else "")
+        title = f"{self.scenario.title}: {frame.disturbance}" + (
+            f", noise {frame.settings.noise:.3g}" if frame.settings.noise else ""
         )
-        self.footer.set_text(
-            "\n".join(textwrap.fill(m, self._wrap) for m in frame.all_messages[:3])
-        )
+        self.title.set_text(textwrap.shorten(title, self._title_wrap, placeholder=" …"))
+        self.footer.set_text(self._footer_text(frame.all_messages))
         rows = {name.split(".")[1] for name in self.axes if name.startswith("uio.")}
         fresh = self._fresh or not self.sticky
         for row in rows:
@@ -445,8 +519,13 @@ class ExplorerFigure:
                     ax.set_ylim(*_log_range(ranged, None if fresh else ax.get_ylim()))
                     continue
                 if row == "input":  # zoomed on the true input: a wild estimate runs off the panel
-                    size = _finite_max(frame.d) or 1.0
+                    size = finite_max(frame.d) or 1.0
                     data = [np.array([-1.6 * size, 1.6 * size])]
+                elif finite_max(*data) <= ROUNDING * frame.limits.get(row, 10.0) / 10:
+                    # zero to rounding: a flat line on the scale of the plant's own signals,
+                    # never rounding noise magnified into a trend
+                    size = frame.limits.get(row, 10.0) / 10
+                    data = [np.array([-size, size])]
                 ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), fresh))
         sig = self.axes["signals"]
         wanted = _nice_range([frame.d, frame.v])
@@ -457,6 +536,18 @@ class ExplorerFigure:
                 if name != "poles":
                     ax.set_xlim(t[0], t[-1])
         self._scale_pole_map(frame)
+
+    def _footer_text(self, messages: Sequence[str]) -> str:
+        """The messages wrapped into the footer's reserved lines; an ellipsis if they overflow."""
+        lines: list[str] = []
+        for m in messages:
+            lines += textwrap.wrap(m, self._wrap) or [""]
+        if len(lines) > self.footer_lines:
+            keep = lines[: self.footer_lines]
+            keep[-1] = textwrap.shorten(keep[-1], self._wrap - 18, placeholder=" …")
+            keep[-1] += " (all in the text)"
+            lines = keep
+        return "\n".join(lines)
 
     def _scale_pole_map(self, frame: Frame) -> None:
         """Limits covering the controls' range (a pole moves on a still map), wider if needed."""
@@ -566,9 +657,6 @@ class ExplorerFigure:
 
     def _redraw(self, names: list[str]) -> bool:
         """Redraw some panels or texts into the stored background; False if one leaves its place."""
-        from matplotlib.patches import Rectangle
-        from matplotlib.transforms import IdentityTransform
-
         canvas = self.fig.canvas
         renderer = canvas.get_renderer()
         canvas.restore_region(self._background)
@@ -603,8 +691,6 @@ class ExplorerFigure:
 
     def _find_cells(self) -> dict:
         """Each panel's cell and the title and footer bands (pixels), or {} if they overlap."""
-        from matplotlib.transforms import Bbox
-
         renderer = self.fig.canvas.get_renderer()
         W, H = self.fig.bbox.width, self.fig.bbox.height
         tight = {name: ax.get_tightbbox(renderer) for name, ax in self.axes.items()}
@@ -677,10 +763,6 @@ class ExplorerFigure:
         >>> len(ef.to_png(colors=32)) < len(ef.to_png())
         True
         """
-        import io
-
-        from PIL import Image
-
         if draw:
             self.draw()
         rgba = np.asarray(self.fig.canvas.buffer_rgba())

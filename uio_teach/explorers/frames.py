@@ -37,7 +37,6 @@ from typing import Any
 import numpy as np
 
 from .._display import format_poles
-from ..linalg import is_stable
 from ..lmi import LMIInfeasibleError, LMISolverError
 from ..luenberger import luenberger_poles
 from ..observers import (
@@ -51,14 +50,35 @@ from ..observers import (
 from ..reconstruction import InputEstimate, reconstruct_input
 from ..simulation import UIOResponse, simulate
 from ..verify import PlacementAccuracyWarning
-from .model import STARTS, Scenario, Settings, _describe, disturbance_signals, expand_poles
+from .messages import (
+    ROUNDING,
+    ErrorVerdict,
+    clipped_notes,
+    describe_disturbance,
+    explain,
+    lmi_message,
+    overflow_message,
+    sampling_notes,
+    stability_message,
+    unsettled_note,
+    zero_notes,
+)
+from .model import STARTS, Scenario, Settings, disturbance_signals, expand_poles
+from .modes import (
+    excited_modes,
+    match_poles,
+    pole_positions,
+    pole_rate,
+    remove_poles,
+    slowest_pole,
+)
 
-__all__ = ["Frame", "compute_frame", "excited_modes", "error_grows"]
+__all__ = ["Frame", "compute_frame", "finite_max"]
 
 
 @dataclass(frozen=True, eq=False)
 class Frame:
-    """Everything one picture of an explorer shows, for one setting of the controls.
+    r"""Everything one picture of an explorer shows, for one setting of the controls.
 
     ``curves`` maps ``"<who>.<what>"`` to an array with one row per channel
     (``who`` is ``"uio"`` for the unknown input observer, ``"lb"`` for the
@@ -111,14 +131,21 @@ class Frame:
     explanation : str
         In words: which poles the controls move, which stay fixed, and which
         modes the start excites.
+    verdict, luenberger_verdict : ErrorVerdict or None
+        What each observer's simulated error does (``None`` without a
+        simulation); every sentence about the error is derived from them.
+    residual_zero : bool
+        The unknown input observer's residual is zero to rounding (its panel
+        then shows a flat line, not magnified rounding noise).
 
     Examples
     --------
     >>> from uio_teach.explorers import compute_frame, pa9_scenario
     >>> s = pa9_scenario()
     >>> frame = compute_frame(s, s.defaults.replace(poles=(0.5, -2.0, -3.0)))
-    >>> print(frame.observer_message)
-    this pole makes the UIO unstable: the error grows (pole 0.5 in the right half-plane)
+    >>> print(frame.observer_message.replace("; ", ";\n"))
+    this pole makes the UIO unstable: the error grows (pole 0.5 in the right half-plane;
+    |e| from 1.5 to 32.8)
     >>> frame.curves["uio.error"].shape
     (3, 1001)
     """
@@ -148,6 +175,9 @@ class Frame:
     initial_error: np.ndarray = field(default_factory=lambda: np.zeros(0))
     guides: dict[str, np.ndarray] = field(default_factory=dict)
     explanation: str = ""
+    verdict: ErrorVerdict | None = None
+    luenberger_verdict: ErrorVerdict | None = None
+    residual_zero: bool = False
 
     @property
     def all_messages(self) -> tuple[str, ...]:
@@ -160,188 +190,7 @@ class Frame:
         return (*out, *self.messages)
 
 
-# the modes an initial error excites ------------------------------------------------------
-
-
-def excited_modes(F: np.ndarray, e0: np.ndarray, *, tol: float = 1e-7) -> np.ndarray:
-    """The eigenvalues of ``F`` that the initial error ``e0`` excites.
-
-    The error ``e(t) = exp(F t) e0`` (``F^k e0``) moves only in the Krylov
-    space of ``e0``: ``span{e0, F e0, F^2 e0, ...}``. Its dimension is the
-    number of modes ``e0`` excites, and ``F`` restricted to it has exactly those
-    modes as eigenvalues. The space is built by Arnoldi's method with
-    re-orthogonalization; a new direction smaller than ``tol`` (relative to
-    ``F`` and ``e0``) ends it.
-
-    Parameters
-    ----------
-    F : array_like, shape (n, n)
-        The error dynamics matrix.
-    e0 : array_like, shape (n,)
-        The initial error.
-    tol : float
-        Relative size below which a direction counts as not excited.
-
-    Returns
-    -------
-    numpy.ndarray of complex
-        The excited eigenvalues (empty for ``e0 = 0``).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from uio_teach.explorers import excited_modes
-    >>> F = np.diag([0.5, -0.2, 0.9])
-    >>> sorted(excited_modes(F, [1.0, 0.0, 1.0]).real.round(6).tolist())
-    [0.5, 0.9]
-    """
-    F = np.asarray(F, dtype=float)
-    e0 = np.asarray(e0, dtype=float).ravel()
-    size = float(np.linalg.norm(e0))
-    if not size or not np.isfinite(size):
-        return np.zeros(0, complex)
-    scale = max(float(np.linalg.norm(F, 2)), 1e-300)
-    basis = [e0 / size]
-    for _ in range(F.shape[0] - 1):
-        w = F @ basis[-1]
-        for _ in range(2):
-            for q in basis:
-                w = w - (q @ w) * q
-        norm = float(np.linalg.norm(w))
-        if norm <= tol * scale:
-            break
-        basis.append(w / norm)
-    Q = np.column_stack(basis)
-    return np.linalg.eigvals(Q.T @ F @ Q)
-
-
-def _match(poles: np.ndarray, found: np.ndarray) -> np.ndarray:
-    """For each pole: is it among ``found`` (each found value used once, nearest first)?"""
-    out = np.zeros(poles.size, bool)
-    left = list(found)
-    scale = max(1.0, float(np.abs(poles).max())) if poles.size else 1.0
-    for i in np.argsort(np.abs(poles)):
-        if not left:
-            break
-        gaps = [abs(poles[i] - f) for f in left]
-        j = int(np.argmin(gaps))
-        if gaps[j] <= 1e-4 * scale + 1e-3 * abs(poles[i]):
-            out[i] = True
-            left.pop(j)
-    return out
-
-
-def _remove(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
-    """The poles with one nearest entry removed for each fixed pole."""
-    left = list(poles)
-    for z in fixed:
-        if not left:
-            break
-        left.pop(int(np.argmin([abs(p - z) for p in left])))
-    return np.array(left, dtype=complex)
-
-
-def error_grows(error: np.ndarray | None) -> bool:
-    """Does the simulated error grow: is it larger at the end than at the start?
-
-    The largest ``|e|`` over the last tenth of the window is compared with the
-    largest over the first tenth: more than 1.5 times as large is growth; a
-    non-finite error (it overflowed) is growth too.
-
-    Parameters
-    ----------
-    error : numpy.ndarray or None
-        The error, one row per channel.
-
-    Returns
-    -------
-    bool
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from uio_teach.explorers import error_grows
-    >>> k = np.arange(41.0)
-    >>> error_grows(np.array([1.05**k])), error_grows(np.array([0.9**k]))
-    (True, False)
-    """
-    if error is None or not np.size(error):
-        return False
-    err = np.abs(np.asarray(error, dtype=float))
-    if not np.all(np.isfinite(err)):
-        return True
-    N = err.shape[-1]
-    part = max(1, N // 10)
-    return bool(err[:, -part:].max() > 1.5 * err[:, :part].max() + 1e-300)
-
-
-def _where(discrete: bool) -> tuple[str, str]:
-    if discrete:
-        return "outside the unit circle", "on the unit circle"
-    return "in the right half-plane", "on the imaginary axis"
-
-
-def _stability_message(
-    name: str,
-    poles: np.ndarray,
-    excited: np.ndarray,
-    grows: bool,
-    discrete: bool,
-) -> str:
-    """What the observer's poles do to the error, in words that agree with the simulation."""
-    if not poles.size:
-        return ""
-    bad = ~is_stable(poles, discrete)
-    if not bad.any():
-        return ""
-    mag = np.abs(poles) - 1 if discrete else poles.real
-    growing = bad & (mag > 1e-9 * np.maximum(1, np.abs(poles)))
-    where, edge = _where(discrete)
-    if growing.any():
-        grow = poles[growing]
-        listed = format_poles(grow, 3)
-        word = "pole" if grow.size == 1 else "poles"
-        if grows:
-            this = "this pole makes" if grow.size == 1 else "these poles make"
-            return f"{this} the {name} unstable: the error grows ({word} {listed} {where})"
-        if not excited[growing].any():
-            it = "it" if grow.size == 1 else "them"
-            return (
-                f"{word} {listed} {where}, but this start does not excite {it}: the error "
-                "does not grow here (noise or another start would make it grow)"
-            )
-        return (
-            f"{word} {listed} {where}: that mode grows, but slowly; within this window the "
-            "error does not yet outgrow its start"
-        )
-    edge_poles = poles[bad]
-    word = "pole" if edge_poles.size == 1 else "poles"
-    if not excited[bad].any():
-        return f"{word} {format_poles(edge_poles, 3)} {edge}, not excited from this start"
-    return f"{word} {format_poles(edge_poles, 3)} {edge}: that part of the error does not decay"
-
-
-def _lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:
-    """An LMI that failed, in plain words (no solver status)."""
-    discrete = scenario.discrete
-    bound = f"radius {decay:.3g}" if discrete else f"decay rate {decay:.3g}"
-    fixed = scenario.fixed_poles
-    if isinstance(exc, LMIInfeasibleError):
-        if fixed.size:
-            worst = (
-                f"radius {np.abs(fixed).max():.3g}"
-                if discrete
-                else f"decay rate {-fixed.real.max():.3g}"
-            )
-            return (
-                f"no gain meets the bound {bound}: the fixed poles (invariant zeros, "
-                f"{worst}) cannot move; choose a bound beyond them"
-            )
-        return f"no gain meets the bound {bound}"
-    return (
-        f"the LMI solver could not settle the bound {bound} numerically (this does not prove "
-        "that no gain exists); try a slightly different bound"
-    )
+# the pipeline: signals, designs, simulations, modes, words, display -------------------------
 
 
 def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list[str]]:
@@ -363,20 +212,20 @@ def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list
                 obs: Observer = design_ginverse(plant)
             elif lmi:
                 key = ("lmi", float(s.decay))
-                if key not in scenario._cache:
+                if key not in scenario.cache:
                     try:
-                        scenario._cache[key] = design_pmo(plant, method="lmi", decay=s.decay)
+                        scenario.cache[key] = design_pmo(plant, method="lmi", decay=s.decay)
                     except (LMIInfeasibleError, LMISolverError) as exc:
-                        scenario._cache[key] = exc
-                if isinstance(scenario._cache[key], Exception):
-                    raise scenario._cache[key]
-                obs = scenario._cache[key]
+                        scenario.cache[key] = exc
+                if isinstance(scenario.cache[key], Exception):
+                    raise scenario.cache[key]
+                obs = scenario.cache[key]
             else:
                 poles = expand_poles(s.poles)
                 design = design_uio if scenario.family == "uio" else design_pmo
                 obs = design(plant, poles=poles)
     except (LMIInfeasibleError, LMISolverError) as exc:
-        return None, _lmi_message(scenario, float(s.decay), exc), notes
+        return None, lmi_message(scenario, float(s.decay), exc), notes
     except Exception as exc:  # a bad pole list, a failed placement: say it, do not raise
         return None, f"cannot design the {name}: {exc}", notes
     for w in caught:
@@ -387,32 +236,6 @@ def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list
             )
         # UnstableObserverWarning: said by the stability message, which agrees with the plot
     return obs, "", notes
-
-
-def _zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
-    """A note for each movable pole placed on (or next to) an invariant zero."""
-    zeros = scenario.invariant_zeros
-    out: list[str] = []
-    seen: set[str] = set()
-    for p in movable:
-        if not zeros.size:
-            break
-        gaps = np.abs(zeros - p)
-        j = int(np.argmin(gaps))
-        z = zeros[j]
-        if gaps[j] > 0.02 * max(1.0, abs(z)):
-            continue
-        text = (
-            f"pole {format_poles([p], 3)} sits on the invariant zero {format_poles([z], 3)}, "
-            "where a fixed pole already is: the error there decays no faster than that fixed "
-            "mode, and a repeated pole is sensitive to small model errors"
-        )
-        if gaps[j] > 1e-9 * max(1.0, abs(z)):
-            text = text.replace("sits on", "is next to")
-        if text not in seen:
-            seen.add(text)
-            out.append(text)
-    return out
 
 
 def _luenberger(scenario: Scenario, s: Settings, obs: Observer | None):
@@ -454,23 +277,6 @@ def _observer_start(
     return w0, x0 - xhat0
 
 
-def _rate(p: complex, discrete: bool, t: np.ndarray) -> np.ndarray:
-    """``|p|^k`` (discrete, k counted in steps from t[0]) or ``exp(Re p t)``."""
-    tt = t - t[0]
-    with np.errstate(all="ignore"):
-        if discrete:
-            step = tt[1] if tt.size > 1 else 1.0
-            return np.abs(p) ** np.round(tt / step)
-        return np.exp(p.real * tt)
-
-
-def _slowest(poles: np.ndarray, discrete: bool) -> complex | None:
-    if not poles.size:
-        return None
-    key = np.abs(poles) if discrete else poles.real
-    return complex(poles[int(np.argmax(key))])
-
-
 def _clip(arr: np.ndarray, limit: float) -> tuple[np.ndarray, bool]:
     out = np.array(arr, dtype=float)
     with np.errstate(invalid="ignore"):
@@ -479,7 +285,25 @@ def _clip(arr: np.ndarray, limit: float) -> tuple[np.ndarray, bool]:
     return out, hit
 
 
-def _finite_max(*arrays: np.ndarray | None) -> float:
+def finite_max(*arrays: np.ndarray | None) -> float:
+    """The largest finite ``|value|`` over some arrays (``None`` and empty ones skipped); 0 if none.
+
+    Parameters
+    ----------
+    *arrays : numpy.ndarray or None
+        The arrays.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.explorers.frames import finite_max
+    >>> finite_max(np.array([1.0, -3.0, np.inf]), None)
+    3.0
+    """
     best = 0.0
     for a in arrays:
         if a is None or not np.size(a):
@@ -559,160 +383,155 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
         )
 
 
-def _explain(scenario: Scenario, s: Settings, movable, fixed, poles, excited) -> str:
-    """Which poles the controls move, which stay fixed, which modes the start excites."""
-    name = scenario.observer_name
-    parts = []
-    if scenario.family == "ginverse":
-        parts.append(f"The {name} has no gain to tune: its poles are set by its structure.")
-    elif movable.size:
-        what = "The LMI bound picks" if s.mode == "lmi" else "The pole controls move"
-        parts.append(f"{what} the {name} poles {format_poles(movable, 3)}.")
-    else:
-        parts.append(f"No pole of the {name} can be moved.")
-    if fixed.size:
-        parts.append(
-            f"Fixed whatever the gain: {format_poles(fixed, 3)} (the invariant zeros, o on "
-            "the pole map)."
-        )
-    if scenario.reconstruct:
-        parts.append(
-            "The input panels are zoomed on the true input (grey): larger swings of a "
-            "reconstruction run off the panel."
-        )
-    if poles.size and excited.size == poles.size:
-        start = STARTS.get(s.start, s.start)
-        quiet = poles[~excited]
-        quiet = quiet[_match(quiet, movable)] if quiet.size and movable.size else quiet[:0]
-        if not quiet.size:
-            parts.append(f"Start: {start}; the error has a part in every movable mode.")
-        else:
-            parts.append(
-                f"Start: {start}; the error has no part in the movable modes "
-                f"{format_poles(quiet, 3)}, so moving them changes nothing here."
-            )
-    return " ".join(parts)
+@dataclass
+class _Run:
+    """What the pipeline has found so far for one frame (filled step by step)."""
+
+    scenario: Scenario
+    settings: Settings
+    notes: list[str] = field(default_factory=list)
+    d: np.ndarray | None = None
+    v: np.ndarray | None = None
+    description: str = ""
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    start: str = "zero estimate"
+    observers: dict[str, Observer | None] = field(default_factory=dict)
+    messages: dict[str, str] = field(default_factory=dict)
+    responses: dict[str, UIOResponse | None] = field(default_factory=dict)
+    starts: dict[str, np.ndarray] = field(default_factory=dict)
+    overflowed: set[str] = field(default_factory=set)
 
 
-def _compute(scenario: Scenario, s: Settings) -> Frame:
-    plant = scenario.plant
-    t = scenario.timepts
-    N = t.size
-    discrete = scenario.discrete
-    notes: list[str] = []
-
-    # the unknown signals
-    d = np.zeros((plant.q, N))
-    v = np.zeros((plant.nv, N))
-    description = ""
+def _signals(run: _Run) -> None:
+    """Step 1: the unknown signals, the noise level and the start (a bad value becomes a note)."""
+    sc, s = run.scenario, run.settings
+    plant, t = sc.plant, sc.timepts
+    run.d = np.zeros((plant.q, t.size))
+    run.v = np.zeros((plant.nv, t.size))
     try:
-        d_sig, v_sig = disturbance_signals(scenario, s)
+        d_sig, v_sig = disturbance_signals(sc, s)
         if d_sig:
-            d = np.vstack([f(t) for f in d_sig])
+            run.d = np.vstack([f(t) for f in d_sig])
         if v_sig:
-            v = np.vstack([f(t) for f in v_sig])
-        description = _describe(s.disturbance, s, discrete)
+            run.v = np.vstack([f(t) for f in v_sig])
+        run.description = describe_disturbance(s.disturbance, s, sc.discrete)
     except (ValueError, TypeError) as exc:
-        notes.append(f"disturbance: {exc}; no disturbance applied")
+        run.notes.append(f"disturbance: {exc}; no disturbance applied")
     noise = s.noise
     if not isinstance(noise, int | float | np.number) or not np.isfinite(noise) or noise < 0:
-        notes.append(f"the noise level must be a number >= 0, got {noise!r}; no noise applied")
+        run.notes.append(f"the noise level must be a number >= 0, got {noise!r}; no noise applied")
         noise = 0.0
-    start = s.start
-    if start not in STARTS:
-        notes.append(f"unknown start {start!r}; the observers start from a zero estimate")
-        start = "zero estimate"
-    kwargs: dict[str, Any] = {
-        "u": scenario.u,
-        "d": d if plant.q else None,
-        "v": v if plant.nv else None,
-        "initial_state": scenario.initial_state,
+    if s.start in STARTS:
+        run.start = s.start
+    else:
+        run.notes.append(f"unknown start {s.start!r}; the observers start from a zero estimate")
+    run.kwargs = {
+        "u": sc.u,
+        "d": run.d if plant.q else None,
+        "v": run.v if plant.nv else None,
+        "initial_state": sc.initial_state,
         "noise": float(noise) if noise > 0 else None,
         "seed": s.seed,
     }
 
-    obs, obs_msg, design_notes = _design(scenario, s)
-    notes += design_notes
-    lb, lb_msg = _luenberger(scenario, s, obs)
 
-    x0 = np.asarray(scenario.initial_state, dtype=float)
-    v0 = v[:, 0] if plant.nv else np.zeros(0)
-    responses: dict[str, UIOResponse | None] = {"uio": None, "lb": None}
-    starts: dict[str, np.ndarray] = {}
-    for key, o in (("uio", obs), ("lb", lb)):
+def _observers(run: _Run) -> None:
+    """Step 2: design the unknown input observer and the Luenberger observer."""
+    obs, obs_msg, design_notes = _design(run.scenario, run.settings)
+    run.notes += design_notes
+    lb, lb_msg = _luenberger(run.scenario, run.settings, obs)
+    run.observers = {"uio": obs, "lb": lb}
+    run.messages = {"uio": obs_msg, "lb": lb_msg}
+
+
+def _simulate(run: _Run) -> None:
+    """Step 3: simulate both observers from the chosen start; an overflow is one short line."""
+    sc = run.scenario
+    plant = sc.plant
+    x0 = np.asarray(sc.initial_state, dtype=float)
+    v0 = run.v[:, 0] if plant.nv else np.zeros(0)
+    run.responses = {"uio": None, "lb": None}
+    for key, o in run.observers.items():
         if o is None:
             continue
         try:
-            w0, starts[key] = _observer_start(o, plant, x0, v0, start)
+            w0, run.starts[key] = _observer_start(o, plant, x0, v0, run.start)
             with np.errstate(all="ignore"):
-                responses[key] = simulate(plant, o, t, observer_state=w0, **kwargs)
+                run.responses[key] = simulate(plant, o, sc.timepts, observer_state=w0, **run.kwargs)
         except Exception as exc:
-            text = f"the simulation failed: {exc}"
-            if key == "uio":
-                obs_msg = text
+            if "floating-point range" in str(exc):
+                run.overflowed.add(key)
+                run.messages[key] = (
+                    "its error overflows too, no curve"
+                    if key == "lb" and "uio" in run.overflowed
+                    else overflow_message(o.poles(), sc.discrete)
+                )
             else:
-                lb_msg = text
+                first = str(exc).split(". ")[0].split("\n")[0]
+                run.messages[key] = f"the simulation failed ({first}), no curve"
 
-    # poles: movable and fixed, excited by the start, stable or not (as simulated)
+
+def _modes(run: _Run) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Step 4: the poles, which the controls move, which are fixed, which the start excites."""
+    sc = run.scenario
+    obs = run.observers["uio"]
     poles = obs.poles() if obs is not None else np.zeros(0, complex)
-    fixed = np.asarray(scenario.fixed_poles, dtype=complex)
-    if obs is None or scenario.family == "ginverse":
-        movable = np.zeros(0, complex)
-    else:
-        movable = _remove(poles, fixed)
+    fixed = np.asarray(sc.fixed_poles, dtype=complex)
+    movable = (
+        np.zeros(0, complex)
+        if obs is None or sc.family == "ginverse"
+        else remove_poles(poles, fixed)
+    )
     excited = np.zeros(poles.size, bool)
-    e0 = starts.get("uio", np.zeros(0))
-    if obs is not None and "uio" in starts:
-        excited = _match(poles, excited_modes(obs.error_matrix, e0))
+    e0 = run.starts.get("uio", np.zeros(0))
+    if obs is not None and "uio" in run.starts:
+        excited = match_poles(poles, excited_modes(obs.error_matrix, e0))
         scale = max(1.0, float(np.abs(poles).max()))
         for i in range(poles.size):  # a repeated pole: one excited copy excites that value
             excited[i] |= bool(np.any(excited & (np.abs(poles - poles[i]) <= 1e-6 * scale)))
-        if kwargs["noise"]:
+        if run.kwargs["noise"]:
             excited[:] = True  # noise reaches every mode
-    resp = responses["uio"]
-    if obs is not None and resp is not None and not obs_msg:
-        obs_msg = _stability_message(
-            scenario.observer_name, poles, excited, error_grows(resp.error), discrete
-        )
-    lresp = responses["lb"]
-    if lb is not None and lresp is not None and not lb_msg:
-        lb_msg = _stability_message(
-            "Luenberger observer",
-            lb.poles(),
-            np.ones(lb.poles().size, bool),
-            error_grows(lresp.error),
-            discrete,
-        )
-    if s.mode != "lmi" and scenario.family != "ginverse":
-        try:
-            notes += _zero_notes(scenario, expand_poles(s.poles))
-        except (TypeError, ValueError):
-            pass
+    return poles, movable, fixed, excited, e0
 
+
+def _reconstruct(run: _Run) -> dict[str, InputEstimate | None]:
+    """Step 5 (explorers that reconstruct the unknown input): each observer's estimate of it."""
     estimates: dict[str, InputEstimate | None] = {"uio": None, "lb": None}
-    if scenario.reconstruct:
-        tau = s.tau
-        if not isinstance(tau, int | float | np.number) or not np.isfinite(tau) or tau < 0:
-            notes.append(f"tau must be a time constant >= 0, got {tau!r}; no filter used")
-            tau = 0.0
-        for key, r in responses.items():
-            if r is None:
-                continue
-            try:
-                with np.errstate(all="ignore"):
-                    estimates[key] = (
-                        reconstruct_input(plant, r, method="filtered", tau=float(tau))
-                        if tau > 0
-                        else reconstruct_input(plant, r)
-                    )
-            except Exception as exc:
-                notes.append(f"input reconstruction failed: {exc}")
+    if not run.scenario.reconstruct:
+        return estimates
+    tau = run.settings.tau
+    if not isinstance(tau, int | float | np.number) or not np.isfinite(tau) or tau < 0:
+        run.notes.append(f"tau must be a time constant >= 0, got {tau!r}; no filter used")
+        tau = 0.0
+    for key, r in run.responses.items():
+        if r is None:
+            continue
+        try:
+            with np.errstate(all="ignore"):
+                estimates[key] = (
+                    reconstruct_input(run.scenario.plant, r, method="filtered", tau=float(tau))
+                    if tau > 0
+                    else reconstruct_input(run.scenario.plant, r)
+                )
+        except Exception as exc:
+            run.notes.append(f"input reconstruction failed: {exc}")
+    if run.settings.tau == 0 and run.kwargs["noise"]:
+        run.notes.append(
+            "the numerical derivative amplifies the noise: try a filter time constant tau > 0"
+        )
+    return estimates
 
-    # display: clip at ten times the size of the plant's own signals
-    ok = [r for r in responses.values() if r is not None]
-    size_x = _finite_max(scenario.initial_state, *(r.states for r in ok))
-    size_y = _finite_max(*(r.outputs for r in ok))
-    size_d = max(_finite_max(d), abs(float(scenario.defaults.amplitude)))
+
+def _display(
+    run: _Run, estimates: dict[str, InputEstimate | None]
+) -> tuple[dict[str, np.ndarray | None], dict[str, float]]:
+    """Step 6: the curves clipped at ten times the size of the plant's own signals."""
+    sc = run.scenario
+    N = sc.timepts.size
+    ok = [r for r in run.responses.values() if r is not None]
+    size_x = finite_max(sc.initial_state, *(r.states for r in ok))
+    size_y = finite_max(*(r.outputs for r in ok))
+    size_d = max(finite_max(run.d), abs(float(sc.defaults.amplitude)))
     limits = {
         "error": 10 * (size_x or 1.0),
         "residual": 10 * (size_y or size_x or 1.0),
@@ -720,13 +539,13 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
     }
     curves: dict[str, np.ndarray | None] = {}
     clipped: dict[str, set[str]] = {}
-    for key, r in responses.items():
-        est = estimates[key]
+    for key, r in run.responses.items():
         parts = {
             "error": None if r is None else r.error,
             "residual": None if r is None else r.residual,
         }
-        if scenario.reconstruct:
+        if sc.reconstruct:
+            est = estimates[key]
             parts["input"] = None if est is None else est.estimates
         for what, arr in parts.items():
             if arr is None:
@@ -737,105 +556,113 @@ def _compute(scenario: Scenario, s: Settings) -> Frame:
             _, hit = _clip(np.asarray(arr)[..., N // 10 :], limits[what])
             if hit:
                 clipped.setdefault(key, set()).add(what)
-    for key, whats in clipped.items():
-        whats.discard("input")  # the input panels are zoomed on the true input anyway
-        if not whats:
-            continue
-        who = scenario.observer_name if key == "uio" else "Luenberger observer"
-        which = " and ".join(sorted(whats))
-        verb = "leaves" if len(whats) == 1 else "leave"
-        notes.append(
-            f"{who}: the {which} {verb} the plotted range (ten times the plant's own "
-            "signals) and are cut off there".replace(
-                "and are", "and is" if len(whats) == 1 else "and are"
-            )
-        )
+    run.notes += clipped_notes(clipped, sc.observer_name)
+    return curves, limits
 
-    # guides over |e|: the rates the poles set, or the LMI's certified envelope
+
+def _guides(run: _Run, poles, movable, fixed, excited, e0) -> dict[str, np.ndarray]:
+    """Step 7: curves over |e|: the rates the poles set, or the LMI's certified envelope."""
+    sc, s = run.scenario, run.settings
+    t = sc.timepts
+    discrete = sc.discrete
+    obs = run.observers["uio"]
     guides: dict[str, np.ndarray] = {}
     size0 = float(np.linalg.norm(e0)) if e0.size else 0.0
-    if obs is not None and size0 > 0:
-        P = getattr(obs, "lmi_certificate", None) if s.mode == "lmi" else None
-        if P is not None:
-            ev = np.linalg.eigvalsh(0.5 * (P + P.T))
-            gain = float(np.sqrt(ev.max() / ev.min()))
-            rho = float(s.decay)
-            rate = rho ** np.round((t - t[0]) / (t[1] - t[0])) if discrete else None
-            if rate is None:
-                rate = np.exp(-rho * (t - t[0]))
-            guides[f"certified bound, {'radius' if discrete else 'rate'} {rho:.3g}"] = (
-                gain * size0 * rate
-            )
-        slow_m = _slowest(movable[excited[_positions(poles, movable)]], discrete)
-        if slow_m is not None and s.mode != "lmi":
-            guides[f"rate of slowest moved pole {format_poles([slow_m], 3)}"] = size0 * _rate(
-                slow_m, discrete, t
-            )
-        slow_f = _slowest(fixed[excited[_positions(poles, fixed)]], discrete)
-        if slow_f is not None:
-            guides[f"rate of slowest fixed pole {format_poles([slow_f], 3)}"] = size0 * _rate(
-                slow_f, discrete, t
-            )
-
-    if resp is not None and not obs_msg and not kwargs["noise"]:
-        err = np.abs(resp.error)
-        top = float(np.max(err)) if err.size else 0.0
-        tail = float(np.max(err[:, -max(1, N // 10) :])) if err.size else 0.0
-        if top > 0 and tail > 0.05 * top:
-            live = poles[excited]
-            stable = live[is_stable(live, discrete)] if live.size else live
-            slow = _slowest(stable, discrete)
-            text = "the error has not settled by the end of the window"
-            if slow is not None:
-                factor = float(_rate(slow, discrete, t)[-1])
-                kind = "fixed" if _match(np.array([slow]), fixed).any() else "movable"
-                if factor > 0.05:
-                    text += (
-                        f": its slowest {kind} pole, {format_poles([slow], 3)}, shrinks it only "
-                        f"to {100 * factor:.2g} % over the window"
-                    )
-            notes.append(text)
-    if scenario.reconstruct and s.tau == 0 and kwargs["noise"]:
-        notes.append(
-            "the numerical derivative amplifies the noise: try a filter time constant tau > 0"
+    if obs is None or not size0 > 0:
+        return guides
+    P = getattr(obs, "lmi_certificate", None) if s.mode == "lmi" else None
+    if P is not None:
+        ev = np.linalg.eigvalsh(0.5 * (P + P.T))
+        gain = float(np.sqrt(ev.max() / ev.min()))
+        rho = float(s.decay)
+        if discrete:
+            rate = rho ** np.round((t - t[0]) / (t[1] - t[0]))
+        else:
+            rate = np.exp(-rho * (t - t[0]))
+        guides[f"certified bound, {'radius' if discrete else 'rate'} {rho:.3g}"] = (
+            gain * size0 * rate
         )
+    slow_m = slowest_pole(movable[excited[pole_positions(poles, movable)]], discrete)
+    if slow_m is not None and s.mode != "lmi":
+        guides[f"rate of slowest moved pole {format_poles([slow_m], 3)}"] = size0 * pole_rate(
+            slow_m, discrete, t
+        )
+    slow_f = slowest_pole(fixed[excited[pole_positions(poles, fixed)]], discrete)
+    if slow_f is not None:
+        guides[f"rate of slowest fixed pole {format_poles([slow_f], 3)}"] = size0 * pole_rate(
+            slow_f, discrete, t
+        )
+    return guides
+
+
+def _compute(scenario: Scenario, s: Settings) -> Frame:
+    """The pipeline: each step fills ``_Run``; the words come from the simulated errors."""
+    run = _Run(scenario, s)
+    _signals(run)
+    _observers(run)
+    _simulate(run)
+    poles, movable, fixed, excited, e0 = _modes(run)
+    discrete = scenario.discrete
+    t = scenario.timepts
+    obs, lb = run.observers["uio"], run.observers["lb"]
+    resp, lresp = run.responses["uio"], run.responses["lb"]
+    estimates = _reconstruct(run)
+    curves, limits = _display(run, estimates)
+    scale = limits["error"] / 10
+    verdict = ErrorVerdict.of(None if resp is None else resp.error, scale)
+    lb_verdict = ErrorVerdict.of(None if lresp is None else lresp.error, scale)
+    if obs is not None and resp is not None and not run.messages["uio"]:
+        run.messages["uio"] = stability_message(
+            scenario.observer_name, poles, excited, verdict, discrete
+        )
+    if lb is not None and lresp is not None and not run.messages["lb"]:
+        lp = lb.poles()
+        run.messages["lb"] = stability_message(
+            "Luenberger observer", lp, np.ones(lp.size, bool), lb_verdict, discrete
+        )
+    notes = []
+    if s.mode != "lmi" and scenario.family != "ginverse":
+        try:
+            notes += zero_notes(scenario, expand_poles(s.poles))
+        except (TypeError, ValueError):
+            pass
+    if resp is not None and not run.messages["uio"] and not run.kwargs["noise"]:
+        text = unsettled_note(verdict, resp.error, poles, excited, fixed, discrete, t)
+        notes += [text] if text else []
+    if resp is not None:
+        notes += sampling_notes(poles, excited, discrete, t)
+    residual_zero = bool(
+        resp is not None
+        and resp.residual.size
+        and finite_max(resp.residual) <= ROUNDING * (limits["residual"] / 10)
+    )
     return Frame(
         scenario=scenario,
         settings=s,
         time=t,
         observer=obs,
         luenberger=lb,
-        response=responses["uio"],
-        luenberger_response=responses["lb"],
+        response=resp,
+        luenberger_response=lresp,
         input_estimate=estimates["uio"],
         luenberger_input_estimate=estimates["lb"],
-        d=d,
-        v=v,
+        d=run.d,
+        v=run.v,
         curves=curves,
         limits=limits,
         poles=poles,
         luenberger_poles=lb.poles() if lb is not None else np.zeros(0, complex),
-        observer_message=obs_msg,
-        luenberger_message=lb_msg,
-        messages=tuple(notes),
-        disturbance=description,
+        observer_message=run.messages["uio"],
+        luenberger_message=run.messages["lb"],
+        messages=tuple(run.notes[: len(run.notes)] + notes),
+        disturbance=run.description,
         movable_poles=movable,
         fixed_poles=fixed,
         excited=excited,
         initial_error=e0,
-        guides=guides,
-        explanation=_explain(scenario, s, movable, fixed, poles, excited),
+        guides=_guides(run, poles, movable, fixed, excited, e0),
+        explanation=explain(scenario, s, movable, fixed, poles, excited, residual_zero),
+        verdict=verdict,
+        luenberger_verdict=lb_verdict,
+        residual_zero=residual_zero,
     )
-
-
-def _positions(poles: np.ndarray, subset: np.ndarray) -> np.ndarray:
-    """For each entry of ``subset``, the index of a distinct nearest entry of ``poles``."""
-    left = list(range(poles.size))
-    out = []
-    for z in subset:
-        if not left:
-            break
-        j = min(left, key=lambda i: abs(poles[i] - z))
-        out.append(j)
-        left.remove(j)
-    return np.array(out, dtype=int)

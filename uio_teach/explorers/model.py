@@ -42,6 +42,8 @@ __all__ = [
     "Scenario",
     "expand_poles",
     "disturbance_signals",
+    "default_poles",
+    "default_timepts",
 ]
 
 DISTURBANCES = ("sinusoid", "piecewise constant", "damped sinusoid", "random steps")
@@ -59,8 +61,8 @@ STARTS = {
 ``"zero estimate"`` (the default) starts both observers at ``xhat(0) = 0``: the
 initial error ``e(0) = x(0)`` then reaches every mode of the error dynamics that
 ``x(0)`` reaches, the movable ones included. ``"zero observer state"`` starts the
-observer's state at zero (``z(0) = 0`` or ``q(0) = 0``): its first estimate is
-``xhat(0) = H y(0)`` (``M y(0)``), and the initial error may lie in the fixed
+observer's state at zero (``z(0) = 0``): its first estimate is ``xhat(0) = H y(0)``
+(``M y(0)``), and the initial error may lie in the fixed
 modes alone, so that moving a pole changes nothing.
 """
 
@@ -232,6 +234,9 @@ class Scenario:
     input_symbol : str
         The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
         the missile paper).
+    cache : dict
+        Designs kept between frames (the LMI's gain for each bound, which
+        takes a solver run); empty at first.
 
     Examples
     --------
@@ -263,7 +268,7 @@ class Scenario:
     static_values: tuple[float, ...]
     static_control: str
     input_symbol: str = "d"
-    _cache: dict = field(default_factory=dict, repr=False)
+    cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def movable(self) -> int:
@@ -413,10 +418,116 @@ def disturbance_signals(
     return d, v
 
 
-def _describe(kind: str, settings: Settings, discrete: bool) -> str:
-    unit = "steps" if discrete else "s"
-    a = f"{settings.amplitude:.3g}"
-    if kind in ("sinusoid", "damped sinusoid"):
-        per = "rad/step" if discrete else "rad/s"
-        return f"{kind}, amplitude {a}, frequency {settings.frequency:.3g} {per}"
-    return f"{kind}, amplitude {a}, switching every {settings.period:.3g} {unit}"
+# default poles and time grid for any plant -----------------------------------------------
+
+SAMPLES_PER_PERIOD = 20
+"""The default grid samples the fastest oscillation of the default poles this finely."""
+
+
+def default_poles(
+    count: int, discrete: bool, size: float = 1.0, avoid: Sequence[complex] = ()
+) -> tuple[float, ...]:
+    """Starting values for ``count`` movable poles, none on (or next to) a value to avoid.
+
+    Discrete time: real poles from 0.5 down in steps of 0.1 (then the values
+    in between); continuous time: ``-size``, ``-1.5 size``, ``-2 size``, ...
+    A candidate closer than 5 % of the scale (0.05 in discrete time) to an
+    entry of ``avoid`` -- the plant's invariant zeros, which are fixed observer
+    poles -- is skipped, so an explorer never opens with a pole on a fixed one.
+
+    Parameters
+    ----------
+    count : int
+        How many movable poles.
+    discrete : bool
+        Discrete time.
+    size : float
+        Continuous time: the magnitude of the first pole (the plant's fastest
+        mode, at least 1).
+    avoid : sequence of complex
+        Values the poles keep away from.
+
+    Returns
+    -------
+    tuple of float
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import default_poles
+    >>> default_poles(1, True, avoid=[0.5])
+    (0.4,)
+    >>> default_poles(2, False, size=2.0, avoid=[-2.0])
+    (-3.0, -4.0)
+    """
+    avoid = np.asarray(avoid, dtype=complex).ravel()
+    if discrete:
+        gap = 0.05
+        candidates = [round(0.5 - 0.1 * i, 10) for i in range(5)]
+        candidates += [round(0.45 - 0.1 * i, 10) for i in range(5)]
+        candidates += [round(-0.1 - 0.1 * i, 10) for i in range(5)]
+    else:
+        gap = 0.05 * size
+        candidates = [-size * (1 + 0.5 * i) for i in range(4 * count + 8)]
+    out: list[float] = []
+    for c in candidates:
+        if len(out) == count:
+            break
+        near = [*avoid.tolist(), *out]
+        if all(abs(c - z) > gap for z in near):
+            out.append(float(c))
+    while len(out) < count:  # more poles than candidates: fall back to a plain spread
+        out.append(float(0.5 - 0.1 * len(out) if discrete else -size * (1 + 0.5 * len(out))))
+    return tuple(out)
+
+
+def default_timepts(
+    poles: Sequence[complex], discrete: bool, dt: float | bool | None = None, samples: int = 1001
+) -> np.ndarray:
+    """A time grid that shows the error settle and samples its oscillations finely.
+
+    Discrete time: enough steps (30 to 300) for the slowest stable pole to
+    shrink the error a thousandfold. Continuous time: ``samples`` points over
+    eight time constants of the slowest stable pole, but at most as long as
+    gives :data:`SAMPLES_PER_PERIOD` samples a period of the fastest
+    oscillating pole -- a lightly damped pair would otherwise stretch the
+    window so far that its oscillation is drawn with a point or two a period,
+    in wiggles that do not exist (aliasing). The explorer then says that the
+    window is set by the oscillation and how long settling would take.
+
+    Parameters
+    ----------
+    poles : sequence of complex
+        Every observer pole (movable and fixed).
+    discrete : bool
+        Discrete time.
+    dt : float or True, optional
+        The sampling time of a discrete plant (``True``: steps).
+    samples : int
+        Continuous time: the number of points.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import default_timepts
+    >>> float(default_timepts([-1.0, -2.0], False)[-1])
+    8.0
+    >>> t = default_timepts([-0.01 + 10j, -0.01 - 10j, -10.0], False)
+    >>> round(float(t[-1]), 2), t.size        # 50 periods of 0.63 s, not 800 s
+    (31.42, 1001)
+    """
+    every = np.asarray(poles, dtype=complex).ravel()
+    if discrete:
+        stable = every[np.abs(every) < 1]
+        slowest = float(np.abs(stable).max()) if stable.size else 0.5
+        steps = int(np.clip(np.ceil(np.log(1e-3) / np.log(max(slowest, 1e-3))), 30, 300))
+        return np.arange(steps + 1.0) * (1.0 if dt is True or dt is None else float(dt))
+    stable = every[every.real < 0]
+    rate = float((-stable.real).min()) if stable.size else 1.0
+    span = 8.0 / rate
+    fastest = float(np.abs(stable.imag).max()) if stable.size else 0.0
+    if fastest > 0:
+        span = min(span, (samples - 1) * 2 * math.pi / (SAMPLES_PER_PERIOD * fastest))
+    return np.linspace(0.0, span, samples)

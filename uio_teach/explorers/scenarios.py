@@ -25,7 +25,15 @@ from ..existence import check_existence
 from ..experiments import CASE_STUDY, MISSILE, PA9, experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
-from .model import FAMILIES, Channel, Scenario, Settings, expand_poles
+from .model import (
+    FAMILIES,
+    Channel,
+    Scenario,
+    Settings,
+    default_poles,
+    default_timepts,
+    expand_poles,
+)
 
 __all__ = ["pa9_scenario", "case_study_scenario", "missile_scenario", "make_scenario"]
 
@@ -288,23 +296,16 @@ def make_scenario(
     k = 0 if observer_family == "ginverse" else report.movable
     fixed = report.fixed_modes
     if poles is None:
-        if discrete:
-            poles = tuple(max(0.05, 0.5 - 0.1 * i) for i in range(k))
-        else:
-            eig = np.abs(np.linalg.eigvals(plant.A)) if plant.n else np.zeros(0)
-            s = max([1.0, *eig.tolist(), *np.abs(fixed).tolist()])
-            poles = tuple(-s * (1 + 0.5 * i) for i in range(k))
+        eig = np.abs(np.linalg.eigvals(plant.A)) if plant.n else np.zeros(0)
+        s = max([1.0, *eig.tolist(), *np.abs(fixed).tolist()])
+        poles = default_poles(k, discrete, s, avoid=[*report.invariant_zeros, *fixed])
     poles = tuple(complex(p) if complex(p).imag else float(complex(p).real) for p in poles)
     every = np.concatenate([expand_poles(poles), fixed])
     stable = every[is_stable(every, discrete)] if every.size else every
+    default_t = default_timepts(stable, discrete, plant.dt)
     if discrete:
-        slowest = max((abs(p) for p in stable), default=0.5)
-        steps = int(np.clip(np.ceil(np.log(1e-3) / np.log(max(slowest, 1e-3))), 30, 300))
-        default_t = np.arange(steps + 1.0) * (1.0 if plant.dt is True else plant.dt)
         lim: tuple[float, float] = (-1.1, 1.1)
     else:
-        rate = min((-p.real for p in stable), default=1.0)
-        default_t = np.linspace(0.0, 8.0 / rate, 1001)
         scale = max(abs(p) for p in [1.0, *expand_poles(poles).tolist(), *fixed.tolist()])
         lim = (-4.0 * scale, 0.4 * scale)
     t = np.asarray(default_t if timepts is None else timepts, dtype=float)
@@ -318,7 +319,7 @@ def make_scenario(
     if not real_first:
         static: tuple[float, ...] = (0.0, 0.5, 1.0, 2.0, 4.0)
     elif discrete:
-        static = (-0.9, -0.5, 0.0, 0.5, 0.9, 1.05)
+        static = tuple(sorted({-0.9, -0.5, 0.0, 0.5, 0.9, 1.05, float(complex(poles[0]).real)}))
     else:
         static = tuple(float(complex(poles[0]).real) * f for f in (-0.5, 0.5, 1.0, 2.0, 4.0))
     return _scenario(

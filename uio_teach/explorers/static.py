@@ -11,10 +11,11 @@ URL is involved, so the page works offline and from ``file://``.
 
 The layout reflows with the screen (a few CSS rules in the HTML itself): on a
 wide screen the controls share a row above a picture at most 780 px wide; on a
-phone each control takes a row of its own and the picture shrinks to the
-column, keeping its aspect ratio, so the page never scrolls sideways. There,
-"enlarge the picture" (or a tap on the picture) shows it at the size its text
-is drawn for, scrolling sideways inside its own box.
+phone each control takes a row of its own and every frame is shown as drawn for
+the phone (:data:`NARROW_PX`): the two observers side by side, one row of panels
+per kind of curve, text no smaller than about 9 CSS pixels, so the page never
+scrolls sideways and nothing needs enlarging. The caption's box keeps the height
+of the longest caption, so the page does not jump while the slider moves.
 
 Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 :class:`uio_teach.explorers.ExplorerFigure`, exactly as in the live explorer.
@@ -45,7 +46,15 @@ from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, Scenario, Settings
 
-__all__ = ["StaticFrame", "StaticExplorer", "frame_settings", "static_explorer", "static_html"]
+__all__ = [
+    "StaticFrame",
+    "StaticExplorer",
+    "frame_settings",
+    "frame_caption",
+    "frame_alt",
+    "static_explorer",
+    "static_html",
+]
 
 _IDS = itertools.count(1)
 
@@ -69,6 +78,9 @@ class StaticFrame:
         The main control's value as shown next to the slider.
     alt : str
         The picture's text alternative: what its curves do.
+    png_narrow : bytes
+        The same frame drawn for a phone (two columns, larger text); empty
+        when the explorer has no phone layout.
 
     Examples
     --------
@@ -85,11 +97,19 @@ class StaticFrame:
     caption: str
     label: str
     alt: str = ""
+    png_narrow: bytes = b""
 
     @property
     def data_url(self) -> str:
         """The picture as a ``data:image/png;base64`` URL."""
         return "data:image/png;base64," + base64.b64encode(self.png).decode("ascii")
+
+    @property
+    def narrow_url(self) -> str:
+        """The phone picture as a ``data:`` URL (the wide one if there is none)."""
+        if not self.png_narrow:
+            return self.data_url
+        return "data:image/png;base64," + base64.b64encode(self.png_narrow).decode("ascii")
 
 
 @dataclass(frozen=True)
@@ -172,7 +192,25 @@ def frame_settings(
     return settings.replace(poles=poles, disturbance=disturbance, mode="poles")
 
 
-def _caption(frame: Frame) -> str:
+def frame_caption(frame: Frame) -> str:
+    """The caption of a static frame: the disturbance, the poles, every message, the explanation.
+
+    Parameters
+    ----------
+    frame : Frame
+        The frame.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers.static import frame_caption
+    >>> frame_caption(compute_frame(pa9_scenario()))[:38]
+    'Disturbance: sinusoid, amplitude 1, fr'
+    """
     name = frame.scenario.observer_name
     parts = [f"disturbance: {frame.disturbance}"] if frame.disturbance else []
     if frame.poles.size:
@@ -184,26 +222,52 @@ def _caption(frame: Frame) -> str:
     return text
 
 
-def _ends(err: np.ndarray | None) -> tuple[float, float] | None:
-    if err is None or not np.size(err):
-        return None
-    size = np.max(np.abs(err), axis=0)
-    return float(size[0]), float(size[-1])
+def frame_alt(frame: Frame, label: str, value: str) -> str:
+    """The text alternative of a static frame: what each observer's error does, in a few sentences.
 
+    The words come from the frame's verdicts on the simulated errors, as do the
+    messages in the caption and the footer, so the three never disagree. A
+    curve that is missing says why in one line: no design, an overflow, or a
+    failed simulation.
 
-def _alt(frame: Frame, label: str, value: str) -> str:
-    """What the picture shows, in a sentence: how each observer's error ends."""
+    Parameters
+    ----------
+    frame : Frame
+        The frame.
+    label, value : str
+        The main control's name and value.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers.static import frame_alt
+    >>> frame_alt(compute_frame(pa9_scenario()), "UIO pole", "-1").split(". ")[1]
+    'UIO: the error size |e| decays from 1.5 to 1.5e-05'
+    """
     sc = frame.scenario
     parts = [f"{sc.title} explorer at {label} {value}."]
-    pairs = ((sc.observer_name, frame.response), ("Luenberger observer", frame.luenberger_response))
-    for who, resp in pairs:
-        ends = _ends(None if resp is None else resp.error)
-        if ends is None:
+    rows = (
+        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message),
+        (
+            "Luenberger observer",
+            frame.luenberger,
+            frame.luenberger_verdict,
+            frame.luenberger_message,
+        ),
+    )
+    for who, observer, verdict, message in rows:
+        if verdict is not None:
+            parts.append(f"{who}: the error size |e| {verdict.words()}.")
+        elif observer is None:
             parts.append(f"{who}: no curve (no design).")
-            continue
-        a, b = ends
-        verb = "grows" if b > 1.5 * a else "decays" if b < 0.05 * a else "stays about as large"
-        parts.append(f"{who}: the largest error {verb}, from {a:.2g} to {b:.2g}.")
+        elif "overflows" in message:
+            parts.append(f"{who}: no curve (the error overflows).")
+        else:
+            parts.append(f"{who}: no curve (the simulation failed).")
     if frame.poles.size:
         parts.append(f"Pole map: {sc.observer_name} poles {format_poles(frame.poles, 3)}.")
     return " ".join(parts)
@@ -216,8 +280,9 @@ def static_explorer(
     values: Sequence[float] | None = None,
     disturbances: Sequence[str] | None = None,
     dpi: float = 144,
-    colors: int = 64,
+    colors: int = 32,
     element_id: str | None = None,
+    narrow: bool = True,
 ) -> StaticExplorer:
     """Pre-compute the frames of a static explorer and write its HTML.
 
@@ -240,10 +305,16 @@ def static_explorer(
         Resolution of the pictures (144: about 1300 pixels wide, twice the
         density at which they are shown).
     colors : int
-        Palette size of the PNGs (smaller files).
+        Palette size of the PNGs (smaller files; 32 keeps the curves' colours and the
+        text's antialiasing).
     element_id : str, optional
         The id of the outer element; a unique ``uio-explorer-<name>-<k>``
         by default.
+    narrow : bool
+        Also draw every frame for a phone (:data:`NARROW_PX` CSS pixels or
+        less): two columns and larger text, so that no text is smaller than
+        about 9 CSS pixels at a 390 px screen's width. The browser picks the
+        picture that fits (``<picture>`` with a media query).
 
     Returns
     -------
@@ -279,21 +350,39 @@ def static_explorer(
     i0 = int(np.argmin([abs(v - current) for v in values]))
     j0 = disturbances.index(base.disturbance) if base.disturbance in disturbances else 0
 
-    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False, fontscale=1.45)
+    # static frames never use the LMI mode: the certified envelope is not in their legend
+    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False, fontscale=WIDE_FONTSCALE, lmi=False)
+    phone = (
+        ExplorerFigure(
+            scenario,
+            dpi=NARROW_DPI,
+            sticky=False,
+            fontscale=NARROW_FONTSCALE,
+            narrow=True,
+            lmi=False,
+        )
+        if narrow
+        else None
+    )
     frames = []
     for j, kind in enumerate(disturbances):
         for i, value in enumerate(values):
             s = frame_settings(scenario, base, value, kind)
             frame = compute_frame(scenario, s)
             figure.update(frame)
+            small = b""
+            if phone is not None:
+                phone.update(frame)
+                small = _png(phone, colors)
             frames.append(
                 StaticFrame(
                     index=(i, j),
                     settings=s,
                     png=_png(figure, colors),
-                    caption=_caption(frame),
+                    caption=frame_caption(frame),
                     label=f"{value:g}",
-                    alt=_alt(frame, main_control_label(scenario, base), f"{value:g}"),
+                    alt=frame_alt(frame, main_control_label(scenario, base), f"{value:g}"),
+                    png_narrow=small,
                 )
             )
     eid = element_id or f"uio-explorer-{scenario.name}-{next(_IDS)}"
@@ -327,8 +416,9 @@ def static_html(
     values: Sequence[float] | None = None,
     disturbances: Sequence[str] | None = None,
     dpi: float = 144,
-    colors: int = 64,
+    colors: int = 32,
     element_id: str | None = None,
+    narrow: bool = True,
 ) -> str:
     """The HTML of :func:`static_explorer` (same parameters).
 
@@ -348,6 +438,8 @@ def static_html(
         Palette size of the PNGs.
     element_id : str, optional
         The id of the outer element.
+    narrow : bool
+        Also draw the frames for a phone.
 
     Returns
     -------
@@ -370,30 +462,37 @@ def static_html(
         dpi=dpi,
         colors=colors,
         element_id=element_id,
+        narrow=narrow,
     ).html
 
 
 # The one handler of the form (``this`` is the form): pick the frame of the slider's and the
-# select's values, show its picture, caption and value; the check box enlarges the picture.
+# select's values, show its pictures (wide and phone), caption, text alternative and value.
 _JS = (
     "var r=this.parentNode,f=r.querySelector('[data-k=\"'+this.main.value+'-'+this.dist.value"
-    "+'\"]');if(f){r.querySelector('img.uio-frame').src=f.getAttribute('data-src');"
-    "r.querySelector('img.uio-frame').alt=f.getAttribute('data-alt');"
+    "+'\"]');if(f){var i=r.querySelector('img.uio-frame'),n=r.querySelector('source');"
+    "if(n){n.srcset=f.getAttribute('data-narrow');}i.src=f.getAttribute('data-src');"
+    "i.alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
     "this.mainval.value=f.getAttribute('data-label');}"
-    "r.classList.toggle('uio-zoomed',this.zoom.checked);"
 )
 
-# The check box's words (also its accessible name: the picture is a second label of it).
-_ZOOM_TEXT = "enlarge the picture (it then scrolls sideways)"
+NARROW_PX = 700
+"""At this width (CSS pixels) or less (a phone), the controls stack and the phone pictures show."""
 
-# Narrower than this (a phone), the controls stack and the picture may be enlarged.
-_NARROW = 700
+WIDE_FONTSCALE = 1.45
+"""Font scale of the wide pictures (shown at most 780 px wide, drawn 1296 px wide)."""
+
+NARROW_FONTSCALE = 1.25
+"""Font scale of the phone pictures: 4.4 inches shown 330 px wide or more keep text >= 9 px."""
+
+NARROW_DPI = 136
+"""Resolution of the phone pictures (about 1.6 times the CSS pixels of a phone's column)."""
 
 # The layout: on a wide screen the controls share a row above a picture at most 780 px wide; on a
-# narrow one each control takes a row of its own, the slider the full width, and the picture
-# shrinks to the column. "Enlarge the picture" (or a tap on it) shows it at half its pixel width,
-# the size its text is drawn for, scrolling sideways inside its own box, never the page.
+# narrow one each control takes a row of its own, the slider the full width, and the picture drawn
+# for the phone fills the column. The caption's box is as tall as the longest caption (every
+# caption is laid out, invisibly, in the same grid cell), so the page never jumps while scrubbing.
 _CSS = """
 .uio-static-explorer{max-width:780px;box-sizing:border-box}
 .uio-static-explorer *{box-sizing:border-box}
@@ -403,12 +502,11 @@ margin:0.3em 0}
 max-width:100%}
 .uio-static-explorer .uio-slider{display:inline-flex;align-items:center;gap:0.5em}
 .uio-static-explorer input[type=range]{margin:0;vertical-align:middle}
-.uio-static-explorer .uio-zoom-label{display:none;align-items:center;gap:0.5em}
-.uio-static-explorer .uio-picture{max-width:100%;overflow-x:auto;overflow-y:hidden;
-scrollbar-width:thin}
+.uio-static-explorer .uio-picture{max-width:100%}
 .uio-static-explorer img.uio-frame{display:block;width:100%;max-width:none;height:auto;margin:0}
-.uio-static-explorer.uio-zoomed img.uio-frame{width:max(100%, @ZOOM@px)}
-.uio-static-explorer .uio-caption{font-size:0.85em;margin:0.2em 0}
+.uio-static-explorer .uio-captions{display:grid}
+.uio-static-explorer .uio-captions>p{grid-area:1/1;font-size:0.85em;margin:0.2em 0}
+.uio-static-explorer .uio-sizer{visibility:hidden}
 .uio-static-explorer .uio-note{font-size:0.8em;opacity:0.75;margin:0.2em 0}
 @media (max-width:@NARROW@px){
 .uio-static-explorer form{flex-direction:column;align-items:stretch;gap:0.6em}
@@ -418,18 +516,9 @@ align-items:stretch;gap:0.2em}
 .uio-static-explorer input[type=range]{flex:1 1 auto;min-width:0;width:100%;height:2.5em}
 .uio-static-explorer output{min-width:3em;text-align:right}
 .uio-static-explorer select{width:100%;min-height:2.5em;font-size:max(16px, 1em)}
-.uio-static-explorer .uio-zoom-label{display:flex;min-height:2.5em}
-.uio-static-explorer .uio-zoom{width:1.4em;height:1.4em;margin:0}
-.uio-static-explorer img.uio-frame{cursor:zoom-in}
-.uio-static-explorer.uio-zoomed img.uio-frame{cursor:zoom-out}
-.uio-static-explorer .uio-caption{font-size:0.95em}
+.uio-static-explorer .uio-captions>p{font-size:0.95em}
 }
 """
-
-
-def _png_width(png: bytes) -> int:
-    """The width in pixels of a PNG (from its header)."""
-    return int.from_bytes(png[16:20], "big")
 
 
 def _html(
@@ -449,20 +538,28 @@ def _html(
         f'<option value="{j}"{" selected" if j == j0 else ""}>{esc(kind)}</option>'
         for j, kind in enumerate(disturbances)
     )
+    phone = bool(first.png_narrow)
     store = "".join(
         f'<span data-k="{f.index[0]}-{f.index[1]}" data-src="{f.data_url}" '
-        f'data-caption="{esc(f.caption)}" data-alt="{esc(f.alt)}" '
+        + (f'data-narrow="{f.narrow_url}" ' if phone else "")
+        + f'data-caption="{esc(f.caption)}" data-alt="{esc(f.alt)}" '
         f'data-label="{esc(f.label)}"></span>'
         for f in frames
+    )
+    # every caption, invisible, in the caption's grid cell: the box is as tall as the longest
+    sizers = "".join(
+        f'<p class="uio-sizer" aria-hidden="true">{esc(c)}</p>'
+        for c in dict.fromkeys(f.caption for f in frames)
     )
     label = esc(main_control_label(scenario, base))
     handler = esc(_JS, quote=True)
     alt = esc(first.alt)
     hidden_select = "" if len(disturbances) > 1 else ' style="display:none"'
-    # enlarged, the picture is shown at half its pixel width: 2 pixels a CSS pixel, as designed
-    css = _CSS.replace("@ZOOM@", str(_png_width(first.png) // 2)).replace("@NARROW@", str(_NARROW))
+    css = _CSS.replace("@NARROW@", str(NARROW_PX))
     css = "".join(line.strip() for line in css.splitlines())
-    zoom = f"{eid}-zoom"
+    source = (
+        f'<source media="(max-width:{NARROW_PX}px)" srcset="{first.narrow_url}">' if phone else ""
+    )
     return (
         f'<div id="{eid}" class="uio-static-explorer">'
         f"<style>{css}</style>"
@@ -473,13 +570,11 @@ def _html(
         f'<output name="mainval">{esc(first.label)}</output></span></label>'
         f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
-        f'<label class="uio-zoom-label"><input type="checkbox" name="zoom" id="{zoom}" '
-        f'class="uio-zoom" aria-label="{_ZOOM_TEXT}"> {_ZOOM_TEXT}</label>'
         "</form>"
-        # a tap on the picture ticks or clears "enlarge the picture" (its label)
-        f'<div class="uio-picture"><label for="{zoom}">'
-        f'<img class="uio-frame" src="{first.data_url}" alt="{alt}"></label></div>'
-        f'<p class="uio-caption" aria-live="polite">{esc(first.caption)}</p>'
+        f'<div class="uio-picture"><picture>{source}'
+        f'<img class="uio-frame" src="{first.data_url}" alt="{alt}"></picture></div>'
+        f'<div class="uio-captions"><p class="uio-caption" aria-live="polite">'
+        f"{esc(first.caption)}</p>{sizers}</div>"
         '<p class="uio-note">Pre-computed pictures: move the '
         "slider or pick a disturbance. Open this page as a notebook with a Python kernel for "
         "the live explorer, where every control can be set.</p>"

@@ -35,6 +35,7 @@ Examples
 from __future__ import annotations
 
 import cmath
+import dataclasses
 import html
 import math
 from collections.abc import Iterator
@@ -46,11 +47,12 @@ import numpy as np
 
 from .._display import format_poles
 from ..plant import Plant
-from ._drag import DragPoles, _in_kernel, drag_available
+from ._drag import DragPoles, drag_available, in_kernel
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+from .static import static_html
 
 __all__ = [
     "Explorer",
@@ -157,8 +159,9 @@ class Explorer(DragPoles):
     >>> from uio_teach.explorers import widgets
     >>> ex = widgets.case_study_explorer(static=False)
     >>> ex.controls["pole 1"].value = 1.05      # what a student's slider does
-    >>> print(ex.frame.observer_message)
-    this pole makes the PMO unstable: the error grows (pole 1.05 outside the unit circle)
+    >>> print(ex.frame.observer_message)   # doctest: +NORMALIZE_WHITESPACE
+    this pole makes the PMO unstable: the error grows (pole 1.05 outside the unit circle;
+    |e| from 3.74 to 33.4)
     >>> ex.set(mode="lmi", decay=0.4)
     >>> print(ex.frame.observer_message)   # doctest: +NORMALIZE_WHITESPACE
     no gain meets the bound radius 0.4: the fixed poles (invariant zeros, radius 0.5)
@@ -192,7 +195,7 @@ class Explorer(DragPoles):
         self.canvas: Any = None
         self._dragging: tuple[int, str] | None = None
         if drag is None:
-            drag = _in_kernel() and drag_available() and scenario.movable > 0
+            drag = in_kernel() and drag_available() and scenario.movable > 0
         if drag:
             self.canvas = self._make_canvas()
         fig = self.figure.fig
@@ -530,8 +533,6 @@ class Explorer(DragPoles):
         18
         """
         if self._static_html is None:
-            from .static import static_html
-
             self._static_html = static_html(self.scenario, self._base)
         return self._static_html
 
@@ -675,14 +676,12 @@ def missile_explorer(
         raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
     scenario = missile_scenario()
     if observer_family == "ginverse":
-        import dataclasses
-
         scenario = dataclasses.replace(
             scenario,
             family="ginverse",
             static_control="amplitude",
             static_values=(0.0, 5.0, 10.0, 20.0, 40.0),
-            _cache={},
+            cache={},
         )
     return Explorer(scenario, static=static, drag=drag)
 
