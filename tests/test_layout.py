@@ -141,7 +141,6 @@ def _is_module(root: Path, dotted: str) -> bool:
     ).exists()
 
 
-@pytest.mark.xfail(strict=False, reason="some modules still share private helpers")
 @pytest.mark.parametrize("path", MODULES, ids=_ids)
 def test_no_module_uses_a_private_name_of_another(path):
     found = private_imports(path)
@@ -203,7 +202,6 @@ def deferred_imports(path: Path) -> list[str]:
     ]
 
 
-@pytest.mark.xfail(strict=False, reason="some modules still import inside functions")
 @pytest.mark.parametrize("path", MODULES, ids=_ids)
 def test_imports_are_at_the_top_unless_deferred_on_purpose(path):
     found = deferred_imports(path)
@@ -333,7 +331,6 @@ def clock_assertions(path: Path) -> list[str]:
     return sorted(set(found))
 
 
-@pytest.mark.xfail(strict=False, reason="three tests still compare durations")
 @pytest.mark.parametrize("path", sorted(TESTS.glob("test_*.py")), ids=lambda p: p.name)
 def test_no_test_asserts_a_wall_clock_duration(path):
     found = clock_assertions(path)

@@ -92,7 +92,7 @@ class DragPoles:
     def _make_canvas(self) -> Any:
         """An ipympl canvas for the figure, or None when the widget backend does not load."""
         try:  # deferred on purpose: ipympl is optional (drag_available said it loads)
-            from ipympl.backend_nbagg import Canvas, FigureManager
+            from ipympl.backend_nbagg import Canvas, FigureManager  # optional
 
             canvas = Canvas(self.figure.fig)
             FigureManager(canvas, 0)
