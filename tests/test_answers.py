@@ -19,7 +19,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.checks import answers
+from uio_teach.checks import answers, grading
 from uio_teach.checks.grading import GRADED, Missing, grade_answers, missing_message
 from uio_teach.instructor.labs import LABS
 
@@ -58,6 +58,49 @@ def solved() -> dict[str, dict]:
     return out
 
 
+class _Answer(str):
+    """An answer variable, as the graded call receives it (its name)."""
+
+
+class _Key(dict):
+    """Any entry of the key's parameters: itself, whatever the key."""
+
+    def __getitem__(self, key):
+        return self
+
+
+def _as_passed(node: ast.expr, given: tuple[str, ...]):
+    """What the graded call must receive for one argument of a check cell."""
+    if isinstance(node, ast.Name) and node.id not in given:
+        return _Answer(node.id)
+    return "key"  # PARAMS[...], the plant, x0: the grader's own value
+
+
+def test_the_registry_calls_each_check_as_its_cell_does(monkeypatch):
+    for lab, graded in GRADED.items():
+        for check, cell in zip(graded, check_cells(lab), strict=True):
+            call = ast.parse(cell).body[0].value
+            seen = []
+
+            def record(*args, _seen=seen, **kwargs):
+                _seen.append((args, kwargs))
+                return checks.CheckResult("recorded")
+
+            monkeypatch.setattr(grading, call.func.attr, record)
+            check.run({n: _Answer(n) for n in check.names}, _Key(), "key")
+            ((args, kwargs),) = seen
+
+            def shown(value):
+                return value if isinstance(value, _Answer) else "key"
+
+            assert [shown(a) for a in args] == [_as_passed(a, check.given) for a in call.args], (
+                check.check_id
+            )
+            assert {k: shown(v) for k, v in kwargs.items()} == {
+                k.arg: _as_passed(k.value, check.given) for k in call.keywords
+            }, check.check_id
+
+
 def test_the_registry_reads_the_answers_each_check_cell_names():
     for lab, graded in GRADED.items():
         cells = check_cells(lab)
@@ -72,7 +115,9 @@ def test_the_registry_reads_the_answers_each_check_cell_names():
                 for n in ast.walk(arg)
                 if isinstance(n, ast.Name)
             }
-            assert used - {"PARAMS"} == set(check.names), check.check_id
+            # the answers come from the notebook; the plant (and the missile's x0) from the key
+            assert used - {"PARAMS"} - set(check.given) == set(check.names), check.check_id
+            assert set(check.given) <= used, check.check_id
 
 
 @pytest.mark.parametrize("lab", list(GRADED))

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from uio_teach.checks.grading import GRADED
 from uio_teach.instructor import grade, output
 from uio_teach.instructor.gradebook import Gradebook, GradebookBusy, Submission
 
@@ -163,8 +164,8 @@ def test_unreadable_submissions_are_graded_without_a_kernel(tmp_path):
     assert [s.status for s in graded] == ["unreadable", "unreadable"]
     table = rows(out)
     assert [(r["group"], r["total"], r["out_of"]) for r in table] == [
-        ("g01", "0", "4"),
-        ("g02", "0", "4"),
+        ("g01", "0", str(len(GRADED["pa9"]))),
+        ("g02", "0", str(len(GRADED["pa9"]))),
     ]
     text = (tmp_path / "grades_feedback" / "pa9_g01.txt").read_text(encoding="utf-8")
     assert "not a notebook" in text

@@ -12,6 +12,7 @@ import pytest
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.existence import decoupling
+from uio_teach.instructor.lab_params import MIN_INITIAL_ERROR
 from uio_teach.instructor.lab_registry import LABS
 from uio_teach.instructor.variants import draw_variants
 from uio_teach.lmi import lmi_gain
@@ -200,3 +201,100 @@ def test_every_graded_value_differs_between_groups(variants, lab):
             if name in ("P", "Y"):  # the LMI's certificate: any solution is right
                 continue
             assert not np.allclose(a[name], b[name], atol=1e-3), (lab, name)
+
+
+def pa9_runs(params, answer):
+    """The PA9 lab's two runs, from z(0) = 0, with the group's own design."""
+    plant = ut.experiments.plant_from_params("pa9", params)
+    observer = ut.design_uio(plant, K1=answer["K1"])
+    t = np.linspace(0, params["duration"], params["samples"])
+    u = ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0))
+    sine = ut.signals.sinusoid(params["sine"]["amplitude"], params["sine"]["frequency"])
+    steps = ut.signals.piecewise_constant(
+        params["piecewise"]["times"], params["piecewise"]["values"]
+    )
+    x0 = params["initial_state"]
+    return (
+        ut.simulate(plant, observer, t, u=u, d=sine, initial_state=x0),
+        ut.simulate(plant, observer, t, u=u, d=steps, initial_state=x0),
+    )
+
+
+def pa9_run_verdicts(params):
+    """The PA9 run checks of a group's own solution against its own key."""
+    plant = ut.experiments.plant_from_params("pa9", params)
+    answer = pa9_solution(params)
+    resp_sine, resp_steps = pa9_runs(params, answer)
+    common = {
+        "poles": params["poles"],
+        "initial_state": params["initial_state"],
+        "H": answer["H"],
+        "K1": answer["K1"],
+        "plant": plant,
+    }
+    return resp_sine, {
+        "pa9.simulation": checks.pa9_simulation(
+            resp_sine,
+            amplitude=params["sine"]["amplitude"],
+            frequency=params["sine"]["frequency"],
+            **common,
+        ),
+        "pa9.piecewise": checks.pa9_piecewise(
+            resp_steps,
+            sinusoidal=resp_sine,
+            times=params["piecewise"]["times"],
+            values=params["piecewise"]["values"],
+            **common,
+        ),
+    }
+
+
+def case_study_run_verdict(params):
+    """The case study's run check of a group's own solution against its own key."""
+    plant = ut.experiments.plant_from_params("case_study", params)
+    pmo = ut.design_pmo(plant, L=case_study_solution(params)["L"])
+    steps = np.arange(params["steps"] + 1)
+    u2 = ut.signals.sinusoid(params["u2"]["amplitude"], params["u2"]["frequency"])
+    rng = np.random.default_rng(params["v"]["seed"])
+    switch = np.arange(0, steps[-1] + 1, params["v"]["hold"])
+    levels = rng.uniform(-params["v"]["amplitude"], params["v"]["amplitude"], switch.size)
+    v = ut.signals.piecewise_constant(switch, levels)
+    run = ut.simulate(plant, pmo, steps, d=u2, v=v, initial_state=params["initial_state"])
+    return run, checks.case_study_simulation(
+        run,
+        u2=(params["u2"]["amplitude"], params["u2"]["frequency"]),
+        v=(params["v"]["amplitude"], params["v"]["hold"], params["v"]["seed"]),
+        initial_state=params["initial_state"],
+        plant=plant,
+        observer=pmo,
+    )
+
+
+def test_the_first_groups_of_seed_3_start_with_a_pa9_error():
+    # x(0) = [-0.5, 0.5, -0.5] along E = [1, -1, 1] once gave e(0) = T x(0) = 0
+    for variant in draw_variants(LABS["pa9"], 2, seed=3):
+        resp, results = pa9_run_verdicts(variant.to_params())
+        assert np.max(np.abs(resp.error[:, 0])) >= MIN_INITIAL_ERROR
+        assert all(r.passed for r in results.values()), {k: r.failures for k, r in results.items()}
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_every_group_run_passes_its_own_key_whatever_the_seed(seed):
+    for variant in draw_variants(LABS["pa9"], 2, seed=seed):
+        resp, results = pa9_run_verdicts(variant.to_params())
+        assert np.max(np.abs(resp.error[:, 0])) >= MIN_INITIAL_ERROR, seed
+        assert all(r.passed for r in results.values()), (seed, variant.initial_state)
+    for variant in draw_variants(LABS["case_study"], 2, seed=seed):
+        run, result = case_study_run_verdict(variant.to_params())
+        assert np.max(np.abs(run.error[:, 0])) >= MIN_INITIAL_ERROR, seed
+        assert result.passed, (seed, result.failures)
+
+
+def test_a_start_along_e_is_no_fair_pa9_exercise():
+    variant = LABS["pa9"].params()
+    E = variant.plant().E.ravel()
+    along = LABS["pa9"].params.from_params(
+        dict(variant.to_params(), initial_state=[float(v) for v in E])
+    )
+    assert any("initial error" in p for p in along.problems())
+    assert not variant.problems()

@@ -198,7 +198,8 @@ def _figure(fig: Any) -> dict[str, Any]:
     groups: list[int] = []
     for i, ax in enumerate(axes):
         shared = ax.get_shared_x_axes()
-        groups.append(next(j for j in range(i + 1) if shared.joined(ax, axes[j])))
+        # an axes that shares its x with none is its own group (joined(ax, ax) can be False)
+        groups.append(next((j for j in range(i) if shared.joined(ax, axes[j])), i))
     out_axes = []
     for ax, group in zip(axes, groups, strict=True):
         legend = ax.get_legend()

@@ -1,10 +1,11 @@
 """The grade side of the labs' checks: which answers each check needs, and the verdicts.
 
 A lab's check cells (``book/lab_*.md``) call a check function of
-:mod:`uio_teach.checks` on the group's answer variables and on ``PARAMS``.
-The grader does the same, in its own process: for each lab, :data:`GRADED`
-lists its checks in order (the check id, the answer variables it reads, and a
-function ``(answers, params, plant) -> CheckResult``), and
+:mod:`uio_teach.checks` on the group's answer variables, on ``PARAMS`` and on
+the set-up cell's ``plant``. The grader makes the same calls, with the same
+arguments, in its own process: for each lab, :data:`GRADED` lists its checks
+in order (the check id, the answer variables it reads, and a function
+``(answers, params, plant) -> CheckResult``), and
 :func:`grade_answers` calls them with the answers taken out of the group's
 kernel (see :mod:`uio_teach.checks.answers`) and the parameters **of the
 answer key**, never those of the notebook. The plant is the group's plant,
@@ -40,6 +41,7 @@ from typing import Any
 from .. import examples
 from . import (
     case_study_lmi,
+    case_study_plot,
     case_study_pole,
     case_study_projection,
     case_study_residual,
@@ -48,10 +50,12 @@ from . import (
     missile_catch_times,
     missile_ginverse,
     missile_noise,
+    missile_plot,
     missile_pmo,
     missile_reconstruction,
     pa9_design,
     pa9_piecewise,
+    pa9_piecewise_plot,
     pa9_plot,
     pa9_simulation,
 )
@@ -111,12 +115,17 @@ class GradedCheck:
         The answer variables it reads (those of the lab's check cell).
     run : callable
         ``run(answers, params, plant) -> CheckResult``.
+    given : tuple of str
+        The other names of the check cell, which the grader takes from the
+        answer key, never from the notebook: the group's ``plant`` (from the
+        key's parameters) and, in the missile lab, the paper's ``x0``.
     """
 
     check_id: str
     title: str
     names: tuple[str, ...]
     run: Callable[[Mapping[str, Any], Mapping[str, Any], Any], CheckResult]
+    given: tuple[str, ...] = ("plant",)
 
 
 def _pa9() -> tuple[GradedCheck, ...]:
@@ -126,31 +135,34 @@ def _pa9() -> tuple[GradedCheck, ...]:
             "Requirement 1: the UIO design",
             ("H", "T", "K1", "F", "K2"),
             lambda a, p, plant: pa9_design(
-                a["H"], a["T"], a["K1"], a["F"], a["K2"], plant, poles=p["poles"]
+                a["H"], a["T"], a["K1"], a["F"], a["K2"], plant=plant, poles=p["poles"]
             ),
         ),
         GradedCheck(
             "pa9.simulation",
             "Requirement 2: the simulation with a sinusoidal d",
-            ("resp_sine",),
+            ("resp_sine", "H", "K1"),
             lambda a, p, plant: pa9_simulation(
                 a["resp_sine"],
                 poles=p["poles"],
                 amplitude=p["sine"]["amplitude"],
                 frequency=p["sine"]["frequency"],
                 initial_state=p["initial_state"],
+                H=a["H"],
+                K1=a["K1"],
+                plant=plant,
             ),
         ),
         GradedCheck(
             "pa9.plot",
             "Requirement 3: the plot of e and r",
             ("fig", "resp_sine"),
-            lambda a, p, plant: pa9_plot(a["fig"], response=a["resp_sine"]),
+            lambda a, p, plant: pa9_plot(a["fig"], response=a["resp_sine"], plant=plant),
         ),
         GradedCheck(
             "pa9.piecewise",
             "Requirement 4: the piecewise-constant d",
-            ("resp_steps", "resp_sine"),
+            ("resp_steps", "resp_sine", "H", "K1"),
             lambda a, p, plant: pa9_piecewise(
                 a["resp_steps"],
                 sinusoidal=a["resp_sine"],
@@ -158,6 +170,17 @@ def _pa9() -> tuple[GradedCheck, ...]:
                 values=p["piecewise"]["values"],
                 poles=p["poles"],
                 initial_state=p["initial_state"],
+                H=a["H"],
+                K1=a["K1"],
+                plant=plant,
+            ),
+        ),
+        GradedCheck(
+            "pa9.piecewise_plot",
+            "Requirement 4: the plot of the piecewise-constant run",
+            ("fig_steps", "resp_steps"),
+            lambda a, p, plant: pa9_piecewise_plot(
+                a["fig_steps"], response=a["resp_steps"], plant=plant
             ),
         ),
     )
@@ -169,38 +192,51 @@ def _case_study() -> tuple[GradedCheck, ...]:
             "case_study.projection",
             "The projection M",
             ("M",),
-            lambda a, p, plant: case_study_projection(a["M"], plant),
+            lambda a, p, plant: case_study_projection(a["M"], plant=plant),
         ),
         GradedCheck(
             "case_study.lmi",
             "The gain L from the LMI",
-            ("L", "P_lmi"),
-            lambda a, p, plant: case_study_lmi(a["L"], a["P_lmi"], plant),
+            ("L", "P_lmi", "Y_lmi"),
+            lambda a, p, plant: case_study_lmi(a["L"], a["P_lmi"], plant=plant, Y=a["Y_lmi"]),
         ),
         GradedCheck(
             "case_study.pole",
             "The movable pole",
             ("L_moved",),
-            lambda a, p, plant: case_study_pole(a["L_moved"], p["pole"], plant),
+            lambda a, p, plant: case_study_pole(a["L_moved"], p["pole"], plant=plant),
         ),
         GradedCheck(
             "case_study.simulation",
             "A run with both unknown signals",
-            ("run",),
+            ("run", "pmo"),
             lambda a, p, plant: case_study_simulation(
                 a["run"],
                 u2=(p["u2"]["amplitude"], p["u2"]["frequency"]),
                 v=(p["v"]["amplitude"], p["v"]["hold"], p["v"]["seed"]),
                 initial_state=p["initial_state"],
+                plant=plant,
+                observer=a["pmo"],
             ),
         ),
         GradedCheck(
             "case_study.residual",
             "The residual and Dv",
             ("Dv", "Nr", "run"),
-            lambda a, p, plant: case_study_residual(a["Dv"], a["Nr"], a["run"]),
+            lambda a, p, plant: case_study_residual(a["Dv"], a["Nr"], a["run"], plant=plant),
+        ),
+        GradedCheck(
+            "case_study.plot",
+            "The plot of the run",
+            ("fig", "run"),
+            lambda a, p, plant: case_study_plot(a["fig"], a["run"], plant=plant),
         ),
     )
+
+
+def _missile_start() -> Any:
+    """The missile lab's initial state: the paper's x0, as its set-up cell takes it."""
+    return examples.MISSILE_PUBLISHED.x0
 
 
 def _missile() -> tuple[GradedCheck, ...]:
@@ -217,29 +253,58 @@ def _missile() -> tuple[GradedCheck, ...]:
             "missile.ginverse",
             "The generalized-inverse observer",
             ("Cg", "Pc", "K"),
-            lambda a, p, plant: missile_ginverse(a["Cg"], a["Pc"], a["K"], plant),
+            lambda a, p, plant: missile_ginverse(a["Cg"], a["Pc"], a["K"], plant=plant),
         ),
         GradedCheck(
             "missile.reconstruction",
             "Reconstructing v1 and v2",
-            ("vhat", "run_pmo"),
-            lambda a, p, plant: missile_reconstruction(a["vhat"], a["run_pmo"]),
+            ("vhat", "run_pmo", "pmo"),
+            lambda a, p, plant: missile_reconstruction(
+                a["vhat"],
+                a["run_pmo"],
+                plant=plant,
+                observer=a["pmo"],
+                poles=p["pmo_poles"],
+                initial_state=_missile_start(),
+            ),
+            given=("plant", "x0"),
+        ),
+        GradedCheck(
+            "missile.plot",
+            "The plot of v1, v2 and their estimates",
+            ("fig", "vhat"),
+            lambda a, p, plant: missile_plot(a["fig"], a["vhat"], plant=plant),
         ),
         GradedCheck(
             "missile.catch_times",
             "The catch times",
-            ("catch", "run_pmo0", "vhat0"),
+            ("catch", "run_pmo0", "vhat0", "pmo"),
             lambda a, p, plant: missile_catch_times(
-                a["catch"], a["run_pmo0"], a["vhat0"], tol=p["tol"]
+                a["catch"],
+                a["run_pmo0"],
+                a["vhat0"],
+                tol=p["tol"],
+                plant=plant,
+                observer=a["pmo"],
+                poles=p["pmo_poles"],
+                initial_state=_missile_start(),
             ),
+            given=("plant", "x0"),
         ),
         GradedCheck(
             "missile.noise",
             "What noise does to the reconstruction",
-            ("rms_noisy", "run_noisy"),
+            ("rms_noisy", "run_noisy", "pmo"),
             lambda a, p, plant: missile_noise(
-                a["rms_noisy"], a["run_noisy"], sigma=p["noise"]["sigma"], seed=p["noise"]["seed"]
+                a["rms_noisy"],
+                a["run_noisy"],
+                sigma=p["noise"]["sigma"],
+                seed=p["noise"]["seed"],
+                plant=plant,
+                observer=a["pmo"],
+                initial_state=_missile_start(),
             ),
+            given=("plant", "x0"),
         ),
     )
 

@@ -31,7 +31,6 @@ Examples
 from __future__ import annotations
 
 import csv
-import fcntl
 import io
 import json
 import os
@@ -42,6 +41,8 @@ from typing import Any
 
 from .output import (
     MANIFEST,
+    FolderBusy,
+    FolderLock,
     OutputError,
     check_output_folder,
     read_manifest,
@@ -68,7 +69,7 @@ _FIRST = ["file", "lab", "group", "status"]
 _LAST = ["total", "out_of"]
 
 
-class GradebookBusy(OutputError):
+class GradebookBusy(FolderBusy):
     """Another grading run is writing this gradebook."""
 
 
@@ -319,23 +320,19 @@ class Gradebook:
         self.resume = resume
         self.names = feedback_names(self.files)
         self.done: dict[str, list[str]] = {}
-        self._lock_path = self.out.with_name(f".{self.out.name}.lock")
-        self._lock: Any = None
+        self._lock = FolderLock(self.out)  # the file .<name>.lock beside the CSV
         self._csv: Any = None
 
     # opening ------------------------------------------------------------------------------
     def __enter__(self) -> Gradebook:
         check_gradebook_target(self.out)
         self.out.parent.mkdir(parents=True, exist_ok=True)
-        self._lock = open(self._lock_path, "a")
         try:
-            fcntl.flock(self._lock.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            self._lock.close()
-            self._lock = None
+            self._lock.acquire()
+        except FolderBusy:
             raise GradebookBusy(
                 f"another grading run is writing {os.fspath(self.out)} (it holds "
-                f"{self._lock_path.name}); wait for it to end, or choose another gradebook"
+                f"{self._lock.path.name}); wait for it to end, or choose another gradebook"
             ) from None
         try:
             self._open()
@@ -426,12 +423,7 @@ class Gradebook:
         write_manifest(self.folder, command=COMMAND, config=config, options=self._options())
 
     def _unlock(self) -> None:
-        if self._lock is not None:
-            try:
-                self._lock_path.unlink(missing_ok=True)
-            finally:
-                self._lock.close()
-                self._lock = None
+        self._lock.release()
 
     def __exit__(self, exc_type: Any, *exc: object) -> None:
         try:

@@ -68,7 +68,14 @@ __all__ = [
     "lab_params_of",
     "pole_text",
     "params_dict",
+    "MIN_INITIAL_ERROR",
 ]
+
+MIN_INITIAL_ERROR = 0.25
+"""The least largest entry of a group's initial estimation error e(0) (from z(0) = 0).
+
+A drawn initial state whose error starts smaller (for PA9, an ``x(0)`` along
+``E``, which ``T`` annuls) is drawn again: the exercises watch the error decay."""
 
 
 def _pole(value: Any) -> complex | float:
@@ -384,7 +391,12 @@ class PA9Params(LabParams):
         grid = np.arange(-6.0, -0.99, 0.5)
         poles = tuple(sorted((float(p) for p in rng.choice(grid, 3, replace=False)), reverse=True))
         levels = [-2.0, -1.5, -1.0, -0.5, 0.5, 1.0, 1.5, 2.0]
-        x0 = tuple(float(v) for v in rng.choice([-1.5, -1.0, -0.5, 0.5, 1.0, 1.5], 3))
+        # x(0) along E would start the error e(0) = T x(0) at zero: nothing to see decay
+        T = PA9Params.error_start_map(A, E)
+        for _ in range(100):
+            x0 = tuple(float(v) for v in rng.choice([-1.5, -1.0, -0.5, 0.5, 1.0, 1.5], 3))
+            if np.max(np.abs(T @ np.asarray(x0))) >= MIN_INITIAL_ERROR:
+                break
         while True:
             t = np.sort(rng.choice(np.arange(1.0, 9.0, 0.5), 3, replace=False))
             if np.all(np.diff(t) >= 1.0):
@@ -408,6 +420,13 @@ class PA9Params(LabParams):
             switch_times=(0.0, *(float(x) for x in t)),
             switch_values=tuple(values),
         )
+
+    @staticmethod
+    def error_start_map(A: Any, E: Any) -> np.ndarray:
+        """``T = I - H C`` of the PA9 plant with this ``A`` and ``E``: e(0) = T x(0)."""
+        plant = plant_from_params("pa9", {"plant": {"A": A, "E": E}})
+        C, E = plant.C, plant.E
+        return np.eye(plant.n) - E @ np.linalg.pinv(C @ E) @ C
 
     def distinct(self) -> dict[str, Any]:
         """Poles, and the direction of ``E`` with ``A`` (``H`` and ``T`` depend on it)."""
@@ -437,6 +456,9 @@ class PA9Params(LabParams):
             plant = self.plant()
         except ValueError as err:
             return [*out, f"the plant: {err}"]
+        e0 = self.error_start_map(plant.A, plant.E) @ np.asarray(self.initial_state, float)
+        if np.max(np.abs(e0)) < MIN_INITIAL_ERROR:
+            out.append("x(0) must give a clearly nonzero initial error e(0) = T x(0)")
         report = check_existence(plant)
         if not report.ok or report.movable != plant.n:
             out.append("the UIO must exist with every pole movable ((C, TA) observable)")
@@ -533,7 +555,7 @@ class CaseStudyParams(LabParams):
         Pi = np.eye(plant.n) - M @ plant.C
         for _ in range(100):
             x0 = rng.choice([-3.0, -2.0, -1.0, 1.0, 2.0, 3.0], 3)
-            if np.linalg.norm(Pi @ x0) > 0.5:
+            if np.max(np.abs(Pi @ x0)) >= MIN_INITIAL_ERROR:
                 break
         return cls(
             initial_state=tuple(float(v) for v in x0),
@@ -583,6 +605,10 @@ class CaseStudyParams(LabParams):
             out.append("the fixed modes must be stable, and fast enough for the run")
         if np.min(np.abs(fixed - self.pole)) < 0.1:
             out.append("the movable pole must differ from the fixed modes")
+        dec = decoupling(plant)
+        e0 = (np.eye(plant.n) - dec.M @ plant.C) @ np.asarray(self.initial_state, float)
+        if np.max(np.abs(e0)) < MIN_INITIAL_ERROR:
+            out.append("x[0] must give a clearly nonzero initial error (I - MC) x[0]")
         if np.max(np.abs(decoupling(plant).M)) > 10:
             out.append("M has entries too large for a fair hand computation")
         natural = np.linalg.eigvals(decoupling(plant).A1)
@@ -732,6 +758,12 @@ class MissileParams(LabParams):
             out.append("the invariant zeros must be stable and actuator-like (|z| <= 600 rad/s)")
         if np.max(np.abs(plant.E @ np.linalg.inv(CE))) > 50:
             out.append("M has entries too large for a fair comparison with the paper's")
+        if not out:
+            # the lab's runs start the PMO at z(0) = 0: e(0) = (I - MC) x0
+            M = design_pmo(plant, poles=[complex(p) for p in self.poles], Mv=MISSILE_PUBLISHED.Mv).M
+            e0 = (np.eye(plant.n) - M @ plant.C) @ np.asarray(MISSILE_PUBLISHED.x0, float)
+            if np.max(np.abs(e0)) < MIN_INITIAL_ERROR:
+                out.append("the paper's x0 must give a clearly nonzero initial error (I - MC) x0")
         if not out:
             # the catch-time story: from xhat(0) = 0 the PMO's v-hat catches v1, v2 early
             run = self.run()

@@ -56,6 +56,7 @@ __all__ = [
     "FORMATS",
     "MANIFEST",
     "OutputError",
+    "FolderBusy",
     "StagedFolder",
     "FolderLock",
     "clean_leftovers",
@@ -82,6 +83,10 @@ _SVG_HASHSALT = "uio-teach"
 
 class OutputError(OSError):
     """The output folder cannot be created or written to."""
+
+
+class FolderBusy(OutputError):
+    """Another process holds the lock of the output folder (see :class:`FolderLock`)."""
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str], fmt: str, dpi: int = 150) -> Path:
@@ -363,7 +368,8 @@ class FolderLock:
     Raises
     ------
     OutputError
-        Another process holds the lock, or the lock file cannot be made.
+        The lock file cannot be made; :class:`FolderBusy` (an OutputError)
+        when another process holds the lock.
 
     Examples
     --------
@@ -405,7 +411,7 @@ class FolderLock:
             except OSError:
                 holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
                 os.close(fd)
-                raise OutputError(
+                raise FolderBusy(
                     f"another uio-teach run (process {holder}) is writing "
                     f"{os.fspath(self.target)}; wait until it ends, or choose another folder"
                 ) from None
