@@ -333,10 +333,12 @@ def test_prose_states_the_experiments_numbers() -> None:
 # The observer's own state is z in every chapter (the missile paper's q is named only as the
 # paper's); r is the residual alone (the number of measurement disturbances is n_v, `plant.nv`).
 _OTHER_OBSERVER_STATE = re.compile(r"\\dot q\b|\bq\(0\)|\bq\[0\]|\bq_\{?\d|plant\.r\b")
-COURSE_CHAPTERS = [path for path in CHAPTERS if not path.name.startswith("lab_")]
+NOTATION_CHAPTERS = [path for path in CHAPTERS if not path.name.startswith("lab_")]
 
 
-@pytest.mark.parametrize("chapter", COURSE_CHAPTERS, ids=[path.name for path in COURSE_CHAPTERS])
+@pytest.mark.parametrize(
+    "chapter", NOTATION_CHAPTERS, ids=[path.name for path in NOTATION_CHAPTERS]
+)
 def test_one_notation_for_the_observer_state_and_the_residual(chapter: Path) -> None:
     lines = chapter.read_text(encoding="utf-8").splitlines()
     found = [

@@ -515,7 +515,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
        reconstructed uniquely from the state estimate.
 
     Every decision is made on the plant in balanced units
-    (:mod:`uio_teach.balancing`): the same plant with its states, outputs or
+    (``uio_teach.balancing``): the same plant with its states, outputs or
     unknown inputs in other units gets the same verdicts, and data in the
     overflow range are scaled before any product is formed.
 

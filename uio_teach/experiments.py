@@ -80,7 +80,7 @@ class Param:
 
     The term config (``uio_teach.instructor.config``), the lab parameters
     (:mod:`uio_teach.instructor.lab_params`) and the explorers
-    (:mod:`uio_teach.explorers.scenarios`) read their keys, types, bounds,
+    (``uio_teach.explorers.scenarios``) read their keys, types, bounds,
     help texts and ranges from these declarations, attached to the fields of
     the experiment dataclasses with :func:`param`; adding a field to an
     experiment adds it to all three.
@@ -185,7 +185,7 @@ def param(default: Any, kind: str, doc: str, **options: Any) -> Any:
         See :class:`Param`.
     **options
         The other arguments of :class:`Param`, and ``init``/``repr`` of
-        :func:`dataclasses.field`.
+        ``dataclasses.field``.
 
     Returns
     -------
@@ -966,7 +966,7 @@ def plant_from_params(lab: str, params: Mapping[str, Any] | None = None) -> Plan
     Parameters
     ----------
     lab : {"pa9", "case_study", "missile"}
-        The lab (see :data:`LAB_PLANTS`).
+        The lab (see ``LAB_PLANTS``).
     params : mapping, optional
         The lab's ``PARAMS``; only its ``"plant"`` entry is read. ``None``, or
         no ``"plant"`` entry: the course's plant.

@@ -314,13 +314,22 @@ def requested_poles(poles, fixed: np.ndarray, movable: int) -> np.ndarray:
 
 
 def place_pair_poles(
-    pair: BalancedPair, poles, *, fixed_name: str = "invariant zeros"
+    pair: BalancedPair,
+    poles,
+    *,
+    fixed_name: str = "invariant zeros",
+    given: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gain ``L`` (``L D = 0``) placing ``poles`` on the balanced pair of a projection design.
+    """Gain ``L`` (``L D = 0``) placing ``poles`` on the pair of a projection design.
 
-    The placement is computed in balanced units (see
-    :class:`uio_teach.balancing.BalancedPair`), so what can be placed and the
-    gain's accuracy do not depend on the units of the data.
+    What can be placed (the movable poles and the fixed modes) is decided on
+    the balanced pair (see :class:`uio_teach.balancing.BalancedPair`), so it
+    does not depend on the units of the data. The gain itself is first
+    computed on the pair as given, ``(A1, N C)``, as python-control's
+    ``place`` would compute it; when that gain does not give the requested
+    poles to ``POLE_RTOL`` (a badly scaled plant), or the pair as given does
+    not split into the same movable and fixed parts, the gain is computed in
+    balanced units instead.
 
     Parameters
     ----------
@@ -329,6 +338,11 @@ def place_pair_poles(
         The movable poles (or all ``n``, the fixed modes among them).
     fixed_name : str
         How the fixed modes are called in messages.
+    given : (A1, C, N), optional
+        The pair in the plant's units: the error matrix's ``A1`` (``TA`` of a
+        UIO), the plant's ``C`` and ``N`` (``N D = 0``, the identity without a
+        measurement disturbance); the gain is then ``L = L_o N`` with ``L_o``
+        placed on ``(A1, N C)``.
 
     Returns
     -------
@@ -374,7 +388,36 @@ def place_pair_poles(
                 "requested on it cannot be told apart from it. Choose the movable poles "
                 "away from the fixed modes"
             )
+    target = np.concatenate([poles, fixed])
+    if given is not None:
+        L = _place_given(given, pair, poles, target)
+        if L is not None:
+            return L, target
     Lb = place_observer_poles(
         pair.A, pair.C, poles / pair.sigma, split=pair.split, fixed_name=fixed_name, verify=False
     )
-    return pair.gain(Lb), np.concatenate([poles, fixed])
+    return pair.gain(Lb), target
+
+
+def _place_given(
+    given: tuple[np.ndarray, np.ndarray, np.ndarray],
+    pair: BalancedPair,
+    poles: np.ndarray,
+    target: np.ndarray,
+) -> np.ndarray | None:
+    """The gain placed on the pair as given, or None when it is not the right one."""
+    A1, C, N = (np.asarray(X, float) for X in given)
+    NC = N @ C
+    if not (np.all(np.isfinite(A1)) and np.all(np.isfinite(NC))):
+        return None
+    with np.errstate(all="ignore"):
+        split = observability_decomposition(A1, NC)
+        if split.Ao.shape[0] != pair.movable:
+            return None
+        try:
+            Lo = _gain(split, poles)
+        except (PlacementAccuracyError, ValueError, np.linalg.LinAlgError):
+            return None
+        if not np.all(np.isfinite(Lo)) or _error(A1, NC, Lo, target) > POLE_RTOL:
+            return None
+        return Lo @ N

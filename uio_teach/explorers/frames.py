@@ -145,7 +145,7 @@ class Frame:
     >>> frame = compute_frame(s, s.defaults.replace(poles=(0.5, -2.0, -3.0)))
     >>> print(frame.observer_message.replace("; ", ";\n"))
     this pole makes the UIO unstable: the error grows (pole 0.5 in the right half-plane;
-    |e| from 1.5 to 84.2)
+    |e| from 1.5 to 32.8)
     >>> frame.curves["uio.error"].shape
     (3, 1001)
     """

@@ -189,7 +189,7 @@ def design_pmo(
     if method == "lmi":
         pass
     elif L is None:
-        L, requested = place_pair_poles(dec.pair, poles)
+        L, requested = place_pair_poles(dec.pair, poles, given=(dec.A1, plant.C, dec.N))
     else:
         L = decoupled_gain("L", plant, L)
     obs = PMO(plant, dec.M, L, Mv, certificate)

@@ -128,7 +128,7 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     dec = decoupling(plant, zeros=report.invariant_zeros)
     requested = None
     if K1 is None:
-        K1, requested = place_pair_poles(dec.pair, poles)
+        K1, requested = place_pair_poles(dec.pair, poles, given=(dec.A1, plant.C, dec.N))
     else:
         K1 = decoupled_gain("K1", plant, K1)
     obs = UIO(plant, dec.M, K1)
