@@ -8,7 +8,7 @@ and inputs ``s = [u; d; v; noise]``::
     w' = A_o w + B_u u + B_y y                 (observer)
     xhat = C_o w + D_y y
 
-(``x[k+1] = ...``, ``w[k+1] = ...`` for a discrete plant). :func:`simulate`
+(``x[k+1] = ...``, ``w[k+1] = ...`` for a discrete plant). :func:`~uio_teach.simulate`
 builds this joint system once and solves it on the time grid.
 
 **Continuous time.** Between two samples the inputs are taken as linear (a
@@ -112,7 +112,7 @@ class SimulationInputs(NamedTuple):
 
 
 class UIOResponse:
-    """The result of :func:`simulate`: plant states, measurements and the observer's estimates.
+    """The result of :func:`~uio_teach.simulate`: plant states, measurements and the observer's estimates.
 
     All signals are arrays with one row per channel and one column per time
     point (python-control's convention).
@@ -314,7 +314,7 @@ _WHAT = {
 
 
 def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
-    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`simulate`) on the grid ``t``.
+    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`~uio_teach.simulate`) on the grid ``t``.
 
     Returns a validated ``(k, N)`` float array; ``name`` names it in messages.
 
@@ -597,7 +597,7 @@ def linear_response(
 ) -> np.ndarray:
     """All states of ``z' = A z + B s`` (``z[k+1] = A z[k] + B s[k]``) on a time grid.
 
-    The one simulation engine of the package (:func:`simulate` and
+    The one simulation engine of the package (:func:`~uio_teach.simulate` and
     :func:`uio_teach.detection.observer_residual` both run on it): in
     continuous time the inputs are taken as linear between samples and the
     system is solved exactly over each step (first-order hold, one matrix
