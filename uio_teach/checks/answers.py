@@ -361,12 +361,30 @@ def _opt_array(data: Any) -> np.ndarray | None:
     return None if data is None else _from_array(data)
 
 
+def _array_at(data: Any, key: str) -> np.ndarray:
+    """The array stored under ``key`` of ``data``."""
+    return _from_array(_need(data, key, dict))
+
+
+def _plant_of(data: Any, plant: Plant | None) -> Plant:
+    """``plant``, or the plant stored in ``data`` when it is None."""
+    return _from_plant(_need(data, "plant", dict)) if plant is None else plant
+
+
+def _timed(cls: type, t: np.ndarray, kwargs: dict[str, Any]) -> Any:
+    """``cls(timepts=t, **kwargs)``, or ``time=t`` where this version of the package names it so."""
+    try:
+        return cls(timepts=t, **kwargs)
+    except TypeError:
+        return cls(time=t, **kwargs)
+
+
 def _from_plant(data: Any) -> Plant:
     dt = data.get("dt") if isinstance(data, dict) else None
     if not (dt is None or isinstance(dt, (bool, int, float))):
         raise AnswerError("malformed answer data: a plant's dt")
     name = data.get("name")
-    matrices = {k: _from_array(_need(data, k, dict)) for k in "ABCED"}
+    matrices = {k: _array_at(data, k) for k in "ABCED"}
     kwargs: dict[str, Any] = {}
     for k in "BED":  # an empty matrix is an absent one
         if matrices[k].size:
@@ -382,55 +400,41 @@ def _from_plant(data: Any) -> Plant:
 
 def _from_observer(data: Any, plant: Plant | None) -> Observer:
     kind = _need(data, "class", str)
-    if plant is None:
-        plant = _from_plant(_need(data, "plant", dict))
-
-    def arr(name: str) -> np.ndarray:
-        return _from_array(_need(data, name, dict))
-
+    plant = _plant_of(data, plant)
     if kind == "UIO":
-        return UIO(plant, arr("H"), arr("K1"))
+        return UIO(plant, _array_at(data, "H"), _array_at(data, "K1"))
     if kind == "PMO":
         return PMO(
             plant,
-            arr("M"),
-            arr("L"),
+            _array_at(data, "M"),
+            _array_at(data, "L"),
             _opt_array(data.get("Mv")),
             _opt_array(data.get("lmi_certificate")),
         )
     if kind == "GInverseObserver":
-        return GInverseObserver(plant, arr("Kv"))
+        return GInverseObserver(plant, _array_at(data, "Kv"))
     if kind == "LuenbergerObserver":
-        return LuenbergerObserver(plant, arr("L"))
+        return LuenbergerObserver(plant, _array_at(data, "L"))
     raise AnswerError(f"an observer of an unknown kind ({kind[:40]})")
 
 
 def _from_response(data: Any, plant: Plant | None) -> UIOResponse:
-    if plant is None:
-        plant = _from_plant(_need(data, "plant", dict))
+    plant = _plant_of(data, plant)
     observer = _from_observer(_need(data, "observer", dict), plant)
     raw_inputs = _need(data, "inputs", dict)
     inputs = SimulationInputs(
-        **{name: _from_array(_need(raw_inputs, name, dict)) for name in SimulationInputs._fields}
+        **{name: _array_at(raw_inputs, name) for name in SimulationInputs._fields}
     )
-
-    def arr(name: str) -> np.ndarray:
-        return _from_array(_need(data, name, dict))
-
     kwargs = {
-        "states": arr("states"),
-        "outputs": arr("outputs"),
-        "estimates": arr("estimates"),
+        "states": _array_at(data, "states"),
+        "outputs": _array_at(data, "outputs"),
+        "estimates": _array_at(data, "estimates"),
         "inputs": inputs,
-        "observer_states": arr("observer_states"),
+        "observer_states": _array_at(data, "observer_states"),
         "plant": plant,
         "observer": observer,
     }
-    t = arr("timepts")
-    try:
-        return UIOResponse(timepts=t, **kwargs)
-    except TypeError:  # this version of the package names the time points `time`
-        return UIOResponse(time=t, **kwargs)
+    return _timed(UIOResponse, _array_at(data, "timepts"), kwargs)
 
 
 def _from_estimate(data: Any) -> InputEstimate:
@@ -441,17 +445,13 @@ def _from_estimate(data: Any) -> InputEstimate:
     ):
         raise AnswerError("malformed answer data: a reconstruction's tau or dt")
     kwargs = {
-        "estimates": _from_array(_need(data, "estimates", dict)),
+        "estimates": _array_at(data, "estimates"),
         "actual": _opt_array(data.get("actual")),
         "method": str(_need(data, "method", str)),
         "tau": tau,
         "dt": dt,
     }
-    t = _from_array(_need(data, "timepts", dict))
-    try:
-        return InputEstimate(timepts=t, **kwargs)
-    except TypeError:
-        return InputEstimate(time=t, **kwargs)
+    return _timed(InputEstimate, _array_at(data, "timepts"), kwargs)
 
 
 def _strings(value: Any, what: str) -> list[str]:
@@ -477,11 +477,7 @@ def _from_figure(data: Any) -> Any:
         ax = fig.add_axes(position, sharex=share)
         for line in _need(spec, "lines", list):
             label = _need(line, "label", str)
-            ax.plot(
-                _from_array(_need(line, "x", dict)),
-                _from_array(_need(line, "y", dict)),
-                label=label,
-            )
+            ax.plot(_array_at(line, "x"), _array_at(line, "y"), label=label)
         titles = _strings(spec.get("title", ["", "", ""]), "a title")
         for loc, text in zip(("center", "left", "right"), titles, strict=False):
             if text:

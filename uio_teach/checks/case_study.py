@@ -34,7 +34,6 @@ from .._display import format_matrix_line, format_poles
 from ..existence import check_existence, decoupling
 from ..linalg import left_null
 from ..signals import piecewise_constant
-from ..simulation import simulate
 from .common import (
     CheckResult,
     check_plant_of,
@@ -44,10 +43,11 @@ from .common import (
     numbers,
     read_matrix,
     read_response,
+    rerun_without_unknown_inputs,
     same_poles,
     up_to,
 )
-from .plots import curves_against_time, read_figure, xlabels
+from .plots import panel_texts, plotted_axes, read_figure
 
 __all__ = [
     "case_study_projection",
@@ -370,10 +370,6 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
     return result
 
 
-def _read_resp(result: CheckResult, response: Any):
-    return read_response(result, response)
-
-
 def _staircase(timepts: np.ndarray, amplitude: float, hold: int, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     switch = np.arange(0, timepts[-1] + 1, hold)
@@ -427,7 +423,7 @@ def case_study_simulation(
     True
     """
     result = CheckResult("Case study: the simulation with u2 and v")
-    resp = _read_resp(result, response)
+    resp = read_response(result, response)
     if resp is None or not check_plant_of(result, resp, plant):
         return result
     _observer_as_asked(result, resp, observer)
@@ -485,16 +481,7 @@ def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_s
 def _ignores_and_decays(result: CheckResult, resp: Any, decay: float) -> None:
     """✓/✗: the error is the same without u2 and v, and decays."""
     t = np.asarray(resp.time, float)
-    quiet = simulate(
-        resp.plant,
-        resp.observer,
-        resp.time,
-        u=resp.inputs.u if resp.plant.m else None,
-        initial_state=resp.states[:, 0],
-        observer_state=resp.observer_states[:, 0],
-    )
-    diff = float(np.max(np.abs(resp.error - quiet.error)))
-    decoupled = diff <= 1e-8 * max(1.0, float(np.max(np.abs(resp.states))))
+    diff, decoupled = rerun_without_unknown_inputs(resp)
     if decoupled:
         result.add(
             True,
@@ -588,7 +575,7 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -
     missing = [name for name, value in (("Dv", Dv), ("Nr", Nr)) if value is None]
     for name in missing:
         result.add(False, f"{name} is missing: compute it from the run (see the exercise).")
-    resp = _read_resp(result, response)
+    resp = read_response(result, response)
     if resp is None or missing or not check_plant_of(result, resp, plant):
         return result
     plant = resp.plant
@@ -639,15 +626,6 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -
     return result
 
 
-def _panel_text(ax: Any) -> str:
-    texts = [ax.get_ylabel(), ax.get_title()]
-    legend = ax.get_legend()
-    if legend is not None:
-        texts += [t.get_text() for t in legend.get_texts()]
-    texts += [ln.get_label() for ln in ax.get_lines() if not ln.get_label().startswith("_")]
-    return " ".join(t for t in texts if t)
-
-
 @never_raises("Case study: the plot of the residual and D v", "case_study.plot")
 def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResult:
     """Check the figure of the residual ``r`` with ``D v``, and of ``N r``, against the step ``k``.
@@ -690,19 +668,15 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
     True
     """
     result = CheckResult("Case study: the plot of the residual and D v")
-    resp = _read_resp(result, response)
+    resp = read_response(result, response)
     fig = read_figure(result, fig)
     if resp is None or fig is None or not check_plant_of(result, resp, plant):
         return result
-    axes = [ax for ax in fig.axes if ax.has_data()]
-    if not axes:
-        result.add(False, "the figure has no curves: did you draw into another figure?")
-        return result
     t = np.asarray(resp.time, float)
-    names = [f"axes {i + 1}" for i in range(len(axes))]
-    units = xlabels(result, axes, names)
-    if not curves_against_time(result, axes, t, units):
+    plotted = plotted_axes(result, fig, t)
+    if plotted is None:
         return result
+    axes = plotted[0]
     N = t.size
     r = np.asarray(resp.residual, float)
     Dv = resp.plant.D @ np.asarray(resp.inputs.v, float)
@@ -758,7 +732,7 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
             "combination v does not reach).",
         )
     for ax in both[:1]:
-        text = _panel_text(ax)
+        text = " ".join(panel_texts(ax))
         if not (re.search(r"\bresidual|\br\b|\br_?\d", text) and re.search(r"D\s*v", text)):
             result.add(
                 False,
@@ -766,6 +740,6 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
                 "or legend naming r and Dv).",
             )
     for ax in n_axes[:1]:
-        if not re.search(r"N\s*r|N\s*\\?cdot\s*r", _panel_text(ax)):
+        if not re.search(r"N\s*r|N\s*\\?cdot\s*r", " ".join(panel_texts(ax))):
             result.add(False, "the panel of N r is not labelled as N r.")
     return result

@@ -21,6 +21,7 @@ import numpy as np
 from .. import examples
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
+from ..simulation import simulate
 
 __all__ = [
     "CheckResult",
@@ -39,6 +40,7 @@ __all__ = [
     "get_plant",
     "stability",
     "read_response",
+    "rerun_without_unknown_inputs",
     "same_plant",
     "check_plant_of",
     "same_poles",
@@ -567,6 +569,50 @@ def read_response(result: CheckResult, response: Any, name: str = "response") ->
         )
         return None
     return response
+
+
+def rerun_without_unknown_inputs(resp: Any, *, keep_v: bool = False) -> tuple[float, bool]:
+    """Simulate a run again without its unknown inputs: how much does its error change?
+
+    The run is made again with the same plant, observer, time points, known
+    input ``u`` and initial states (of the plant and of the observer), without
+    ``d``, and without ``v`` unless ``keep_v``.
+
+    Parameters
+    ----------
+    resp : UIOResponse
+        The run, a result of :func:`uio_teach.simulate`.
+    keep_v : bool, optional
+        Keep the measurement disturbance ``v`` (leave out ``d`` alone).
+
+    Returns
+    -------
+    change : float
+        The largest change of the error ``e``.
+    same : bool
+        Whether the change is round-off: at most ``1e-8`` times the largest
+        state (or ``1e-8`` for states below 1).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> from uio_teach.checks.common import rerun_without_unknown_inputs
+    >>> from uio_teach.experiments import PA9
+    >>> run = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles), d=PA9.d_sine)
+    >>> rerun_without_unknown_inputs(run)[1]
+    True
+    """
+    quiet = simulate(
+        resp.plant,
+        resp.observer,
+        resp.time,
+        u=resp.inputs.u if resp.plant.m else None,
+        v=resp.inputs.v if keep_v and resp.plant.nv else None,
+        initial_state=resp.states[:, 0],
+        observer_state=resp.observer_states[:, 0],
+    )
+    change = float(np.max(np.abs(resp.error - quiet.error)))
+    return change, change <= 1e-8 * max(1.0, float(np.max(np.abs(resp.states))))
 
 
 def same_plant(a: Any, b: Any) -> bool:

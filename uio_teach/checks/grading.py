@@ -128,6 +128,17 @@ class GradedCheck:
     given: tuple[str, ...] = ("plant",)
 
 
+def _pa9_run(a: Mapping[str, Any], p: Mapping[str, Any], plant: Any) -> dict[str, Any]:
+    """What a PA9 run is checked against: the asked poles and x(0), the group's H, K1, plant."""
+    return {
+        "poles": p["poles"],
+        "initial_state": p["initial_state"],
+        "H": a["H"],
+        "K1": a["K1"],
+        "plant": plant,
+    }
+
+
 def _pa9() -> tuple[GradedCheck, ...]:
     return (
         GradedCheck(
@@ -144,13 +155,9 @@ def _pa9() -> tuple[GradedCheck, ...]:
             ("resp_sine", "H", "K1"),
             lambda a, p, plant: pa9_simulation(
                 a["resp_sine"],
-                poles=p["poles"],
                 amplitude=p["sine"]["amplitude"],
                 frequency=p["sine"]["frequency"],
-                initial_state=p["initial_state"],
-                H=a["H"],
-                K1=a["K1"],
-                plant=plant,
+                **_pa9_run(a, p, plant),
             ),
         ),
         GradedCheck(
@@ -168,11 +175,7 @@ def _pa9() -> tuple[GradedCheck, ...]:
                 sinusoidal=a["resp_sine"],
                 times=p["piecewise"]["times"],
                 values=p["piecewise"]["values"],
-                poles=p["poles"],
-                initial_state=p["initial_state"],
-                H=a["H"],
-                K1=a["K1"],
-                plant=plant,
+                **_pa9_run(a, p, plant),
             ),
         ),
         GradedCheck(
@@ -234,9 +237,15 @@ def _case_study() -> tuple[GradedCheck, ...]:
     )
 
 
-def _missile_start() -> Any:
-    """The missile lab's initial state: the paper's x0, as its set-up cell takes it."""
-    return examples.MISSILE_PUBLISHED.x0
+def _missile_run(a: Mapping[str, Any], plant: Any) -> dict[str, Any]:
+    """What a missile run is checked against: the group's plant and PMO, the paper's x0.
+
+    The initial state is the paper's x0, as the lab's set-up cell takes it.
+    """
+    return {"plant": plant, "observer": a["pmo"], "initial_state": examples.MISSILE_PUBLISHED.x0}
+
+
+_MISSILE_GIVEN = ("plant", "x0")
 
 
 def _missile() -> tuple[GradedCheck, ...]:
@@ -262,12 +271,10 @@ def _missile() -> tuple[GradedCheck, ...]:
             lambda a, p, plant: missile_reconstruction(
                 a["vhat"],
                 a["run_pmo"],
-                plant=plant,
-                observer=a["pmo"],
                 poles=p["pmo_poles"],
-                initial_state=_missile_start(),
+                **_missile_run(a, plant),
             ),
-            given=("plant", "x0"),
+            given=_MISSILE_GIVEN,
         ),
         GradedCheck(
             "missile.plot",
@@ -284,12 +291,10 @@ def _missile() -> tuple[GradedCheck, ...]:
                 a["run_pmo0"],
                 a["vhat0"],
                 tol=p["tol"],
-                plant=plant,
-                observer=a["pmo"],
                 poles=p["pmo_poles"],
-                initial_state=_missile_start(),
+                **_missile_run(a, plant),
             ),
-            given=("plant", "x0"),
+            given=_MISSILE_GIVEN,
         ),
         GradedCheck(
             "missile.noise",
@@ -300,11 +305,9 @@ def _missile() -> tuple[GradedCheck, ...]:
                 a["run_noisy"],
                 sigma=p["noise"]["sigma"],
                 seed=p["noise"]["seed"],
-                plant=plant,
-                observer=a["pmo"],
-                initial_state=_missile_start(),
+                **_missile_run(a, plant),
             ),
-            given=("plant", "x0"),
+            given=_MISSILE_GIVEN,
         ),
     )
 

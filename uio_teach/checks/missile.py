@@ -51,7 +51,7 @@ from .common import (
     same_poles,
     up_to,
 )
-from .plots import curves_against_time, read_figure, xlabels
+from .plots import figure_titles, panel_texts, plotted_axes, read_figure
 
 __all__ = [
     "missile_pmo",
@@ -249,10 +249,6 @@ def missile_ginverse(
     return result
 
 
-def _resp(result: CheckResult, response: Any, name: str = "response"):
-    return read_response(result, response, name)
-
-
 def _vhat(result: CheckResult, vhat: Any):
     if vhat is None or not all(hasattr(vhat, a) for a in ("estimates", "actual", "time", "error")):
         got = "None" if vhat is None else type(vhat).__name__
@@ -414,7 +410,7 @@ def missile_reconstruction(
     True
     """
     result = CheckResult("Missile: reconstructing v1 and v2")
-    resp = _resp(result, response)
+    resp = read_response(result, response)
     vh = _vhat(result, vhat)
     if resp is None or vh is None:
         return result
@@ -521,7 +517,7 @@ def missile_catch_times(
         missing = [k for k in NAMES if k not in catch]
         if missing:
             result.add(False, f"catch has no time for {', '.join(missing)}.")
-    resp = _resp(result, response)
+    resp = read_response(result, response)
     vh = _vhat(result, vhat)
     if resp is None or vh is None or missing:
         return result
@@ -616,7 +612,7 @@ def missile_noise(
     result = CheckResult("Missile: what noise does to the reconstruction")
     q = 2
     vals = read_matrix(result, "rms", rms, 1, q, f"{q} numbers: v1, v2")
-    resp = _resp(result, response)
+    resp = read_response(result, response)
     if resp is None or vals is None:
         return result
     if not check_plant_of(result, resp, plant):
@@ -727,15 +723,11 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     fig = read_figure(result, fig)
     if fig is None or vh is None:
         return result
-    axes = [ax for ax in fig.axes if ax.has_data()]
-    if not axes:
-        result.add(False, "the figure has no curves: did you draw into another figure?")
-        return result
     t = np.asarray(vh.time, float)
-    names = [f"axes {i + 1}" for i in range(len(axes))]
-    units = xlabels(result, axes, names)
-    if not curves_against_time(result, axes, t, units):
+    plotted = plotted_axes(result, fig, t)
+    if plotted is None:
         return result
+    axes, names = plotted
     N = t.size
     actual = np.asarray(vh.actual, float)
     est = np.asarray(vh.estimates, float)
@@ -757,7 +749,9 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     else:
         result.add(True, "the figure shows v1, v2 and their estimates v̂1, v̂2.")
     unlabelled = [
-        n for n, ax in zip(names, axes, strict=True) if not _V_LABEL.search(_axis_texts(ax))
+        n
+        for n, ax in zip(names, axes, strict=True)
+        if not _V_LABEL.search(" ".join(panel_texts(ax)))
     ]
     if unlabelled:
         result.add(
@@ -765,10 +759,7 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
             f"{', '.join(unlabelled)} {'does' if len(unlabelled) == 1 else 'do'} not say which "
             "input is drawn: label each panel (y-label or legend).",
         )
-    sup = getattr(fig, "_suptitle", None)
-    title = " ".join(
-        [sup.get_text() if sup is not None else ""] + [ax.get_title() for ax in axes]
-    ).strip()
+    title = " ".join(figure_titles(fig, axes)).strip()
     if not title:
         result.add(False, "the figure has no title: say what is drawn, and for which run.")
     elif re.search(r"g-?inverse|generali[sz]ed", title, re.IGNORECASE):
@@ -779,12 +770,3 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     else:
         result.add(True, f"the figure has a title, {title!r}.")
     return result
-
-
-def _axis_texts(ax: Any) -> str:
-    texts = [ax.get_ylabel(), ax.get_title()]
-    legend = ax.get_legend()
-    if legend is not None:
-        texts += [t.get_text() for t in legend.get_texts()]
-    texts += [ln.get_label() for ln in ax.get_lines() if not ln.get_label().startswith("_")]
-    return " ".join(t for t in texts if t)

@@ -27,6 +27,9 @@ __all__ = [
     "time_factor",
     "xlabels",
     "curves_against_time",
+    "plotted_axes",
+    "panel_texts",
+    "figure_titles",
 ]
 
 
@@ -251,6 +254,82 @@ def curves_against_time(
     return True
 
 
+def plotted_axes(result: CheckResult, fig: Any, t: np.ndarray) -> tuple[list, list[str]] | None:
+    """The panels of ``fig`` that hold curves, and their names, once their time axes are right.
+
+    A ✗, and None, when no panel holds a curve, or when the curves are not drawn
+    against ``t`` in the unit the x-labels name (:func:`xlabels`,
+    :func:`curves_against_time`).
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from uio_teach.checks.common import CheckResult
+    >>> from uio_teach.checks.plots import plotted_axes
+    >>> result = CheckResult("demo")
+    >>> plotted_axes(result, Figure(), [0.0, 0.1]) is None, result.failures[0][:25]
+    (True, 'the figure has no curves:')
+    """
+    axes = [ax for ax in fig.axes if ax.has_data()]
+    if not axes:
+        result.add(False, "the figure has no curves: did you draw into another figure?")
+        return None
+    names = [f"axes {i + 1}" for i in range(len(axes))]
+    units = xlabels(result, axes, names)
+    if not curves_against_time(result, axes, np.asarray(t, float), units):
+        return None
+    return axes, names
+
+
+def panel_texts(ax: Any, title_locs: Sequence[str] = ("center",)) -> list[str]:
+    """The texts that say what a panel shows: y-label, titles, legend entries, line labels.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    title_locs : sequence of str, optional
+        Which of its titles count (``"center"``, ``"left"``, ``"right"``).
+
+    Returns
+    -------
+    list of str
+        The non-empty texts; labels matplotlib makes up (``"_child0"``) are left out.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from uio_teach.checks.plots import panel_texts
+    >>> ax = Figure().subplots()
+    >>> _ = ax.plot([0, 1], [1, 0], label="r1"); _ = ax.set_ylabel("residual")
+    >>> panel_texts(ax)
+    ['residual', 'r1']
+    """
+    out = [ax.get_ylabel()] + [ax.get_title(loc) for loc in title_locs]
+    legend = ax.get_legend()
+    if legend is not None:
+        out += [t.get_text() for t in legend.get_texts()]
+    out += [ln.get_label() for ln in ax.get_lines() if not ln.get_label().startswith("_")]
+    return [t for t in out if t]
+
+
+def figure_titles(fig: Any, axes: Sequence) -> list[str]:
+    """The figure's title (``""`` when it has none), then the title of each of ``axes``.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from uio_teach.checks.plots import figure_titles
+    >>> fig = Figure()
+    >>> ax = fig.subplots()
+    >>> _ = fig.suptitle("v and v̂"); _ = ax.set_title("v1")
+    >>> figure_titles(fig, fig.axes)
+    ['v and v̂', 'v1']
+    """
+    sup = getattr(fig, "_suptitle", None)
+    return [sup.get_text() if sup is not None else ""] + [ax.get_title() for ax in axes]
+
+
 _QUANTITIES = {
     "e": re.compile(r"\berror|\be\b", re.IGNORECASE),
     "r": re.compile(r"\bresidual|\br\b", re.IGNORECASE),
@@ -278,11 +357,7 @@ def titles(result: CheckResult, fig: Any, axes: Sequence, kinds: Sequence[str]) 
 
 def experiment_title(result: CheckResult, fig: Any, resp: Any) -> None:
     """✗ for a figure or panel title that names another experiment than the plotted run."""
-    texts = [ax.get_title() for ax in fig.axes]
-    sup = getattr(fig, "_suptitle", None)
-    if sup is not None:
-        texts.append(sup.get_text())
-    text = " ".join(t for t in texts if t).lower()
+    text = " ".join(t for t in figure_titles(fig, fig.axes) if t).lower()
     if not text:
         return
     d = np.asarray(resp.inputs.d, float)
@@ -385,17 +460,8 @@ def pa9_piecewise_plot(fig: Any, response: Any = None, *, plant: Any = None) -> 
     return result
 
 
-def _panel_texts(ax) -> list[str]:
-    out = [ax.get_ylabel(), ax.get_title(), ax.get_title("left"), ax.get_title("right")]
-    legend = ax.get_legend()
-    if legend is not None:
-        out += [t.get_text() for t in legend.get_texts()]
-    out += [ln.get_label() for ln in ax.get_lines() if not ln.get_label().startswith("_")]
-    return [t for t in out if t]
-
-
 def _kind(ax) -> str:
-    texts = _panel_texts(ax)
+    texts = panel_texts(ax, ("center", "left", "right"))
     e = any(_ERROR.search(t) for t in texts)
     r = any(_RESIDUAL.search(t) for t in texts)
     return "both" if e and r else "e" if e else "r" if r else ""

@@ -22,7 +22,6 @@ import numpy as np
 
 from .._display import format_complex, format_poles
 from ..signals import piecewise_constant
-from ..simulation import simulate
 from .common import (
     CheckResult,
     as_poles,
@@ -32,6 +31,7 @@ from .common import (
     numbers,
     plural,
     read_response,
+    rerun_without_unknown_inputs,
     same_observer,
     same_poles,
     stability,
@@ -78,26 +78,16 @@ def _initial_error(result: CheckResult, resp) -> float:
     return e0
 
 
-def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
+def _same_without_d(result: CheckResult, resp) -> bool:
     """Re-simulate with ``d = 0``; add a ✓/✗ on whether the error is unchanged."""
-    quiet = simulate(
-        resp.plant,
-        resp.observer,
-        resp.time,
-        u=resp.inputs.u if resp.plant.m else None,
-        v=resp.inputs.v if resp.plant.nv else None,
-        initial_state=resp.states[:, 0],
-        observer_state=resp.observer_states[:, 0],
-    )
-    diff = float(np.max(np.abs(resp.error - quiet.error)))
-    scale = max(1.0, float(np.max(np.abs(resp.states))))
-    if diff <= 1e-8 * scale:
+    diff, same = rerun_without_unknown_inputs(resp, keep_v=True)
+    if same:
         result.add(
             True,
             f"the error does not depend on d: simulated again with d = 0, it is the same"
             f"{up_to(diff, 'largest difference')}.",
         )
-        return quiet.error
+        return True
     if not resp.observer.decouples:
         hint = (
             f" Your observer is a {resp.observer.family}, which ignores d; design a decoupling "
@@ -115,7 +105,7 @@ def _same_without_d(result: CheckResult, resp) -> np.ndarray | None:
         f"the error depends on d: simulated again with d = 0, it changes by up to "
         f"{diff:.3g}.{hint}",
     )
-    return None
+    return False
 
 
 def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool = True) -> None:
@@ -123,7 +113,7 @@ def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool 
         return
     e_end = float(np.max(np.abs(resp.error[:, -1])))
     t0, t1 = float(resp.time[0]), float(resp.time[-1])
-    unit = "" if resp.plant.dt is True else " s"
+    unit = _seconds(resp)
     if e_end <= decay * e0:
         result.add(
             True,
@@ -160,6 +150,11 @@ def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool 
         f"With the slowest error pole {format_complex(poles[np.argmax(poles.real)])} it needs "
         f"{need_txt} to shrink to {decay:.0%}: simulate longer.",
     )
+
+
+def _seconds(resp: Any) -> str:
+    """The unit of the run's time in a message: `` s``, or nothing for steps (``dt=True``)."""
+    return "" if resp.plant.dt is True else " s"
 
 
 def _jumps(d: np.ndarray) -> np.ndarray:
@@ -255,13 +250,10 @@ def pa9_simulation(
             _asked_signal(
                 result, d[0], want, f"d(t) = {float(amplitude):g} sin({float(frequency):g} t)"
             )
-    if not check_plant_of(result, resp, plant):
+    checked = _run_checks(result, resp, plant, poles, initial_state, H, K1)
+    if checked is None:
         return result
-    _asked_setup(result, resp, poles, initial_state, H, K1)
-    if not _noise_free(result, resp):
-        return result
-    e0 = _initial_error(result, resp)
-    decoupled = _same_without_d(result, resp) is not None
+    e0, decoupled = checked
     _decays(result, resp, e0, decay, decoupled)
     return result
 
@@ -355,7 +347,7 @@ def pa9_piecewise(
         else:
             at = ", ".join(f"{resp.time[k + 1]:.3g}" for k in jumps[:6])
             more = ", ..." if jumps.size > 6 else ""
-            unit = "" if resp.plant.dt is True else " s"
+            unit = _seconds(resp)
             result.add(
                 True,
                 f"d is piecewise constant: {plural(jumps.size, 'jump')} (at t = {at}{more}{unit}).",
@@ -369,13 +361,10 @@ def pa9_piecewise(
                 f"the piecewise-constant d with times {numbers(times)} and values "
                 f"{numbers(values)}",
             )
-    if not check_plant_of(result, resp, plant):
+    checked = _run_checks(result, resp, plant, poles, initial_state, H, K1)
+    if checked is None:
         return result
-    _asked_setup(result, resp, poles, initial_state, H, K1)
-    if not _noise_free(result, resp):
-        return result
-    e0 = _initial_error(result, resp)
-    decoupled = _same_without_d(result, resp) is not None
+    e0, decoupled = checked
     if sinusoidal is None:
         result.add(
             None,
@@ -388,6 +377,29 @@ def pa9_piecewise(
             _compare(result, resp, other)
     _decays(result, resp, e0, decay, decoupled)
     return result
+
+
+def _run_checks(
+    result: CheckResult,
+    resp: Any,
+    plant: Any,
+    poles: Any,
+    initial_state: Any,
+    H: Any,
+    K1: Any,
+) -> tuple[float, bool] | None:
+    """✓/✗ on what both PA9 runs share: the plant, the set-up, no noise, the error without d.
+
+    Returns the initial error and whether the error ignores ``d``; None when
+    the plant or the noise already rules the run out.
+    """
+    if not check_plant_of(result, resp, plant):
+        return None
+    _asked_setup(result, resp, poles, initial_state, H, K1)
+    if not _noise_free(result, resp):
+        return None
+    e0 = _initial_error(result, resp)
+    return e0, _same_without_d(result, resp)
 
 
 def _compare(result: CheckResult, resp, other) -> None:
