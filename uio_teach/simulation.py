@@ -112,7 +112,7 @@ class SimulationInputs(NamedTuple):
 
 
 class UIOResponse:
-    """The result of :func:`~uio_teach.simulate`: plant states, measurements and the observer's estimates.
+    """The result of :func:`simulate`: plant states, measurements and the observer's estimates.
 
     All signals are arrays with one row per channel and one column per time
     point (python-control's convention).
@@ -314,7 +314,7 @@ _WHAT = {
 
 
 def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.ndarray:
-    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`~uio_teach.simulate`) on the grid ``t``.
+    """Sample a signal argument (``u``, ``d``, ``v`` of :func:`simulate`) on the grid ``t``.
 
     Returns a validated ``(k, N)`` float array; ``name`` names it in messages.
 
