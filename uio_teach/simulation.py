@@ -598,7 +598,7 @@ def linear_response(
     """All states of ``z' = A z + B s`` (``z[k+1] = A z[k] + B s[k]``) on a time grid.
 
     The one simulation engine of the package (:func:`~uio_teach.simulate` and
-    :func:`uio_teach.detection.observer_residual` both run on it): in
+    :func:`~uio_teach.observer_residual` both run on it): in
     continuous time the inputs are taken as linear between samples and the
     system is solved exactly over each step (first-order hold, one matrix
     exponential per step size), with the fast Schur recursion on a uniform
