@@ -10,6 +10,10 @@
 * :func:`missile_autopilot` -- De, Banerjee and Das (IJERA 4(1), 2014): the
   missile autopilot, with matrices as read back from the paper's scrambled
   text; ``Mv``, ``x0`` and the unknown inputs in :data:`MISSILE_PUBLISHED`.
+* :func:`quadruple_tank` -- Johansson (IEEE TCST 8(3), 2000): the
+  quadruple-tank process linearized at the paper's operating points, both
+  pump flows unknown (``E = B``); the paper's parameters, time constants and
+  zeros in :data:`QUADRUPLE_TANK_PUBLISHED`.
 """
 
 from __future__ import annotations
@@ -34,6 +38,9 @@ __all__ = [
     "DT_CASE_STUDY_PUBLISHED",
     "PA9_PUBLISHED",
     "MISSILE_PUBLISHED",
+    "quadruple_tank",
+    "tank_time_constants",
+    "QUADRUPLE_TANK_PUBLISHED",
 ]
 
 
@@ -192,3 +199,163 @@ MISSILE_PUBLISHED = Published(
     ),
 )
 """The missile paper's ``Mv``, ``x0`` and Table II catch times (seconds, read by eye)."""
+
+
+def _tank_published(setting: str, values: dict[str, Any]) -> Published:
+    shared = {
+        "A": (28.0, 32.0, 28.0, 32.0),  # tank cross-sections, cm^2
+        "a": (0.071, 0.057, 0.071, 0.057),  # outlet holes, cm^2
+        "kc": 0.50,  # level sensors, V/cm
+        "g": 981.0,  # cm/s^2
+    }
+    return Published(
+        source=f"Johansson, IEEE TCST 8(3) 2000, Tables I-II, setting {setting}",
+        decimals=3,
+        values=MappingProxyType({k: read_only(v) for k, v in {**shared, **values}.items()}),
+    )
+
+
+QUADRUPLE_TANK_PUBLISHED = MappingProxyType(
+    {
+        "P-": _tank_published(
+            "P-",
+            {
+                "gamma": (0.70, 0.60),
+                "h0": (12.4, 12.7, 1.8, 1.4),  # cm
+                "v0": (3.00, 3.00),  # V
+                "k": (3.33, 3.35),  # cm^3/(V s)
+                "T": (62.0, 90.0, 23.0, 30.0),  # s, whole seconds
+                "zeros": (-0.060, -0.018),  # 1/s
+            },
+        ),
+        "P+": _tank_published(
+            "P+",
+            {
+                "gamma": (0.43, 0.34),
+                "h0": (12.6, 13.0, 4.8, 4.9),
+                "v0": (3.15, 3.15),
+                "k": (3.14, 3.29),
+                "T": (63.0, 91.0, 39.0, 56.0),
+                "zeros": (-0.056, 0.013),
+            },
+        ),
+    }
+)
+"""The quadruple-tank paper's two settings, ``"P-"`` (minimum phase) and ``"P+"``.
+
+Each holds the tank areas ``A`` and outlet areas ``a`` (cm^2), the sensor gain
+``kc`` (V/cm), ``g`` (cm/s^2), the valve splits ``gamma``, the operating point
+(levels ``h0`` in cm, pump voltages ``v0`` in V, pump gains ``k`` in cm^3/(V s)),
+and the printed time constants ``T`` (s) and zeros (1/s)."""
+
+
+def tank_time_constants(setting: str = "P-") -> np.ndarray:
+    """The time constants ``T_i = (A_i / a_i) sqrt(2 h_i0 / g)`` of a setting, in s.
+
+    Parameters
+    ----------
+    setting : {"P-", "P+"}
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> from uio_teach import examples
+    >>> examples.tank_time_constants("P+").round(1).tolist()
+    [63.2, 91.4, 39.0, 56.1]
+    """
+    pub = _tank_setting(setting)
+    return np.asarray(pub.A) / np.asarray(pub.a) * np.sqrt(2.0 * np.asarray(pub.h0) / pub.g)
+
+
+def _tank_setting(setting: str) -> Published:
+    if setting not in QUADRUPLE_TANK_PUBLISHED:
+        raise ValueError(
+            f"setting must be one of {', '.join(map(repr, QUADRUPLE_TANK_PUBLISHED))}, "
+            f"got {setting!r}"
+        )
+    return QUADRUPLE_TANK_PUBLISHED[setting]
+
+
+def _valve(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ValueError(f"{name} must be a number between 0 and 1, got {value!r}")
+    value = float(value)
+    if not 0.0 < value < 1.0:
+        raise ValueError(
+            f"{name} must lie strictly between 0 and 1 (the share of the pump's flow sent to "
+            f"the lower tank), got {value!r}"
+        )
+    return value
+
+
+def quadruple_tank(
+    setting: str = "P-", *, gamma1: float | None = None, gamma2: float | None = None
+) -> Plant:
+    """The quadruple-tank process of Johansson (2000), linearized, both pump flows unknown.
+
+    States are the level deviations ``h_i - h_i0`` (cm) of the four tanks, the
+    outputs the two measured lower levels ``kc (h_1 - h_10)``, ``kc (h_2 - h_20)``
+    (V), the unknown inputs the two pump voltages' deviations (V), entering as
+    the paper's ``B`` (``E = B``; no known input)::
+
+        A = [[-1/T1, 0, A3/(A1 T3), 0], [0, -1/T2, 0, A4/(A2 T4)],
+             [0, 0, -1/T3, 0], [0, 0, 0, -1/T4]]
+        E = [[g1 k1/A1, 0], [0, g2 k2/A2], [0, (1-g2) k2/A3], [(1-g1) k1/A4, 0]]
+
+    with ``T_i`` from :func:`tank_time_constants`. The valves split each pump's
+    flow between a lower tank (``gamma``) and the upper tank on the other side;
+    the invariant zeros solve ``(1 + s T3)(1 + s T4) = (1-g1)(1-g2)/(g1 g2)``,
+    so one crosses into the right half-plane when ``g1 + g2 < 1``.
+
+    Parameters
+    ----------
+    setting : {"P-", "P+"}
+        The operating point (levels, pump gains, valves) of the paper's
+        minimum-phase (``"P-"``, gamma 0.70, 0.60) or non-minimum-phase
+        (``"P+"``, gamma 0.43, 0.34) setting.
+    gamma1, gamma2 : float, optional
+        Other valve splits, strictly between 0 and 1; the operating point
+        stays the setting's (the valves change ``E`` only).
+
+    Returns
+    -------
+    Plant
+
+    Raises
+    ------
+    ValueError
+        An unknown setting, or a valve split outside (0, 1).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.examples.quadruple_tank("P+")
+    Plant('quadruple tank (P+)', continuous-time, n=4, m=0, q=2, p=2, nv=0)
+    >>> ut.check_existence(ut.examples.quadruple_tank("P-")).ok
+    True
+    >>> ut.check_existence(ut.examples.quadruple_tank("P+")).ok
+    False
+    """
+    pub = _tank_setting(setting)
+    g1 = _valve("gamma1", pub.gamma[0] if gamma1 is None else gamma1)
+    g2 = _valve("gamma2", pub.gamma[1] if gamma2 is None else gamma2)
+    A1, A2, A3, A4 = (float(x) for x in pub.A)
+    k1, k2 = (float(x) for x in pub.k)
+    T1, T2, T3, T4 = tank_time_constants(setting)
+    kc = float(pub.kc)
+    custom = (g1, g2) != tuple(float(x) for x in pub.gamma)
+    name = f"quadruple tank ({setting}" + (f", gamma {g1:g}, {g2:g})" if custom else ")")
+    return Plant(
+        [
+            [-1 / T1, 0, A3 / (A1 * T3), 0],
+            [0, -1 / T2, 0, A4 / (A2 * T4)],
+            [0, 0, -1 / T3, 0],
+            [0, 0, 0, -1 / T4],
+        ],
+        [[kc, 0, 0, 0], [0, kc, 0, 0]],
+        E=[[g1 * k1 / A1, 0], [0, g2 * k2 / A2], [0, (1 - g2) * k2 / A3], [(1 - g1) * k1 / A4, 0]],
+        name=name,
+    )
