@@ -72,6 +72,8 @@ __all__ = [
 
 PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
 """The kinds of value a :class:`Param` declares."""
+CONTROLS = ("amplitude", "frequency", "noise", "plant")
+"""The explorer controls a declared field can set (:attr:`Param.control`)."""
 
 
 @dataclass(frozen=True)
@@ -120,6 +122,11 @@ class Param:
         Left out of ``PARAMS`` while it has its default value.
     range : (float, float), optional
         The range a student explores (the explorers' sliders).
+    control : str
+        The explorer's control that the field sets, with ``range``:
+        ``"amplitude"``, ``"frequency"`` or ``"noise"`` (the disturbance and
+        measurement controls), or ``"plant"`` (a slider of its own for a
+        physical parameter, a field of ``plant_fields``).
 
     Examples
     --------
@@ -143,10 +150,18 @@ class Param:
     optional: bool = False
     omit_default: bool = False
     range: tuple[float, float] | None = None
+    control: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in PARAM_KINDS:
             raise ValueError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
+        if (self.range is None) != (not self.control) or (
+            self.control and self.control not in CONTROLS
+        ):
+            raise ValueError(
+                f"a Param with a range names its explorer control (one of {CONTROLS}) and "
+                f"a control needs a range; got range={self.range!r}, control={self.control!r}"
+            )
 
     def config_key(self, section: str, name: str = "") -> str | None:
         """The key of the term config (``None``: not in the config).
@@ -325,6 +340,12 @@ class Experiment:
         The plant's own matrices as ``(name, rows)`` pairs (empty: the course's
         plant); :meth:`plant` puts them in place.
 
+    Class attributes: ``lab``, the worked example's name in
+    :data:`uio_teach.worked.WORKED` (its config table, and its lab's id when it
+    has one); ``tables``, the comments of its config tables; ``plant_fields``,
+    the fields passed to the worked example's plant factory as keywords
+    (physical parameters, such as the valves of the quadruple tank).
+
     Examples
     --------
     >>> from uio_teach.experiments import MISSILE
@@ -334,6 +355,7 @@ class Experiment:
 
     lab: ClassVar[str] = ""
     tables: ClassVar[Mapping[str, str]] = MappingProxyType({})
+    plant_fields: ClassVar[tuple[str, ...]] = ()
 
     name: str
     timepts: np.ndarray = field(repr=False)
@@ -384,7 +406,11 @@ class Experiment:
         >>> PA9.with_values(matrices={"E": [[1], [0], [0]]}).plant().E.ravel().tolist()
         [1.0, 0.0, 0.0]
         """
-        return plant_from_params(self.lab, {"plant": dict(self.matrices)})
+        from .worked import WORKED
+
+        factory = WORKED[self.lab].plant_factory()
+        course = factory(**{name: getattr(self, name) for name in self.plant_fields})
+        return _with_matrices(self.lab, course, dict(self.matrices))
 
     def grid(self, samples: int | None = None, duration: float | None = None) -> np.ndarray:
         """The time grid, or one from the same start with another length or resolution.
@@ -578,6 +604,7 @@ class PA9Experiment(Experiment):
         maximum=MAX_VALUE,
         omit_default=True,
         range=(0.0, 0.2),
+        control="noise",
     )
     seed: int | None = param(
         4, "int", SEED_DOC, config="seed", minimum=0, maximum=MAX_SEED, omit_default=True
@@ -595,6 +622,7 @@ class PA9Experiment(Experiment):
         key="sine.amplitude",
         maximum=MAX_VALUE,
         range=(0.0, 5.0),
+        control="amplitude",
     )
     sine_frequency: float = param(
         2.0,
@@ -604,6 +632,7 @@ class PA9Experiment(Experiment):
         key="sine.frequency",
         positive=True,
         range=(0.1, 10.0),
+        control="frequency",
     )
     switch_times: tuple[float, ...] = param(
         (0.0, 2.0, 5.0, 7.5),
@@ -712,6 +741,7 @@ class CaseStudyExperiment(Experiment):
         key="u2.amplitude",
         maximum=MAX_VALUE,
         range=(0.0, 5.0),
+        control="amplitude",
     )
     u2_frequency: float = param(
         0.6,
@@ -722,6 +752,7 @@ class CaseStudyExperiment(Experiment):
         positive=True,
         maximum=math.pi,
         range=(0.05, 3.0),
+        control="frequency",
     )
     v_amplitude: float = param(
         1.0,
@@ -919,37 +950,40 @@ MISSILE = MissileExperiment(name="missile", timepts=np.linspace(0.0, 0.5, 10_001
 """
 
 
-class _Experiments(Mapping):
-    """The course's experiments by lab, read from this module's names when asked."""
+class _FromRegistry(Mapping):
+    """A view of the worked examples' registry (:data:`uio_teach.worked.WORKED`), read on use."""
 
-    _names = {"pa9": "PA9", "case_study": "CASE_STUDY", "missile": "MISSILE"}
+    def __init__(self, what: str) -> None:
+        self._what = what
 
-    def __getitem__(self, lab: str) -> Experiment:
-        return globals()[self._names[lab]]
+    def _items(self) -> dict[str, Any]:
+        from .worked import WORKED
+
+        if self._what == "experiments":
+            return {name: entry.run() for name, entry in WORKED.items()}
+        return {name: entry.plant_factory() for name, entry in WORKED.items() if entry.lab}
+
+    def __getitem__(self, name: str) -> Any:
+        return self._items()[name]
 
     def __iter__(self):
-        return iter(self._names)
+        return iter(self._items())
 
     def __len__(self) -> int:
-        return len(self._names)
+        return len(self._items())
 
     def __repr__(self) -> str:
-        return f"EXPERIMENTS({', '.join(self._names)})"
+        return f"{self._what.upper()}({', '.join(self)})"
 
 
-EXPERIMENTS: Mapping[str, Experiment] = _Experiments()
-"""The course's experiments by lab (and table of the term config): ``PA9``, ``CASE_STUDY``,
-``MISSILE`` (a view: replacing one of them in this module replaces it here)."""
+EXPERIMENTS: Mapping[str, Experiment] = _FromRegistry("experiments")
+"""The experiment of every worked example, by name (the tables of the term config): ``PA9``,
+``CASE_STUDY``, ``MISSILE``, ... (a view of :data:`uio_teach.worked.WORKED`)."""
 
 
-LAB_PLANTS: Mapping[str, Callable[[], Plant]] = MappingProxyType(
-    {
-        "pa9": examples.pa9,
-        "case_study": examples.dt_case_study,
-        "missile": examples.missile_autopilot,
-    }
-)
-"""The course's plant of each lab (``"pa9"``, ``"case_study"``, ``"missile"``), as a factory."""
+LAB_PLANTS: Mapping[str, Callable[[], Plant]] = _FromRegistry("lab plants")
+"""The course's plant of each lab (``"pa9"``, ``"case_study"``, ``"missile"``), as a factory
+(the worked examples of :data:`uio_teach.worked.WORKED` that have a lab)."""
 
 _PLANT_MATRICES = ("A", "B", "C", "D", "E")
 
@@ -1004,8 +1038,12 @@ def plant_from_params(lab: str, params: Mapping[str, Any] | None = None) -> Plan
         return course
     if not isinstance(params, Mapping):
         raise ValueError(f"params of the {lab} lab must be a mapping (PARAMS), got {params!r}")
-    given = params.get("plant")
-    if given is None:
+    return _with_matrices(lab, course, params.get("plant"))
+
+
+def _with_matrices(lab: str, course: Plant, given: Any) -> Plant:
+    """``course`` with the matrices of ``given`` (a lab's ``PARAMS["plant"]``) in their place."""
+    if not given:
         return course
     if not isinstance(given, Mapping):
         raise ValueError(

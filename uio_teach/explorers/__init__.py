@@ -42,6 +42,7 @@ from .model import (
     FAMILIES,
     STARTS,
     Channel,
+    PlantControl,
     Scenario,
     Settings,
     default_poles,
@@ -50,13 +51,20 @@ from .model import (
     expand_poles,
 )
 from .modes import excited_modes
-from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+from .scenarios import (
+    case_study_scenario,
+    make_scenario,
+    missile_scenario,
+    pa9_scenario,
+    scenario_of,
+)
 
 __all__ = [
     "DISTURBANCES",
     "FAMILIES",
     "STARTS",
     "Channel",
+    "PlantControl",
     "Settings",
     "Scenario",
     "Frame",
@@ -65,6 +73,7 @@ __all__ = [
     "case_study_scenario",
     "missile_scenario",
     "make_scenario",
+    "scenario_of",
     "expand_poles",
     "disturbance_signals",
     "luenberger_poles",

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from .._display import format_poles
+from ..linalg import is_stable
 from ..lmi import LMIInfeasibleError, LMISolverError
 from ..luenberger import luenberger_poles
 from ..observers import (
@@ -250,7 +251,9 @@ def _luenberger(scenario: Scenario, s: Settings, obs: Observer | None):
                 wanted = expand_poles(s.poles)
             except (TypeError, ValueError):
                 wanted = expand_poles(scenario.defaults.poles)
-        target = np.concatenate([wanted, scenario.fixed_poles])
+        # no UIO: an unstable fixed pole (an unstable zero) is no pole a Luenberger observer has
+        fixed = scenario.fixed_poles
+        target = np.concatenate([wanted, fixed[is_stable(fixed, scenario.discrete)]])
     try:
         poles = luenberger_poles(plant, target)
         with warnings.catch_warnings():

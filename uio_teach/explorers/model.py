@@ -38,6 +38,7 @@ __all__ = [
     "FAMILIES",
     "STARTS",
     "Channel",
+    "PlantControl",
     "Settings",
     "Scenario",
     "expand_poles",
@@ -103,6 +104,37 @@ class Channel:
     speed: float = 1.0
     decay: float = 0.2
     kind: str = "sin"
+
+
+@dataclass(frozen=True)
+class PlantControl:
+    """A slider of a physical parameter of the plant (a valve, a gain): moving it remakes the plant.
+
+    Attributes
+    ----------
+    name : str
+        The keyword of the scenario's ``rebuild`` (a field of the experiment).
+    label : str
+        The slider's label.
+    doc : str
+        What it is, one line (the slider's tooltip).
+    limits : (float, float)
+        Its range.
+    value : float
+        Its value in this scenario.
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import PlantControl
+    >>> PlantControl("gamma1", "gamma1", "valve 1", (0.1, 0.9), 0.7).value
+    0.7
+    """
+
+    name: str
+    label: str
+    doc: str
+    limits: tuple[float, float]
+    value: float
 
 
 @dataclass(frozen=True)
@@ -234,6 +266,14 @@ class Scenario:
     input_symbol : str
         The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
         the missile paper).
+    plant_controls : tuple of PlantControl
+        Sliders of physical parameters of the plant (empty: the plant is fixed).
+    rebuild : callable or None
+        ``rebuild(**values)``: the scenario with other values of the plant
+        controls (the explorer swaps its scenario when one moves).
+    note : str
+        A sentence on this plant that the explorer shows above its messages
+        (say, why no unknown input observer exists for these valves).
     cache : dict
         Designs kept between frames (the LMI's gain for each bound, which
         takes a solver run); empty at first.
@@ -268,6 +308,9 @@ class Scenario:
     static_values: tuple[float, ...]
     static_control: str
     input_symbol: str = "d"
+    plant_controls: tuple[PlantControl, ...] = ()
+    rebuild: Callable[..., Scenario] | None = field(default=None, repr=False)
+    note: str = ""
     cache: dict = field(default_factory=dict, repr=False)
 
     @property

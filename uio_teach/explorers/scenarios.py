@@ -28,6 +28,7 @@ from ..plant import Plant
 from .model import (
     FAMILIES,
     Channel,
+    PlantControl,
     Scenario,
     Settings,
     default_poles,
@@ -35,15 +36,80 @@ from .model import (
     expand_poles,
 )
 
-__all__ = ["pa9_scenario", "case_study_scenario", "missile_scenario", "make_scenario"]
+__all__ = [
+    "pa9_scenario",
+    "case_study_scenario",
+    "missile_scenario",
+    "make_scenario",
+    "plant_controls",
+    "scenario_of",
+]
 
 
-def _range(experiment: Any, name: str) -> tuple[float, float]:
-    """The range a student explores of an experiment's field (its declared ``Param.range``)."""
-    spec = dict(experiment_params(experiment))[name]
-    if spec.range is None:  # pragma: no cover - every field read here declares one
-        raise ValueError(f"{type(experiment).__name__}.{name} declares no range")
-    return spec.range
+def scenario_of(name: str, **plant_values: float) -> Scenario:
+    """The explorer's scenario of a worked example of :data:`uio_teach.worked.WORKED`.
+
+    Parameters
+    ----------
+    name : str
+        The worked example (``"pa9"``, ``"quadruple_tank"``, ...).
+    **plant_values
+        Physical parameters of its plant (its explorer's plant sliders).
+
+    Returns
+    -------
+    Scenario
+
+    Examples
+    --------
+    >>> from uio_teach.explorers.scenarios import scenario_of
+    >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
+    False
+    """
+    from ..worked import WORKED
+
+    return WORKED[name].make_scenario(**plant_values)
+
+
+def _range(experiment: Any, control: str) -> tuple[float, float]:
+    """The range of an explorer control: the ``Param.range`` of the field that sets it."""
+    for _, spec in experiment_params(experiment):
+        if spec.control == control:
+            return spec.range
+    raise ValueError(f"{type(experiment).__name__} declares no field for the control {control!r}")
+
+
+def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
+    """The sliders of an experiment's physical parameters: its ``plant_fields`` with a range.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        The worked experiment (its values are the sliders' values).
+
+    Returns
+    -------
+    tuple of PlantControl
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import EXPERIMENTS
+    >>> from uio_teach.explorers.scenarios import plant_controls
+    >>> [(c.name, c.value) for c in plant_controls(EXPERIMENTS["quadruple_tank"])]
+    [('gamma1', 0.7), ('gamma2', 0.6)]
+    """
+    specs = dict(experiment_params(experiment))
+    return tuple(
+        PlantControl(
+            name=name,
+            label=specs[name].key or name,
+            doc=specs[name].help,
+            limits=specs[name].range,
+            value=float(getattr(experiment, name)),
+        )
+        for name in type(experiment).plant_fields
+        if name in specs and specs[name].control == "plant"
+    )
 
 
 def _scenario(plant: Plant, family: str, **kwargs: Any) -> Scenario:
@@ -100,8 +166,8 @@ def pa9_scenario() -> Scenario:
         ),
         pole_limits=(-10.0, 1.0),
         frequency_limits=(0.0, 10.0),
-        amplitude_limits=_range(PA9, "sine_amplitude"),
-        disturbance_frequency_limits=_range(PA9, "sine_frequency"),
+        amplitude_limits=_range(PA9, "amplitude"),
+        disturbance_frequency_limits=_range(PA9, "frequency"),
         period_limits=(0.25, 5.0),
         noise_limits=_range(PA9, "noise"),
         tau_limits=None,
@@ -153,8 +219,8 @@ def case_study_scenario() -> Scenario:
         ),
         pole_limits=(-1.1, 1.1),
         frequency_limits=(0.0, 180.0),
-        amplitude_limits=_range(CASE_STUDY, "u2_amplitude"),
-        disturbance_frequency_limits=_range(CASE_STUDY, "u2_frequency"),
+        amplitude_limits=_range(CASE_STUDY, "amplitude"),
+        disturbance_frequency_limits=_range(CASE_STUDY, "frequency"),
         period_limits=(1.0, 20.0),
         noise_limits=(0.0, 0.5),
         tau_limits=None,

@@ -6,6 +6,7 @@ One explorer per example of the course, and one for any plant::
     widgets.pa9_explorer()            # PA9 decoupling UIO, three movable poles
     widgets.case_study_explorer()     # discrete case study: one pole, or the LMI bound
     widgets.missile_explorer()        # missile autopilot: PMO, reconstructed inputs
+    widgets.tank_explorer()           # quadruple tank: UIO poles and a slider per valve
     widgets.explorer(plant, "pmo")    # your own plant
 
 Each shows the unknown input observer next to a plain Luenberger observer with
@@ -51,7 +52,13 @@ from ._drag import DragPoles, drag_available, in_kernel
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
-from .scenarios import case_study_scenario, make_scenario, missile_scenario, pa9_scenario
+from .scenarios import (
+    case_study_scenario,
+    make_scenario,
+    missile_scenario,
+    pa9_scenario,
+    scenario_of,
+)
 from .static import static_html
 
 __all__ = [
@@ -59,6 +66,8 @@ __all__ = [
     "pa9_explorer",
     "case_study_explorer",
     "missile_explorer",
+    "tank_explorer",
+    "worked_explorer",
     "explorer",
     "drag_available",
 ]
@@ -142,7 +151,10 @@ class Explorer(DragPoles):
         time ``"pole 2 radius"`` and ``"pole 2 angle"``), ``"pattern"`` (how
         many complex pairs), ``"mode"`` and ``"decay"`` (LMI), ``"disturbance"``,
         ``"amplitude"``, ``"frequency"``, ``"period"``, ``"noise"``, ``"tau"``,
-        ``"start"`` (where the observers start, ``uio_teach.explorers.STARTS``).
+        ``"start"`` (where the observers start, ``uio_teach.explorers.STARTS``),
+        and one slider per physical parameter of the plant
+        (``Scenario.plant_controls``, named as they are, e.g. ``"gamma1"``):
+        moving one remakes the plant, its existence check and the figure.
     figure : ExplorerFigure
         The figure, updated in place.
     frame : Frame
@@ -196,6 +208,8 @@ class Explorer(DragPoles):
         self._dragging: tuple[int, str] | None = None
         if drag is None:
             drag = in_kernel() and drag_available() and scenario.movable > 0
+        if scenario.plant_controls:
+            drag = False  # a new plant is a new figure: shown as a picture
         if drag:
             self.canvas = self._make_canvas()
         fig = self.figure.fig
@@ -237,7 +251,8 @@ class Explorer(DragPoles):
         if fixed.size:
             zeros = format_poles(fixed, 3)
             text += ("; " if text else "") + f"fixed: {zeros} (invariant zeros)"
-        observer.append(W.HTML(f"<small>{html.escape(text)}</small>"))
+        self._fixed_text = W.HTML(f"<small>{html.escape(text)}</small>")
+        observer.append(self._fixed_text)
         if sc.decay_limits is not None:
             c["mode"] = W.ToggleButtons(
                 options=[("place poles", "poles"), ("LMI bound", "lmi")],
@@ -283,8 +298,17 @@ class Explorer(DragPoles):
             if name in ("pattern",) or name.startswith("pole "):
                 continue
             control.observe(self._changed, names="value")
+        groups = [observer, dist, meas]
+        if sc.plant_controls:
+            plant_box = [W.HTML("<b>Plant</b>")]
+            for pc in sc.plant_controls:
+                c[pc.name] = _slider(pc.label, *pc.limits, pc.value, 180)
+                c[pc.name].description_tooltip = pc.doc
+                c[pc.name].observe(self._plant_changed, names="value")
+                plant_box.append(c[pc.name])
+            groups.insert(0, plant_box)
         self._show_relevant()
-        boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in (observer, dist, meas)]
+        boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in groups]
         controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
         view = self.canvas if self.canvas is not None else self.image
         self.widget = W.VBox([controls, view, self.message])
@@ -461,6 +485,24 @@ class Explorer(DragPoles):
         if not self._holding:
             self.update()
 
+    def _plant_changed(self, change: dict) -> None:
+        """A physical parameter moved: remake the scenario (plant, existence) and the figure."""
+        old = self.scenario
+        values = {pc.name: float(self.controls[pc.name].value) for pc in old.plant_controls}
+        new = old.rebuild(**values)
+        self.scenario = new
+        _LIVE[new.name] = self
+        self.figure.fig.clear()
+        self.figure = ExplorerFigure(new, dpi=self.figure.fig.dpi)
+        fixed = new.fixed_poles
+        text = f"fixed: {format_poles(fixed, 3)} (invariant zeros)" if fixed.size else ""
+        self._fixed_text.value = f"<small>{html.escape(text)}</small>"
+        if new.movable != old.movable:
+            with self.hold():
+                self._make_slots(list(new.defaults.poles))
+        elif not self._holding:
+            self.update()
+
     def update(self) -> None:
         """Recompute the frame for the controls' values and redraw the figure in place.
 
@@ -563,7 +605,8 @@ def _close_tree(widget: Any) -> None:
 
 def _message_html(frame: Frame) -> str:
     name = html.escape(frame.scenario.observer_name)
-    lines = [frame.explanation] if frame.explanation else []
+    lines = [frame.scenario.note] if frame.scenario.note else []
+    lines += [frame.explanation] if frame.explanation else []
     if frame.poles.size:
         lines.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     if frame.luenberger_poles.size:
@@ -684,6 +727,58 @@ def missile_explorer(
             cache={},
         )
     return Explorer(scenario, static=static, drag=drag)
+
+
+def tank_explorer(*, static: bool = True) -> Explorer:
+    """Explore the quadruple tank: the UIO's two poles, and the valves ``gamma1``, ``gamma2``.
+
+    Moving a valve remakes the plant; below ``gamma1 + gamma2 = 1`` an
+    invariant zero is in the right half-plane and the explorer says that no
+    UIO exists, and why. See :func:`uio_teach.worked.quadruple_tank.tank_scenario`.
+
+    Parameters
+    ----------
+    static : bool
+        Include the static book's frames in the display.
+
+    Returns
+    -------
+    Explorer
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> ex = widgets.tank_explorer(static=False)
+    >>> ex.set(gamma1=0.43, gamma2=0.34)
+    >>> ex.frame.observer_message.startswith("no UIO exists")
+    True
+    """
+    return worked_explorer("quadruple_tank", static=static)
+
+
+def worked_explorer(name: str, *, static: bool = True, drag: bool | None = None) -> Explorer:
+    """The explorer of a worked example of :data:`uio_teach.worked.WORKED`, by name.
+
+    Parameters
+    ----------
+    name : str
+        ``"pa9"``, ``"case_study"``, ``"missile"``, ``"quadruple_tank"``, ...
+    static : bool
+        Include the static book's frames in the display.
+    drag : bool, optional
+        Drag the movable poles on the pole map (ipympl).
+
+    Returns
+    -------
+    Explorer
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import widgets
+    >>> widgets.worked_explorer("pa9", static=False).scenario.title
+    'PA9'
+    """
+    return Explorer(scenario_of(name), static=static, drag=drag)
 
 
 def explorer(

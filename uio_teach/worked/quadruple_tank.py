@@ -1,0 +1,381 @@
+"""The quadruple-tank process (Johansson, 2000): its experiment, figures, explorer and entry.
+
+Four tanks, two pumps, the two lower levels measured; both pump flows are the
+unknown inputs (``E = B``, :func:`uio_teach.examples.quadruple_tank`). The
+valves ``gamma1, gamma2`` decide whether a UIO exists: the invariant zeros
+solve ``(1 + s T3)(1 + s T4) = (1 - gamma1)(1 - gamma2) / (gamma1 gamma2)``,
+and one of them is at the origin when ``gamma1 + gamma2 = 1`` and in the
+right half-plane below. This module is the whole of the worked example in the
+package: the experiment (:data:`QUADRUPLE_TANK`, its fields the config table
+``[quadruple_tank]``), its figures, its explorer (with a slider per valve) and
+its registry entry.
+
+Examples
+--------
+>>> import uio_teach as ut
+>>> from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK, valve_verdict
+>>> QUADRUPLE_TANK.gamma1, QUADRUPLE_TANK.gamma2, QUADRUPLE_TANK.poles
+(0.7, 0.6, (-0.1, -0.2))
+>>> print(valve_verdict(0.43, 0.34))   # doctest: +NORMALIZE_WHITESPACE
+gamma1 + gamma2 = 0.77 < 1: the pumps fill the upper tanks more than the lower ones, an
+invariant zero lies in the right half-plane at 0.0128, and no UIO with a stable error exists
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from .. import signals
+from ..existence import check_existence
+from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
+from . import FigureEntry, WorkedExample
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from ..explorers.model import Scenario
+
+__all__ = ["QuadrupleTankExperiment", "QUADRUPLE_TANK", "valve_verdict", "tank_scenario"]
+
+VALVE_DOC = "the share of pump {i}'s flow sent to lower tank {i} (the rest to upper tank {j})"
+
+
+@dataclass(frozen=True)
+class QuadrupleTankExperiment(Experiment):
+    """The quadruple tank at the operating point of setting P-, with valves of one's choice.
+
+    The UIO (two movable poles; the two invariant zeros are its fixed poles)
+    watches the levels while pump 1 steps and pump 2 oscillates, unknown to it.
+
+    Attributes
+    ----------
+    gamma1, gamma2 : float
+        The valve splits (strictly between 0 and 1); passed to the plant.
+    step_size : float
+        Pump 1's unknown deviation: a step of this many volts ...
+    step_time : float
+        ... at this time (s).
+    sine_amplitude : float
+        Pump 2's unknown deviation ``amplitude sin(frequency t)`` (V) ...
+    sine_frequency : float
+        ... of this angular frequency (rad/s).
+
+    Examples
+    --------
+    >>> from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK
+    >>> QUADRUPLE_TANK.d
+    [0.5 step(t - 100); 0.3 sin(0.05 t)]
+    """
+
+    lab: ClassVar[str] = "quadruple_tank"
+    plant_fields: ClassVar[tuple[str, ...]] = ("gamma1", "gamma2")
+    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {
+            "": "the quadruple-tank process of Johansson (2000), operating point P-",
+            "pump1": "pump 1's unknown deviation, a step",
+            "pump2": "pump 2's unknown deviation, a sinusoid",
+        }
+    )
+
+    initial_state: np.ndarray = param(
+        (2.0, -1.0, 1.0, 1.5),
+        "floats",
+        "level deviations h(0) - h0 of tanks 1-4",
+        unit="cm",
+        length=4,
+        maximum=MAX_VALUE,
+    )
+    poles: tuple[complex, ...] | None = param(
+        (-0.1, -0.2), "poles", "UIO poles (two; the other two are the invariant zeros)"
+    )
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
+    )
+    gamma1: float = param(
+        0.70,
+        "float",
+        VALVE_DOC.format(i=1, j=4),
+        positive=True,
+        maximum=0.99,
+        range=(0.05, 0.95),
+        control="plant",
+    )
+    gamma2: float = param(
+        0.60,
+        "float",
+        VALVE_DOC.format(i=2, j=3),
+        positive=True,
+        maximum=0.99,
+        range=(0.05, 0.95),
+        control="plant",
+    )
+    step_size: float = param(
+        0.5, "float", "size of the step", unit="V", key="pump1.step", maximum=MAX_VALUE
+    )
+    step_time: float = param(
+        100.0, "float", "time of the step", unit="s", key="pump1.time", minimum=0.0
+    )
+    sine_amplitude: float = param(
+        0.3,
+        "float",
+        "amplitude of the sinusoid",
+        unit="V",
+        key="pump2.amplitude",
+        maximum=MAX_VALUE,
+        range=(0.0, 1.0),
+        control="amplitude",
+    )
+    sine_frequency: float = param(
+        0.05,
+        "float",
+        "its angular frequency",
+        unit="rad/s",
+        key="pump2.frequency",
+        positive=True,
+        range=(0.005, 0.5),
+        control="frequency",
+    )
+
+    @property
+    def d(self) -> signals.Signal:
+        """The pumps' unknown deviations ``[d1; d2]``."""
+        return signals.stack(
+            signals.step(self.step_size, self.step_time),
+            signals.sinusoid(self.sine_amplitude, self.sine_frequency),
+        )
+
+    @property
+    def unknown_inputs(self) -> Mapping[str, Callable]:
+        """``{"pumps": d}``."""
+        return MappingProxyType({"pumps": self.d})
+
+
+QUADRUPLE_TANK = QuadrupleTankExperiment(
+    name="quadruple-tank", timepts=np.linspace(0.0, 600.0, 1201)
+)
+"""The run of the quadruple tank: 600 s on 1201 points, the valves of P-, UIO poles -0.1, -0.2."""
+
+
+def valve_verdict(gamma1: float, gamma2: float) -> str:
+    """One sentence: does a UIO exist for these valves, and why (from the existence check).
+
+    Parameters
+    ----------
+    gamma1, gamma2 : float
+        The valve splits.
+
+    Returns
+    -------
+    str
+    """
+    from ..examples import quadruple_tank
+
+    report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2))
+    zeros = np.sort(report.invariant_zeros.real)
+    total = gamma1 + gamma2
+    digits = 3 if abs(total - 1) >= 5e-3 else 12  # close to 1: enough digits to tell the side
+    if total == 1:
+        head = "gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike"
+    else:
+        more, less = ("lower", "upper") if total > 1 else ("upper", "lower")
+        sign = ">" if total > 1 else "<"
+        head = (
+            f"gamma1 + gamma2 = {total:.{digits}g} {sign} 1: the pumps fill the {more} tanks "
+            f"more than the {less} ones"
+        )
+    if report.ok:
+        slow = zeros[-1]
+        return (
+            f"{head}, both invariant zeros are stable ({', '.join(f'{z:.3g}' for z in zeros)}) "
+            f"and a UIO exists; its slowest fixed pole {slow:.3g} takes {-1 / slow:.3g} s per "
+            "e-fold of the error, whatever the gain"
+        )
+    worst = float(zeros[-1])
+    if abs(worst) <= 1e-9 * max(1.0, float(np.max(np.abs(zeros)))):
+        place = "an invariant zero sits at the origin (to round-off)"
+    else:
+        place = f"an invariant zero lies in the right half-plane at {worst:.3g}"
+    return f"{head}, {place}, and no UIO with a stable error exists"
+
+
+# figures ---------------------------------------------------------------------------------------
+
+
+def _run(runs: Any) -> dict[str, Any]:
+    """The tank's run of the figures (computed once per ``runs``)."""
+    from ..instructor.config import design_observer
+    from ..luenberger import luenberger_poles
+    from ..observers import design_luenberger
+    from . import run_from_config
+
+    cache = runs.__dict__.setdefault("_worked", {})
+    if "quadruple_tank" not in cache:
+        run = run_from_config("quadruple_tank", runs.cfg)
+        plant = run.plant()
+        uio = design_observer(runs.cfg, "quadruple_tank.poles")
+        luen = design_luenberger(plant, poles=luenberger_poles(plant, uio.poles()))
+        cache["quadruple_tank"] = {
+            "run": run,
+            "plant": plant,
+            "uio": uio,
+            "uio_run": run.simulate(uio),
+            "luen_run": run.simulate(luen),
+        }
+    return cache["quadruple_tank"]
+
+
+def _figure_error(runs: Any) -> Figure:
+    from .._display import format_poles
+    from ..plotting import finish_panel, new_figure, plot_error, symbol, time_label, with_unit
+
+    r = _run(runs)
+    resp, luen = r["uio_run"], r["luen_run"]
+    fig = new_figure(8.0, 7.0)
+    ax_d, ax_e, ax_l = fig.subplots(3, 1, sharex=True)
+    for i in range(resp.inputs.d.shape[0]):
+        ax_d.plot(resp.time, resp.inputs.d[i], label=symbol("d", i))
+    finish_panel(ax_d, with_unit("pump deviations $d$", "V"))
+    plot_error(ax_e, resp)
+    ax_e.set_title(f"UIO, poles {format_poles(r['uio'].poles(), 3)}", fontsize=9)
+    plot_error(ax_l, luen)
+    ax_l.set_title("Luenberger observer with the same poles", fontsize=9)
+    ax_l.set_xlabel(time_label(r["plant"].dt))
+    run = r["run"]
+    fig.suptitle(
+        f"Quadruple tank, gamma = {run.gamma1:g}, {run.gamma2:g}: the UIO ignores the pumps"
+    )
+    return fig
+
+
+def _figure_zeros(runs: Any) -> Figure:
+    from ..examples import quadruple_tank
+    from ..plotting import finish_panel, new_figure
+
+    run = _run(runs)["run"]
+    ratio = run.gamma2 / run.gamma1
+    top = min(0.99, 0.99 / ratio)
+    g1 = np.linspace(0.05, top, 241)
+    zeros = np.array(
+        [
+            np.sort(
+                check_existence(quadruple_tank(gamma1=g, gamma2=g * ratio)).invariant_zeros.real
+            )
+            for g in g1
+        ]
+    )
+    total = g1 * (1 + ratio)
+    fig = new_figure(8.0, 4.5)
+    ax = fig.subplots()
+    ax.plot(total, zeros[:, 0], color="C0", label="faster zero")
+    ax.plot(total, zeros[:, 1], color="C3", label="slower zero")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
+    mine = np.sort(check_existence(run.plant()).invariant_zeros.real)
+    here = run.gamma1 + run.gamma2
+    ax.plot([here, here], mine, "ko", mfc="none", label="this run's valves")
+    ax.axvspan(total[0], 1.0, color="C3", alpha=0.08, lw=0)
+    ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="C3")
+    ax.set_xlabel(r"$\gamma_1 + \gamma_2$" + f" (along $\\gamma_2 = {ratio:.3g}\\,\\gamma_1$)")
+    finish_panel(ax, "invariant zero (1/s)")
+    ax.set_title("Quadruple tank: the zeros move with the valves and cross 0 at 1")
+    return fig
+
+
+# the explorer ----------------------------------------------------------------------------------
+
+
+def tank_scenario(gamma1: float | None = None, gamma2: float | None = None) -> Scenario:
+    """The explorer of the quadruple tank: two UIO poles, and a slider per valve.
+
+    Parameters
+    ----------
+    gamma1, gamma2 : float, optional
+        The valves (default: the experiment's, setting P-).
+
+    Returns
+    -------
+    Scenario
+
+    Examples
+    --------
+    >>> from uio_teach.worked.quadruple_tank import tank_scenario
+    >>> s = tank_scenario()
+    >>> s.movable, [c.name for c in s.plant_controls]
+    (2, ['gamma1', 'gamma2'])
+    >>> tank_scenario(0.43, 0.34).existence.ok
+    False
+    """
+    from ..explorers.model import Channel, Settings
+    from ..explorers.scenarios import _range, _scenario, plant_controls
+
+    values = {}
+    if gamma1 is not None:
+        values["gamma1"] = float(gamma1)
+    if gamma2 is not None:
+        values["gamma2"] = float(gamma2)
+    run = QUADRUPLE_TANK.with_values(**values)
+    plant = run.plant()
+    return _scenario(
+        plant,
+        "uio",
+        name="quadruple-tank",
+        title="Quadruple tank",
+        timepts=run.grid(samples=601),
+        initial_state=run.initial_state,
+        u=None,
+        defaults=Settings(
+            poles=run.poles,
+            disturbance="sinusoid",
+            amplitude=run.sine_amplitude,
+            frequency=run.sine_frequency,
+            period=100.0,
+        ),
+        pole_limits=(-0.5, 0.05),
+        frequency_limits=(0.0, 0.5),
+        amplitude_limits=_range(run, "amplitude"),
+        disturbance_frequency_limits=_range(run, "frequency"),
+        period_limits=(10.0, 300.0),
+        noise_limits=(0.0, 0.2),
+        tau_limits=None,
+        decay_limits=None,
+        d_channels=(Channel(), Channel(gain=0.5, speed=1.5)),
+        v_channels=(),
+        static_values=(-0.4, -0.2, -0.1, -0.05, -0.02, 0.02),
+        static_control="pole",
+        plant_controls=plant_controls(run),
+        rebuild=tank_scenario,
+        note=valve_verdict(run.gamma1, run.gamma2),
+    )
+
+
+EXAMPLES = (
+    WorkedExample(
+        name="quadruple_tank",
+        title="The quadruple-tank process",
+        plant="uio_teach.examples:quadruple_tank",
+        experiment=f"{__name__}:QUADRUPLE_TANK",
+        family="uio",
+        scenario=f"{__name__}:tank_scenario",
+        order=40,
+        figures=(
+            FigureEntry(
+                "tank_error",
+                "Quadruple tank: pump deviations, error of the UIO and of a Luenberger observer",
+                f"{__name__}:_figure_error",
+            ),
+            FigureEntry(
+                "tank_zeros",
+                "Quadruple tank: the invariant zeros against gamma1 + gamma2, the run's valves",
+                f"{__name__}:_figure_zeros",
+            ),
+        ),
+    ),
+)
