@@ -701,16 +701,44 @@ def default_config_toml() -> str:
     return "\n".join(lines) + "\n"
 
 
-OBSERVER_KEYS = {
-    "pa9.poles": "pa9",
-    "case_study.poles": "case_study",
-    "missile.pmo_poles": "missile",
-}
-"""The keys that set an observer's poles, and the experiment each belongs to."""
+class _ObserverKeys(Mapping[str, str]):
+    """The config keys that set an observer's poles, and their worked example (the registry)."""
+
+    def _items(self) -> dict[str, str]:
+        from ..worked import WORKED
+
+        out = {}
+        for name, entry in WORKED.items():
+            key = entry.poles_key()
+            if key is not None:
+                out[key] = name
+        return out
+
+    def __getitem__(self, key: str) -> str:
+        return self._items()[key]
+
+    def __iter__(self):
+        return iter(self._items())
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __repr__(self) -> str:
+        return f"OBSERVER_KEYS({self._items()})"
+
+
+OBSERVER_KEYS: Mapping[str, str] = _ObserverKeys()
+"""The keys that set an observer's poles, and the worked example each belongs to: the
+``poles`` field of each experiment of :data:`uio_teach.worked.WORKED`."""
 
 
 def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
     """The observer that a poles key of the config sets (validated poles in, observer out).
+
+    The worked example's observer family (:attr:`uio_teach.worked.WorkedExample.family`)
+    is designed for the plant of its experiment with the config's values in place
+    (:func:`uio_teach.worked.run_from_config`: a physical parameter such as a
+    valve changes the plant); a PMO without poles takes the LMI's gain.
 
     Parameters
     ----------
@@ -718,8 +746,8 @@ def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
         A validated configuration (:class:`FigureConfig`).
     key : str
         One of :data:`OBSERVER_KEYS`: ``"pa9.poles"`` (the UIO),
-        ``"case_study.poles"`` (the PMO; absent: the LMI gain) or
-        ``"missile.pmo_poles"`` (the PMO).
+        ``"case_study.poles"`` (the PMO; absent: the LMI gain),
+        ``"missile.pmo_poles"`` (the PMO), ``"quadruple_tank.poles"`` (the UIO).
 
     Returns
     -------
@@ -728,7 +756,8 @@ def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
     Raises
     ------
     ConfigError
-        Not as many poles as the observer has movable ones.
+        Not as many poles as the observer has movable ones, or no such
+        observer for the plant (say why, from the existence check).
     ValueError
         Poles the observer cannot have (from the design).
 
@@ -738,17 +767,31 @@ def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
     >>> design_observer(FigureConfig(), "missile.pmo_poles").L.shape
     (4, 2)
     """
+    from ..worked import WORKED, run_from_config
+
     if key not in OBSERVER_KEYS:
         raise KeyError(f"{key!r} sets no observer; expected one of {', '.join(OBSERVER_KEYS)}")
+    name = OBSERVER_KEYS[key]
+    family = WORKED[name].family
     poles = cfg[key]
-    plant = EXPERIMENTS[OBSERVER_KEYS[key]].plant()
-    if key == "pa9.poles":
-        _expect_count(key, poles, check_existence(plant).movable)
-        return design_uio(plant, poles=list(poles))
-    if poles is None:
+    run = run_from_config(name, cfg)
+    plant = run.plant()
+    report = check_existence(plant)
+    if not report.ok:
+        why = "; ".join(f"{c.name}: {c.reason}" for c in report.failed)
+        specs = dict(experiment_params(run))
+        given = [
+            f"{specs[f].config_key(name, f)} = {getattr(run, f):g}"
+            for f in run.plant_fields
+            if f in specs and specs[f].config_key(name, f)
+        ]
+        plant_text = f"the plant with {', '.join(given)}" if given else "this plant"
+        raise ConfigError(f"no {family.upper()} exists for {plant_text} ({why})")
+    if family == "pmo" and poles is None:
         return design_pmo(plant, method="lmi")
-    _expect_count(key, poles, check_existence(plant).movable)
-    return design_pmo(plant, poles=list(poles))
+    _expect_count(key, poles, report.movable)
+    design = design_uio if family == "uio" else design_pmo
+    return design(plant, poles=list(poles))
 
 
 def _expect_count(key: str, poles: Sequence[complex], movable: int) -> None:

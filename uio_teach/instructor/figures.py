@@ -30,7 +30,6 @@ True
 
 from __future__ import annotations
 
-import dataclasses
 import difflib
 import os
 import time
@@ -38,7 +37,6 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import matplotlib.style
@@ -47,7 +45,6 @@ import numpy as np
 import uio_teach as ut
 
 from .._display import format_poles
-from ..experiments import CASE_STUDY, MISSILE, PA9
 from ..plotting import (
     finish_panel,
     new_figure,
@@ -59,6 +56,7 @@ from ..plotting import (
     with_unit,
     zero_to_rounding,
 )
+from ..worked import WORKED, resolve, run_from_config
 from .config import (
     ConfigError,
     FigureConfig,
@@ -104,32 +102,26 @@ CATCH_TOL = 0.02
 class _Runs:
     """Every simulation the figures need, computed once and shared (lazily).
 
-    Each run is a worked experiment of :mod:`uio_teach.experiments` with the
-    configuration's values in place of its own.
+    Each run is a worked experiment with the configuration's values in place of
+    its own (:func:`uio_teach.worked.run_from_config`: every declared field
+    with a config key, none mapped here by hand).
     """
 
     def __init__(self, cfg: FigureConfig) -> None:
         self.cfg = cfg
 
+    def run(self, name: str) -> Any:
+        """The experiment of the worked example ``name`` with the config's values."""
+        return run_from_config(name, self.cfg)
+
     # PA9 --------------------------------------------------------------------------------------
     @cached_property
     def pa9(self) -> dict[str, Any]:
         c = self.cfg
-        run = dataclasses.replace(
-            PA9,
-            timepts=PA9.grid(samples=c["pa9.samples"], duration=c["pa9.duration"]),
-            initial_state=c["pa9.initial_state"],
-            poles=c["pa9.poles"],
-            sine_amplitude=c["pa9.sine.amplitude"],
-            sine_frequency=c["pa9.sine.frequency"],
-            switch_times=c["pa9.piecewise.times"],
-            switch_values=c["pa9.piecewise.values"],
-            noise=c["pa9.noise"] or None,
-            seed=c["seed"],
-        )
+        run = self.run("pa9")
         plant = run.plant()
         uio = design_observer(c, "pa9.poles")
-        luen = ut.design_luenberger(plant, poles=list(c["pa9.poles"]))
+        luen = ut.design_luenberger(plant, poles=list(run.poles))
         d_sine, d_steps = run.d_sine, run.d_piecewise
         return {
             "plant": plant,
@@ -145,18 +137,8 @@ class _Runs:
     # case study -------------------------------------------------------------------------------
     @cached_property
     def case(self) -> dict[str, Any]:
-        c = self.cfg
-        run = dataclasses.replace(
-            CASE_STUDY,
-            timepts=np.arange(c["case_study.steps"] + 1, dtype=float),
-            initial_state=c["case_study.initial_state"],
-            u2_amplitude=c["case_study.u2.amplitude"],
-            u2_frequency=c["case_study.u2.frequency"],
-            v_amplitude=c["case_study.v.amplitude"],
-            v_hold=c["case_study.v.hold"],
-            seed=c["seed"],
-        )
-        pmo = design_observer(c, "case_study.poles")
+        run = self.run("case_study")
+        pmo = design_observer(self.cfg, "case_study.poles")
         return {
             "plant": run.plant(),
             "pmo": pmo,
@@ -167,17 +149,12 @@ class _Runs:
     # missile ----------------------------------------------------------------------------------
     @cached_property
     def missile(self) -> dict[str, Any]:
-        c = self.cfg
-        run = dataclasses.replace(
-            MISSILE,
-            timepts=MISSILE.grid(samples=c["missile.samples"], duration=c["missile.duration"]),
-            poles=c["missile.pmo_poles"],
-        )
+        run = self.run("missile")
         plant, t = run.plant(), run.timepts
         out: dict[str, Any] = {"plant": plant, "time": t}
         ginverse = ut.design_ginverse(plant)
         out["free"] = run.simulate(ginverse, d=None, observer_state=None)
-        pmo = design_observer(c, "missile.pmo_poles")
+        pmo = design_observer(self.cfg, "missile.pmo_poles")
         # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
         # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
         # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles
@@ -437,70 +414,30 @@ class FigureSpec:
     table: bool = False
 
 
-FIGURES: Mapping[str, FigureSpec] = MappingProxyType(
-    {
-        spec.name: spec
-        for spec in [
-            FigureSpec(
-                "pa9_sine",
-                "PA9 lab: sinusoidal disturbance d(t), error e and residual r of the UIO",
-                _pa9_sine,
-            ),
-            FigureSpec(
-                "pa9_piecewise",
-                "PA9 lab: piecewise-constant disturbance d(t), error e and residual r of the UIO",
-                _pa9_piecewise,
-            ),
-            FigureSpec(
-                "pa9_states",
-                "PA9: each state with its UIO estimate, error and residual (sinusoidal d)",
-                _pa9_states,
-            ),
-            FigureSpec(
-                "pa9_luenberger",
-                "PA9: UIO vs Luenberger observer, same poles, errors and residuals for both d",
-                _pa9_luenberger,
-            ),
-            FigureSpec(
-                "case_response",
-                "Case study: states, estimates, error and residual with u2 and v both active",
-                _case_response,
-            ),
-            FigureSpec(
-                "case_error",
-                "Case study: error norm on a log scale, with and without the unknown signals",
-                _case_error,
-            ),
-            FigureSpec(
-                "missile_pmo",
-                "Missile: x1..x4 with/without v and the PMO estimates (paper Fig. 4.1-4.4)",
-                _missile_pmo,
-            ),
-            FigureSpec(
-                "missile_ginverse",
-                "Missile: x1..x4 with/without v and the g-inverse estimates (Fig. 4.7-4.10)",
-                _missile_ginverse,
-            ),
-            FigureSpec(
-                "missile_error",
-                "Missile: estimation error of the PMO and the g-inverse observer, per state",
-                _missile_error,
-            ),
-            FigureSpec(
-                "missile_inputs",
-                "Missile: v1, v2 and their reconstructions by both observers (Fig. 4.5-4.6, "
-                "4.11-4.12)",
-                _missile_inputs,
-            ),
-            FigureSpec(
-                "missile_table2",
-                "Missile: Table II, catch times (tol 2 %) next to the paper's, as .csv and .md",
-                _table2,
-                table=True,
-            ),
-        ]
-    }
-)
+class _Figures(Mapping):
+    """The figures of every worked example of the registry, in its order (read on use)."""
+
+    def _items(self) -> dict[str, FigureSpec]:
+        out = {}
+        for entry in WORKED.values():
+            for fig in entry.figures:
+                out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
+        return out
+
+    def __getitem__(self, name: str) -> FigureSpec:
+        return self._items()[name]
+
+    def __iter__(self):
+        return iter(self._items())
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __repr__(self) -> str:
+        return f"FIGURES({', '.join(self)})"
+
+
+FIGURES: Mapping[str, FigureSpec] = _Figures()
 """Every output of ``uio-teach figures``, by name, in the order they are made."""
 
 

@@ -283,6 +283,8 @@ def _figure_zeros(runs: Any) -> Figure:
     ax.plot([here, here], mine, "ko", mfc="none", label="this run's valves")
     ax.axvspan(total[0], 1.0, color="C3", alpha=0.08, lw=0)
     ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="C3")
+    lim = 2.5 * max(float(np.max(np.abs(mine))), 0.02)
+    ax.set_ylim(-lim, 0.6 * lim)
     ax.set_xlabel(r"$\gamma_1 + \gamma_2$" + f" (along $\\gamma_2 = {ratio:.3g}\\,\\gamma_1$)")
     finish_panel(ax, "invariant zero (1/s)")
     ax.set_title("Quadruple tank: the zeros move with the valves and cross 0 at 1")
