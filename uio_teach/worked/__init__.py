@@ -34,7 +34,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 __all__ = ["WorkedExample", "FigureEntry", "WORKED", "resolve", "run_from_config"]
@@ -128,7 +128,6 @@ class WorkedExample:
     figures: tuple[FigureEntry, ...] = ()
     lab: str | None = None
     order: int = 100
-    _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
@@ -139,10 +138,8 @@ class WorkedExample:
         return resolve(self.plant)
 
     def run(self) -> Any:
-        """The experiment (imported on first use)."""
-        if "experiment" not in self._cache:
-            self._cache["experiment"] = resolve(self.experiment)
-        return self._cache["experiment"]
+        """The experiment (imported on first use, looked up on every call)."""
+        return resolve(self.experiment)
 
     def make_scenario(self, **plant_values: Any) -> Any:
         """The explorer's scenario; ``plant_values`` set physical parameters of the plant."""

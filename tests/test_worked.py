@@ -1,0 +1,159 @@
+"""One registry entry per worked example: every config key acts, every declared field arrives."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import io
+import tempfile
+from pathlib import Path
+
+import matplotlib.style
+import pytest
+
+from uio_teach.experiments import EXPERIMENTS, LAB_PLANTS, experiment_params, pole_text
+from uio_teach.explorers import compute_frame
+from uio_teach.instructor import figures
+from uio_teach.instructor.config import OBSERVER_KEYS, FigureConfig, config_schema
+from uio_teach.instructor.lab_registry import LABS
+from uio_teach.worked import WORKED, run_from_config
+
+BOOK = Path(__file__).resolve().parent.parent / "book"
+SCHEMA = config_schema()
+
+
+def _other(key: str) -> object:
+    """Another valid value of a config key, as TOML would give it (derived from its declaration)."""
+    opt = SCHEMA[key]
+    value = opt.default
+    if opt.kind == "str":
+        return "ggplot" if value != "ggplot" else "default"
+    if opt.kind == "int":
+        up = value + 1
+        return up if opt.maximum is None or up <= opt.maximum else value - 1
+    if opt.kind == "float":
+        return 0.05 if value == 0 else value * 0.9
+    if opt.kind == "floats":
+        return [v * 0.9 for v in value]
+    # poles: faster by 10 % (a discrete one absent by default: one inside the unit circle)
+    if value is None:
+        return [0.2]
+    return [pole_text(complex(p) * 1.1) for p in value]
+
+
+def _nested(key: str, value: object) -> dict:
+    out: dict = {}
+    node = out
+    *tables, last = key.split(".")
+    for part in tables:
+        node = node.setdefault(part, {})
+    node[last] = value
+    return out
+
+
+def _section(key: str) -> str | None:
+    head = key.split(".", 1)[0]
+    return head if "." in key and head in WORKED else None
+
+
+def _lab_params(cfg: FigureConfig, name: str) -> dict:
+    return LABS[name].params.from_config(cfg).to_params()
+
+
+def _figure_bytes(cfg: FigureConfig, name: str, folder: Path) -> bytes:
+    spec = figures.FIGURES[name]
+    runs = figures._Runs(cfg)
+    with matplotlib.style.context(cfg["style"]):
+        if spec.table:
+            return b"".join(p.read_bytes() for p in spec.draw(runs, folder))
+        fig = spec.draw(runs)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=20, metadata={"Software": None})
+        return buf.getvalue()
+
+
+@functools.cache
+def _default_figure(name: str) -> bytes:
+    with tempfile.TemporaryDirectory() as folder:
+        return _figure_bytes(FigureConfig(), name, Path(folder))
+
+
+def test_the_registry_is_the_source_of_experiments_labs_observers_and_figures():
+    assert list(EXPERIMENTS) == list(WORKED)
+    assert set(LAB_PLANTS) == {n for n, e in WORKED.items() if e.lab} == set(LABS)
+    for name, entry in WORKED.items():
+        assert EXPERIMENTS[name] is entry.run() and entry.run().lab == name
+        if entry.lab:
+            assert LABS[name].source == entry.lab and (BOOK / entry.lab).is_file()
+        assert OBSERVER_KEYS[entry.poles_key()] == name
+    assert list(figures.FIGURES) == [f.name for e in WORKED.values() for f in e.figures]
+    assert set(OBSERVER_KEYS) == {e.poles_key() for e in WORKED.values()}
+
+
+@pytest.mark.parametrize("name", list(WORKED))
+def test_every_declared_field_reaches_the_config_the_lab_and_the_explorer(name):
+    entry, experiment = WORKED[name], WORKED[name].run()
+    scenario = entry.make_scenario()
+    lab_fields = {f.name for f in dataclasses.fields(LABS[name].params)} if entry.lab else set()
+    limits = {
+        "amplitude": (scenario.amplitude_limits, scenario.defaults.amplitude),
+        "frequency": (scenario.disturbance_frequency_limits, scenario.defaults.frequency),
+        "noise": (scenario.noise_limits, None),
+    }
+    sliders = {c.name: c for c in scenario.plant_controls}
+    for field, spec in experiment_params(experiment):
+        key = spec.config_key(name, field)
+        if key is not None:
+            assert key in SCHEMA, (name, field)
+        if spec.lab and entry.lab:
+            assert field in lab_fields, (name, field)
+        if spec.control == "plant":
+            assert field in type(experiment).plant_fields, (name, field)
+            assert sliders[field].limits == spec.range
+            assert sliders[field].value == getattr(experiment, field)
+        elif spec.control:
+            (lo_hi, default) = limits[spec.control]
+            assert lo_hi == spec.range, (name, field)
+            if default is not None:
+                assert default == getattr(experiment, field), (name, field)
+    assert set(sliders) <= set(type(experiment).plant_fields)
+
+
+def test_a_plant_slider_remakes_the_plant_and_the_verdict():
+    for name, entry in WORKED.items():
+        scenario = entry.make_scenario()
+        for control in scenario.plant_controls:
+            lo, hi = control.limits
+            other = scenario.rebuild(**{control.name: lo if control.value != lo else hi})
+            assert other.plant != scenario.plant, (name, control.name)
+            frame = compute_frame(other)
+            assert frame.scenario is other
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("key", list(SCHEMA))
+def test_every_config_key_changes_an_output(key, tmp_path_factory):
+    """A key is never accepted and ignored: it changes a lab's PARAMS or a figure's bytes."""
+    cfg = FigureConfig.from_dict(_nested(key, _other(key)))
+    assert cfg[key] != FigureConfig()[key]
+    section = _section(key)
+    names = [section] if section else list(WORKED)
+    for name in names:
+        if WORKED[name].lab and _lab_params(cfg, name) != _lab_params(FigureConfig(), name):
+            return
+    folder = tmp_path_factory.mktemp("figures")
+    for name in names:
+        for fig in WORKED[name].figures:
+            if _figure_bytes(cfg, fig.name, folder) != _default_figure(fig.name):
+                return
+    pytest.fail(f"the config key {key} changes no lab's PARAMS and no figure")
+
+
+def test_the_figures_run_is_the_config_through_the_declared_fields():
+    cfg = FigureConfig.from_dict(
+        {"quadruple_tank": {"gamma1": 0.8, "pump2": {"amplitude": 0.7}}, "seed": 9}
+    )
+    run = run_from_config("quadruple_tank", cfg)
+    assert (run.gamma1, run.gamma2, run.sine_amplitude) == (0.8, 0.6, 0.7)
+    assert run.plant().E[0, 0] == pytest.approx(0.8 * 3.33 / 28, rel=1e-15)
+    assert run_from_config("case_study", cfg).seed == 9
