@@ -303,7 +303,7 @@ class Explorer(DragPoles):
             plant_box = [W.HTML("<b>Plant</b>")]
             for pc in sc.plant_controls:
                 c[pc.name] = _slider(pc.label, *pc.limits, pc.value, 180)
-                c[pc.name].description_tooltip = pc.doc
+                c[pc.name].tooltip = pc.doc
                 c[pc.name].observe(self._plant_changed, names="value")
                 plant_box.append(c[pc.name])
             groups.insert(0, plant_box)
