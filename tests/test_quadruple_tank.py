@@ -10,10 +10,10 @@ import pytest
 
 import uio_teach as ut
 from uio_teach.examples import QUADRUPLE_TANK_PUBLISHED, quadruple_tank, tank_time_constants
-from uio_teach.explorers import compute_frame
+from uio_teach.explorers import compute_frame, scenario_of
 from uio_teach.instructor import figures
 from uio_teach.instructor.config import ConfigError, FigureConfig, config_schema
-from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK, tank_scenario, valve_verdict
+from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK, valve_verdict
 
 EPS = np.finfo(float).eps
 SETTINGS = list(QUADRUPLE_TANK_PUBLISHED)
@@ -186,9 +186,9 @@ def test_the_figures_are_registered():
 
 
 def test_the_explorer_says_when_no_uio_exists_and_why():
-    good = compute_frame(tank_scenario())
+    good = compute_frame(scenario_of("quadruple_tank"))
     assert good.observer_message == "" and good.poles.size == 4
-    bad_scenario = tank_scenario(gamma1=0.43, gamma2=0.34)
+    bad_scenario = scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34)
     bad = compute_frame(bad_scenario)
     assert bad.observer_message.startswith("no UIO exists")
     assert "outside the open left half-plane" in bad.observer_message

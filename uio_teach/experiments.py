@@ -52,6 +52,7 @@ from . import examples, signals
 from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
+from .worked import WORKED
 
 __all__ = [
     "Experiment",
@@ -406,8 +407,6 @@ class Experiment:
         >>> PA9.with_values(matrices={"E": [[1], [0], [0]]}).plant().E.ravel().tolist()
         [1.0, 0.0, 0.0]
         """
-        from .worked import WORKED
-
         factory = WORKED[self.lab].plant_factory()
         course = factory(**{name: getattr(self, name) for name in self.plant_fields})
         return _with_matrices(self.lab, course, dict(self.matrices))
@@ -957,8 +956,6 @@ class _FromRegistry(Mapping):
         self._what = what
 
     def _items(self) -> dict[str, Any]:
-        from .worked import WORKED
-
         if self._what == "experiments":
             return {name: entry.run() for name, entry in WORKED.items()}
         return {name: entry.plant_factory() for name, entry in WORKED.items() if entry.lab}

@@ -15,6 +15,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -25,6 +26,7 @@ from ..existence import check_existence
 from ..experiments import CASE_STUDY, MISSILE, PA9, experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
+from ..worked import WORKED, resolve
 from .model import (
     FAMILIES,
     Channel,
@@ -43,6 +45,7 @@ __all__ = [
     "make_scenario",
     "plant_controls",
     "scenario_of",
+    "experiment_scenario",
 ]
 
 
@@ -66,8 +69,6 @@ def scenario_of(name: str, **plant_values: float) -> Scenario:
     >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
     False
     """
-    from ..worked import WORKED
-
     return WORKED[name].make_scenario(**plant_values)
 
 
@@ -409,4 +410,75 @@ def make_scenario(
         v_channels=tuple(Channel(gain=0.5, speed=2.0 + 0.5 * i) for i in range(plant.nv)),
         static_values=static,
         static_control="pole" if real_first else "amplitude",
+    )
+
+
+def experiment_scenario(name: str, **plant_values: float) -> Scenario:
+    """The explorer of a worked example, made from its experiment and its registry entry.
+
+    The plant, the time grid, the known input, the initial state, the starting
+    poles, the disturbance's amplitude and frequency (and their ranges, from
+    the fields declared with ``control="amplitude"`` / ``"frequency"``) come
+    from the experiment; one slider per physical parameter
+    (:func:`plant_controls`); the rest from the entry's ``explorer`` options:
+    ``title``, ``samples``, ``period``, ``pole_limits``, ``frequency_limits``,
+    ``period_limits``, ``noise_limits``, ``d_channels`` (``(gain, speed)`` per
+    unknown input), ``static_values`` and ``note`` (``"module:function"``
+    called with the physical parameters: a sentence on this plant).
+
+    Parameters
+    ----------
+    name : str
+        The worked example (a key of :data:`uio_teach.worked.WORKED`).
+    **plant_values
+        Physical parameters of its plant.
+
+    Returns
+    -------
+    Scenario
+
+    Examples
+    --------
+    >>> from uio_teach.explorers.scenarios import experiment_scenario
+    >>> s = experiment_scenario("quadruple_tank", gamma1=0.43, gamma2=0.34)
+    >>> s.existence.ok, [c.value for c in s.plant_controls]
+    (False, [0.43, 0.34])
+    """
+    entry = WORKED[name]
+    options = dict(entry.explorer)
+    run = entry.run().with_values(**plant_values)
+    plant = run.plant()
+    values = {spec.control: getattr(run, f) for f, spec in experiment_params(run) if spec.control}
+    note = options.pop("note", None)
+    physical = {f: getattr(run, f) for f in type(run).plant_fields}
+    channels = options.pop("d_channels", ((1.0, 1.0),) * plant.q)
+    noise_limits = options.pop("noise_limits", (0.0, 0.5))
+    return _scenario(
+        plant,
+        entry.family,
+        name=name.replace("_", "-"),
+        title=options.pop("title", entry.title),
+        timepts=run.grid(samples=options.pop("samples", None)),
+        initial_state=run.initial_state,
+        u=run.inputs,
+        defaults=Settings(
+            poles=run.poles,
+            disturbance="sinusoid",
+            amplitude=values.get("amplitude", 1.0),
+            frequency=values.get("frequency", 1.0),
+            period=options.pop("period"),
+            noise=values.get("noise", 0.0) or 0.0,
+        ),
+        amplitude_limits=_range(run, "amplitude"),
+        disturbance_frequency_limits=_range(run, "frequency"),
+        noise_limits=_range(run, "noise") if "noise" in values else noise_limits,
+        tau_limits=None,
+        decay_limits=None,
+        d_channels=tuple(Channel(gain=g, speed=v) for g, v in channels),
+        v_channels=(),
+        static_control="pole",
+        plant_controls=plant_controls(run),
+        rebuild=functools.partial(experiment_scenario, name),
+        note=resolve(note)(**physical) if note else "",
+        **options,
     )

@@ -734,7 +734,7 @@ def tank_explorer(*, static: bool = True) -> Explorer:
 
     Moving a valve remakes the plant; below ``gamma1 + gamma2 = 1`` an
     invariant zero is in the right half-plane and the explorer says that no
-    UIO exists, and why. See :func:`uio_teach.worked.quadruple_tank.tank_scenario`.
+    UIO exists, and why. See :func:`uio_teach.explorers.scenarios.experiment_scenario`.
 
     Parameters
     ----------

@@ -43,6 +43,7 @@ from ..experiments import (
     pole_text,
 )
 from ..observers import design_pmo, design_uio
+from ..worked import WORKED, run_from_config
 
 __all__ = [
     "ConfigError",
@@ -705,8 +706,6 @@ class _ObserverKeys(Mapping[str, str]):
     """The config keys that set an observer's poles, and their worked example (the registry)."""
 
     def _items(self) -> dict[str, str]:
-        from ..worked import WORKED
-
         out = {}
         for name, entry in WORKED.items():
             key = entry.poles_key()
@@ -767,8 +766,6 @@ def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
     >>> design_observer(FigureConfig(), "missile.pmo_poles").L.shape
     (4, 2)
     """
-    from ..worked import WORKED, run_from_config
-
     if key not in OBSERVER_KEYS:
         raise KeyError(f"{key!r} sets no observer; expected one of {', '.join(OBSERVER_KEYS)}")
     name = OBSERVER_KEYS[key]

@@ -34,10 +34,12 @@ from __future__ import annotations
 import importlib
 import pkgutil
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["WorkedExample", "FigureEntry", "WORKED", "resolve", "run_from_config"]
+
+_GENERIC_SCENARIO = "uio_teach.explorers.scenarios:experiment_scenario"
 
 FAMILIES = ("uio", "pmo")
 """The observer families whose poles a worked example's config key sets."""
@@ -109,8 +111,13 @@ class WorkedExample:
     family : {"uio", "pmo"}
         The observer that the experiment's ``poles`` set (``None`` poles of a
         PMO: the LMI gain).
-    scenario : str
-        ``"module:function"`` returning the explorer's scenario.
+    scenario : str or None
+        ``"module:function"`` returning the explorer's scenario (``None``: made
+        from the experiment and ``explorer`` by
+        ``uio_teach.explorers.scenarios.experiment_scenario``).
+    explorer : mapping
+        The explorer's options beyond the experiment's declarations (ranges of
+        the poles, the channels of ``d``, ...; see ``experiment_scenario``).
     figures : tuple of FigureEntry
         Its outputs of ``uio-teach figures``, in order.
     lab : str or None
@@ -124,7 +131,8 @@ class WorkedExample:
     plant: str
     experiment: str
     family: str
-    scenario: str
+    scenario: str | None = None
+    explorer: Mapping[str, Any] = field(default_factory=dict)
     figures: tuple[FigureEntry, ...] = ()
     lab: str | None = None
     order: int = 100
@@ -143,10 +151,13 @@ class WorkedExample:
 
     def make_scenario(self, **plant_values: Any) -> Any:
         """The explorer's scenario; ``plant_values`` set physical parameters of the plant."""
+        if self.scenario is None:
+            return resolve(_GENERIC_SCENARIO)(self.name, **plant_values)
         return resolve(self.scenario)(**plant_values)
 
     def poles_key(self) -> str | None:
         """The config key that sets the observer's poles (``None``: not in the config)."""
+        # deferred: the experiments read this registry (a cycle at import time)
         from ..experiments import experiment_params
 
         spec = dict(experiment_params(self.run())).get("poles")
@@ -216,6 +227,7 @@ def run_from_config(name: str, config: Mapping[str, Any]) -> Any:
     >>> run.sine_amplitude, run.duration, run.samples
     (3.0, 5.0, 2001)
     """
+    # deferred: the experiments read this registry (a cycle at import time)
     from ..experiments import experiment_params
 
     experiment = WORKED[name].run()

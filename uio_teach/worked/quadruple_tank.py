@@ -18,7 +18,7 @@ Examples
 (0.7, 0.6, (-0.1, -0.2))
 >>> print(valve_verdict(0.43, 0.34))   # doctest: +NORMALIZE_WHITESPACE
 gamma1 + gamma2 = 0.77 < 1: the pumps fill the upper tanks more than the lower ones, an
-invariant zero lies in the right half-plane at 0.0128, and no UIO with a stable error exists
+invariant zero lies in the right half-plane at 0.0225, and no UIO with a stable error exists
 """
 
 from __future__ import annotations
@@ -31,16 +31,18 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from .. import signals
+from .._display import format_poles
+from ..examples import quadruple_tank
 from ..existence import check_existence
 from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
-from . import FigureEntry, WorkedExample
+from ..luenberger import luenberger_poles
+from ..observers import design_luenberger, design_uio
+from . import FigureEntry, WorkedExample, run_from_config
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-    from ..explorers.model import Scenario
-
-__all__ = ["QuadrupleTankExperiment", "QUADRUPLE_TANK", "valve_verdict", "tank_scenario"]
+__all__ = ["QuadrupleTankExperiment", "QUADRUPLE_TANK", "valve_verdict"]
 
 VALVE_DOC = "the share of pump {i}'s flow sent to lower tank {i} (the rest to upper tank {j})"
 
@@ -176,8 +178,6 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
     -------
     str
     """
-    from ..examples import quadruple_tank
-
     report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2))
     zeros = np.sort(report.invariant_zeros.real)
     total = gamma1 + gamma2
@@ -211,16 +211,11 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
 
 def _run(runs: Any) -> dict[str, Any]:
     """The tank's run of the figures (computed once per ``runs``)."""
-    from ..instructor.config import design_observer
-    from ..luenberger import luenberger_poles
-    from ..observers import design_luenberger
-    from . import run_from_config
-
     cache = runs.__dict__.setdefault("_worked", {})
     if "quadruple_tank" not in cache:
         run = run_from_config("quadruple_tank", runs.cfg)
         plant = run.plant()
-        uio = design_observer(runs.cfg, "quadruple_tank.poles")
+        uio = design_uio(plant, poles=list(run.poles))  # the config checked that it exists
         luen = design_luenberger(plant, poles=luenberger_poles(plant, uio.poles()))
         cache["quadruple_tank"] = {
             "run": run,
@@ -233,7 +228,7 @@ def _run(runs: Any) -> dict[str, Any]:
 
 
 def _figure_error(runs: Any) -> Figure:
-    from .._display import format_poles
+    # deferred: the registry is read without matplotlib, which the plotting module loads
     from ..plotting import finish_panel, new_figure, plot_error, symbol, time_label, with_unit
 
     r = _run(runs)
@@ -256,7 +251,7 @@ def _figure_error(runs: Any) -> Figure:
 
 
 def _figure_zeros(runs: Any) -> Figure:
-    from ..examples import quadruple_tank
+    # deferred: the registry is read without matplotlib, which the plotting module loads
     from ..plotting import finish_panel, new_figure
 
     run = _run(runs)["run"]
@@ -291,73 +286,6 @@ def _figure_zeros(runs: Any) -> Figure:
     return fig
 
 
-# the explorer ----------------------------------------------------------------------------------
-
-
-def tank_scenario(gamma1: float | None = None, gamma2: float | None = None) -> Scenario:
-    """The explorer of the quadruple tank: two UIO poles, and a slider per valve.
-
-    Parameters
-    ----------
-    gamma1, gamma2 : float, optional
-        The valves (default: the experiment's, setting P-).
-
-    Returns
-    -------
-    Scenario
-
-    Examples
-    --------
-    >>> from uio_teach.worked.quadruple_tank import tank_scenario
-    >>> s = tank_scenario()
-    >>> s.movable, [c.name for c in s.plant_controls]
-    (2, ['gamma1', 'gamma2'])
-    >>> tank_scenario(0.43, 0.34).existence.ok
-    False
-    """
-    from ..explorers.model import Channel, Settings
-    from ..explorers.scenarios import _range, _scenario, plant_controls
-
-    values = {}
-    if gamma1 is not None:
-        values["gamma1"] = float(gamma1)
-    if gamma2 is not None:
-        values["gamma2"] = float(gamma2)
-    run = QUADRUPLE_TANK.with_values(**values)
-    plant = run.plant()
-    return _scenario(
-        plant,
-        "uio",
-        name="quadruple-tank",
-        title="Quadruple tank",
-        timepts=run.grid(samples=601),
-        initial_state=run.initial_state,
-        u=None,
-        defaults=Settings(
-            poles=run.poles,
-            disturbance="sinusoid",
-            amplitude=run.sine_amplitude,
-            frequency=run.sine_frequency,
-            period=100.0,
-        ),
-        pole_limits=(-0.5, 0.05),
-        frequency_limits=(0.0, 0.5),
-        amplitude_limits=_range(run, "amplitude"),
-        disturbance_frequency_limits=_range(run, "frequency"),
-        period_limits=(10.0, 300.0),
-        noise_limits=(0.0, 0.2),
-        tau_limits=None,
-        decay_limits=None,
-        d_channels=(Channel(), Channel(gain=0.5, speed=1.5)),
-        v_channels=(),
-        static_values=(-0.4, -0.2, -0.1, -0.05, -0.02, 0.02),
-        static_control="pole",
-        plant_controls=plant_controls(run),
-        rebuild=tank_scenario,
-        note=valve_verdict(run.gamma1, run.gamma2),
-    )
-
-
 EXAMPLES = (
     WorkedExample(
         name="quadruple_tank",
@@ -365,8 +293,21 @@ EXAMPLES = (
         plant="uio_teach.examples:quadruple_tank",
         experiment=f"{__name__}:QUADRUPLE_TANK",
         family="uio",
-        scenario=f"{__name__}:tank_scenario",
         order=40,
+        explorer=MappingProxyType(
+            {
+                "title": "Quadruple tank",
+                "samples": 601,
+                "period": 100.0,
+                "pole_limits": (-0.5, 0.05),
+                "frequency_limits": (0.0, 0.5),
+                "period_limits": (10.0, 300.0),
+                "noise_limits": (0.0, 0.2),
+                "d_channels": ((1.0, 1.0), (0.5, 1.5)),
+                "static_values": (-0.4, -0.2, -0.1, -0.05, -0.02, 0.02),
+                "note": f"{__name__}:valve_verdict",
+            }
+        ),
         figures=(
             FigureEntry(
                 "tank_error",
