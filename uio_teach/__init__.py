@@ -57,8 +57,9 @@ __version__ = "0.1.0"
 # Loaded on first use, not by `import uio_teach`, so that a script (or `uio-teach figures`)
 # that needs only the algorithms does not pay for them: the lab checks (`ut.checks`, which
 # build the worked experiments and their figures), the plotting layer and the explorers
-# (matplotlib figures; ipywidgets for the live explorers) and the worked experiments.
-_LAZY = ("checks", "experiments", "explorers", "plotting")
+# (matplotlib figures; ipywidgets for the live explorers), the worked experiments and the
+# registry of the worked examples.
+_LAZY = ("checks", "experiments", "explorers", "plotting", "worked")
 
 
 def __getattr__(name: str):
@@ -75,6 +76,7 @@ __all__ = [
     "Plant",
     "examples",
     "experiments",
+    "worked",
     "linalg",
     "signals",
     "plotting",
