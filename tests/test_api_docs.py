@@ -13,6 +13,8 @@ import uio_teach as ut
 # The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest.
 SUBPACKAGE_API = (
     "experiments",
+    "worked",
+    "worked.quadruple_tank",
     "luenberger",
     "explorers",
     "explorers.widgets",

@@ -85,6 +85,12 @@ class FigureEntry:
         registry does not load matplotlib.
     table : bool
         A table (``.csv`` and ``.md``) rather than a picture.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import WORKED
+    >>> [f.name for f in WORKED["quadruple_tank"].figures]
+    ['tank_error', 'tank_zeros']
     """
 
     name: str
@@ -124,6 +130,15 @@ class WorkedExample:
         The file name of its lab chapter in ``book/`` (``None``: no lab).
     order : int
         Its place among the worked examples (the book's order).
+
+    Examples
+    --------
+    >>> from uio_teach.worked import WORKED
+    >>> tank = WORKED["quadruple_tank"]
+    >>> tank.plant_factory()(gamma1=0.43, gamma2=0.34).name
+    'quadruple tank (P-, gamma 0.43, 0.34)'
+    >>> tank.poles_key(), tank.lab is None
+    ('quadruple_tank.poles', True)
     """
 
     name: str

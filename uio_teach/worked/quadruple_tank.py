@@ -177,6 +177,13 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
     Returns
     -------
     str
+
+    Examples
+    --------
+    >>> from uio_teach.worked.quadruple_tank import valve_verdict
+    >>> print(valve_verdict(0.5, 0.5))   # doctest: +NORMALIZE_WHITESPACE
+    gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike, an invariant zero
+    sits at the origin (to round-off), and no UIO with a stable error exists
     """
     report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2))
     zeros = np.sort(report.invariant_zeros.real)
