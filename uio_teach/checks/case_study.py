@@ -32,8 +32,8 @@ import numpy as np
 from .. import examples
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence, decoupling
+from ..experiments import CASE_STUDY
 from ..linalg import left_null
-from ..signals import piecewise_constant
 from .common import (
     CheckResult,
     check_plant_of,
@@ -371,10 +371,10 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
 
 
 def _staircase(timepts: np.ndarray, amplitude: float, hold: int, seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    switch = np.arange(0, timepts[-1] + 1, hold)
-    levels = rng.uniform(-amplitude, amplitude, switch.size)
-    return np.asarray(piecewise_constant(switch, levels)(timepts), float).ravel()
+    """The experiment's staircase ``v`` with the asked amplitude, hold and seed, on ``timepts``."""
+    run = CASE_STUDY.with_values(v_amplitude=amplitude, v_hold=hold)
+    v = run.measurement_disturbance(seed=seed, timepts=timepts)
+    return np.asarray(v(timepts), float).ravel()
 
 
 @never_raises("Case study: the simulation with u2 and v", "case_study.simulation")

@@ -59,7 +59,7 @@ from . import (
     pa9_plot,
     pa9_simulation,
 )
-from ._common import CheckResult
+from .common import CheckResult
 
 try:  # the group's plant from its parameters, where the experiments define it
     from ..experiments import plant_from_params as _experiment_plant

@@ -32,9 +32,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import examples
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence
+from ..experiments import MISSILE
 from ..reconstruction import catch_time, reconstruct_input
 from ..simulation import simulate
 from .common import (
@@ -261,7 +261,7 @@ def _vhat(result: CheckResult, vhat: Any):
 
 
 def _paper_v(result: CheckResult, resp) -> bool:
-    want = np.asarray(examples.missile_inputs()(resp.time), float)
+    want = np.asarray(MISSILE.v(resp.time), float)
     d = np.asarray(resp.inputs.d, float)
     if d.shape == want.shape and np.allclose(d, want, rtol=0, atol=1e-9):
         return True
