@@ -4,6 +4,7 @@ checkout (figures, lab notebooks and the live explorer from any folder)."""
 from __future__ import annotations
 
 import ast
+import importlib
 import importlib.metadata
 import os
 import re
@@ -65,6 +66,24 @@ def test_every_run_time_import_is_declared_in_pyproject():
         if not dists & everything:
             missing[module] = sorted(users)
     assert not missing, f"imported but not declared in pyproject.toml: {missing}"
+
+
+def test_the_plain_install_is_the_algorithms_and_the_rest_are_extras():
+    declared = _declared()
+    assert declared[""] == {"numpy", "scipy", "control", "cvxpy", "matplotlib"}
+    assert {"ipywidgets", "ipympl"} <= declared["explorers"]
+    assert not declared["explorers"] & declared[""]
+
+
+def test_without_the_explorers_extra_the_live_explorers_say_so_in_one_line(monkeypatch):
+    monkeypatch.setitem(sys.modules, "ipywidgets", None)  # as if it were not installed
+    monkeypatch.delitem(sys.modules, "uio_teach.explorers.widgets", raising=False)
+    with pytest.raises(ImportError) as err:
+        importlib.import_module("uio_teach.explorers.widgets")
+    message = str(err.value)
+    assert "\n" not in message and "pip install 'uio-teach[explorers]'" in message
+    assert message.startswith("the live explorers need ipywidgets")
+    assert err.value.__cause__ is None and err.value.__suppress_context__
 
 
 def test_the_instructor_extra_holds_what_only_the_labs_need():

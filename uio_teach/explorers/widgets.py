@@ -43,8 +43,16 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
-import ipywidgets as W
 import numpy as np
+
+try:
+    import ipywidgets as W
+except ImportError as err:  # the live explorers are an extra: say so in one line
+    raise ImportError(
+        f"the live explorers need {err.name or 'ipywidgets'}, which is not installed: "
+        "pip install 'uio-teach[explorers]' (the static explorers of uio_teach.explorers "
+        "need no extra)"
+    ) from None
 
 from .._display import format_poles
 from ..plant import Plant
