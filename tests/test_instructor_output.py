@@ -209,14 +209,31 @@ def leftovers(parent: Path) -> list[str]:
     return sorted(p.name for p in parent.iterdir() if p.name.startswith("."))
 
 
+# A child process that runs the command line and kills itself (SIGKILL) at the k-th step of
+# its staged output (a file written, a point of the swap): the package's steps do nothing.
+_KILLER = """
+import os, signal, sys
+from uio_teach.instructor import cli, output
+count = 0
+def step():
+    global count
+    count += 1
+    if count == int(sys.argv[1]):
+        os.kill(os.getpid(), signal.SIGKILL)
+output._step = step
+sys.exit(cli.main(sys.argv[2:]))
+"""
+
+
 def uio_teach(*argv: str, kill_at: int | None = None, **kwargs) -> subprocess.CompletedProcess:
     """``python -m uio_teach ARGV`` in a child process (killed at its step ``kill_at``)."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), *sys.path]))
-    env.pop(output.KILL_AT_ENV, None)
-    if kill_at is not None:
-        env[output.KILL_AT_ENV] = str(kill_at)
+    if kill_at is None:
+        command = [sys.executable, "-m", "uio_teach", *argv]
+    else:
+        command = [sys.executable, "-c", _KILLER, str(kill_at), *argv]
     return subprocess.run(
-        [sys.executable, "-m", "uio_teach", *argv],
+        command,
         capture_output=True,
         text=True,
         env=env,

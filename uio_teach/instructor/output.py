@@ -39,7 +39,6 @@ import hashlib
 import json
 import os
 import shutil
-import signal
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -60,7 +59,6 @@ __all__ = [
     "StagedFolder",
     "FolderLock",
     "clean_leftovers",
-    "KILL_AT_ENV",
     "save_figure",
     "prepare_output_dir",
     "write_manifest",
@@ -446,20 +444,10 @@ class FolderLock:
         self.release()
 
 
-KILL_AT_ENV = "UIO_TEACH_KILL_AT"
-"""A testing aid: with ``UIO_TEACH_KILL_AT=k`` in its environment, a run kills itself (SIGKILL)
-at its k-th step (a file written into the staging folder, or a point of the swap), so that the
-tests can check what a kill at that moment leaves. Unset, it does nothing."""
-_steps = 0
-
-
 def _step() -> None:
-    """One step of a staged run: a file written, or a point of the swap (see ``KILL_AT_ENV``)."""
-    global _steps
-    _steps += 1
-    wanted = os.environ.get(KILL_AT_ENV)
-    if wanted and wanted.isdigit() and int(wanted) == _steps:
-        os.kill(os.getpid(), signal.SIGKILL)
+    """One step of a staged run: a file written, or a point of the swap. It does nothing; the
+    tests put a function of their own here to stop a run at a chosen step and look at what is
+    left."""
 
 
 def _umask() -> int:
