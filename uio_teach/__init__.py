@@ -31,6 +31,7 @@ from .detection import (
     sensor_fault,
     simulate_fault,
 )
+from .errors import UIOTeachError, UIOTeachWarning
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
 from .lmi import LMIError, LMIInfeasibleError, LMIResult, LMISolverError, lmi_gain
@@ -73,6 +74,8 @@ def __dir__() -> list[str]:
 
 
 __all__ = [
+    "UIOTeachError",
+    "UIOTeachWarning",
     "Plant",
     "examples",
     "experiments",

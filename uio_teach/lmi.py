@@ -12,6 +12,7 @@ import scipy.linalg as sla
 from ._display import format_complex
 from ._validation import as_matrix
 from .balancing import BalancedPair, balanced_pair
+from .errors import UIOTeachError
 from .linalg import is_stable, pinv
 from .placement import place_pair_poles
 
@@ -29,7 +30,7 @@ __all__ = [
 STRICT_MARGIN = 1e-9
 
 
-class LMIError(ValueError):
+class LMIError(UIOTeachError, ValueError):
     """Base class of the LMI errors; ``.status`` is the solver's word."""
 
     def __init__(self, message: str, status: str) -> None:

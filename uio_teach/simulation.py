@@ -48,6 +48,7 @@ import scipy.linalg as sla
 
 from ._display import format_complex
 from ._validation import as_seed, as_time
+from .errors import UIOTeachError
 from .observers import Observer
 from .plant import Plant
 
@@ -64,7 +65,7 @@ __all__ = [
 ]
 
 
-class SimulationOverflowError(OverflowError):
+class SimulationOverflowError(UIOTeachError, OverflowError):
     """The response leaves the floating-point range: an unstable pole, too long a time span.
 
     ``.poles`` are the unstable poles of the plant/observer system and ``.time`` the

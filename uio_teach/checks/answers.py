@@ -50,6 +50,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import UIOTeachError
 from ..observers import PMO, UIO, GInverseObserver, LuenbergerObserver, Observer
 from ..plant import Plant
 from ..reconstruction import InputEstimate
@@ -79,7 +80,7 @@ _DTYPES = {"bool": "?", "int64": "<i8", "float64": "<f8", "complex128": "<c16"}
 _TAG = "__uio__"
 
 
-class AnswerError(ValueError):
+class AnswerError(UIOTeachError, ValueError):
     """The data is not a valid answer export (one line, never the data itself)."""
 
 

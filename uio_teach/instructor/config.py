@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .._display import format_poles
+from ..errors import UIOTeachError
 from ..existence import check_existence
 from ..experiments import (
     EXPERIMENTS,
@@ -65,7 +66,7 @@ __all__ = [
 ]
 
 
-class ConfigError(ValueError):
+class ConfigError(UIOTeachError, ValueError):
     """A configuration that cannot be used: one line per problem, each naming its key.
 
     Parameters

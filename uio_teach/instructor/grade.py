@@ -55,6 +55,7 @@ import nbformat
 
 from ..checks.answers import AnswerError, from_data
 from ..checks.grading import GRADED, Missing, grade_answers, lab_plant
+from ..errors import UIOTeachError, UIOTeachWarning
 from .gradebook import (
     FAIL,
     PASS,
@@ -94,7 +95,7 @@ _GROUP_NAME = re.compile(r"^(?P<lab>.+?)_(?P<group>g\d+)$")
 _CHECKING = threading.Lock()  # the checks run one at a time in the grader's process
 
 
-class GradeError(ValueError):
+class GradeError(UIOTeachError, ValueError):
     """Grading cannot start (a missing answer key, an unreadable key, a bad option); one line."""
 
 
@@ -102,7 +103,7 @@ class SandboxRefused(GradeError):
     """Submissions cannot be isolated here, and running them unisolated was not asked for."""
 
 
-class UnsandboxedWarning(UserWarning):
+class UnsandboxedWarning(UIOTeachWarning):
     """The submissions run with the grader's permissions (``sandbox=False``)."""
 
 

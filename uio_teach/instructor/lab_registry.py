@@ -22,12 +22,13 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..errors import UIOTeachError
 from .lab_params import CaseStudyParams, MissileParams, PA9Params
 
 __all__ = ["LABS", "Lab", "LabError", "LabUsageError", "lab_of"]
 
 
-class LabError(ValueError):
+class LabError(UIOTeachError, ValueError):
     """A lab chapter that cannot be converted (one-line message naming the file)."""
 
 

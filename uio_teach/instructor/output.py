@@ -47,6 +47,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .. import __version__
+from ..errors import UIOTeachError
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -79,7 +80,7 @@ FORMATS = ("png", "pdf", "svg")
 _SVG_HASHSALT = "uio-teach"
 
 
-class OutputError(OSError):
+class OutputError(UIOTeachError, OSError):
     """The output folder cannot be created or written to."""
 
 

@@ -41,6 +41,8 @@ from pathlib import Path
 
 import uio_teach
 
+from ..errors import UIOTeachError
+
 __all__ = ["Limits", "Sandbox", "SandboxUnavailable", "sandbox_problem", "BWRAP", "HOME"]
 
 BWRAP = "bwrap"
@@ -61,7 +63,7 @@ _ETC = (
 )
 
 
-class SandboxUnavailable(RuntimeError):
+class SandboxUnavailable(UIOTeachError, RuntimeError):
     """Isolation is not available on this machine (one line saying why)."""
 
 

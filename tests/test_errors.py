@@ -1,0 +1,52 @@
+"""The package's errors share one base (numeric ones stay ValueErrors), its warnings another."""
+
+from __future__ import annotations
+
+import pytest
+
+import uio_teach as ut
+from uio_teach.checks.answers import AnswerError
+from uio_teach.instructor.config import ConfigError
+from uio_teach.instructor.grade import GradeError, SandboxRefused, UnsandboxedWarning
+from uio_teach.instructor.lab_registry import LabError, LabUsageError
+from uio_teach.instructor.output import FolderBusy, OutputError
+from uio_teach.instructor.sandbox import SandboxUnavailable
+
+# each error with the built-in class that says what went wrong
+ERRORS = {
+    ut.LMIError: ValueError,
+    ut.LMIInfeasibleError: ValueError,
+    ut.LMISolverError: ValueError,
+    ut.SimulationOverflowError: OverflowError,
+    ConfigError: ValueError,
+    AnswerError: ValueError,
+    LabError: ValueError,
+    LabUsageError: ValueError,
+    GradeError: ValueError,
+    SandboxRefused: ValueError,
+    OutputError: OSError,
+    FolderBusy: OSError,
+    SandboxUnavailable: RuntimeError,
+}
+
+
+@pytest.mark.parametrize("error", list(ERRORS), ids=lambda e: e.__name__)
+def test_every_error_has_the_common_base_and_its_builtin_kind(error):
+    assert issubclass(error, ut.UIOTeachError)
+    assert issubclass(error, ERRORS[error])
+
+
+def test_warnings_have_the_common_base():
+    assert issubclass(UnsandboxedWarning, ut.UIOTeachWarning)
+    assert issubclass(ut.UIOTeachWarning, UserWarning)
+
+
+def test_one_except_catches_a_bad_config_and_an_infeasible_lmi():
+    from uio_teach.instructor.config import FigureConfig
+
+    with pytest.raises(ut.UIOTeachError, match="seed: must be >= 0"):
+        FigureConfig.from_dict({"seed": -1})
+    # the case study's fixed modes sit at radius 0.5: no gain certifies a radius of 0.3
+    with pytest.raises(ut.UIOTeachError) as err:
+        ut.design_pmo(ut.examples.dt_case_study(), method="lmi", decay=0.3)
+    assert isinstance(err.value, ut.LMIError)
