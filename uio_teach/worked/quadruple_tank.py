@@ -23,6 +23,7 @@ invariant zero lies in the right half-plane at 0.0225, and no UIO with a stable 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -181,17 +182,20 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
     Examples
     --------
     >>> from uio_teach.worked.quadruple_tank import valve_verdict
-    >>> print(valve_verdict(0.5, 0.5))   # doctest: +NORMALIZE_WHITESPACE
+    >>> print(valve_verdict(0.7, 0.3))   # doctest: +NORMALIZE_WHITESPACE
     gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike, an invariant zero
     sits at the origin (to round-off), and no UIO with a stable error exists
+    >>> valve_verdict(0.5, 0.5 + 1e-6)[:43]
+    'gamma1 + gamma2 = 1.000001 > 1: the pumps f'
     """
     report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2))
     zeros = np.sort(report.invariant_zeros.real)
     total = gamma1 + gamma2
-    digits = 3 if abs(total - 1) >= 5e-3 else 12  # close to 1: enough digits to tell the side
-    if total == 1:
+    if abs(total - 1) <= 4 * np.finfo(float).eps:  # 0.7 + 0.3 is 1 to round-off
         head = "gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike"
     else:
+        # close to 1: enough digits to tell the side
+        digits = max(3, 2 + math.ceil(-math.log10(abs(total - 1))))
         more, less = ("lower", "upper") if total > 1 else ("upper", "lower")
         sign = ">" if total > 1 else "<"
         head = (
