@@ -16,6 +16,10 @@ figure, explorer and lab that uses it.
   the poles ``-100, -120``, the paper's unknown inputs ``v1, v2`` and initial
   state, the observer started at ``q(0) = -M C x(0)`` (so ``xhat(0) = 0``).
 
+A worked example added later keeps its experiment beside its registry entry (the quadruple
+tank's is :data:`uio_teach.worked.quadruple_tank.QUADRUPLE_TANK`); :data:`EXPERIMENTS` holds
+them all, read from :data:`uio_teach.worked.WORKED`.
+
 Each is a frozen dataclass; :meth:`Experiment.simulate` runs an observer on it
 with :func:`uio_teach.simulate`. The numbers an instructor may change are
 fields declared once with :func:`param` (type, unit, help, bounds, range): the
