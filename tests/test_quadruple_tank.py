@@ -210,3 +210,17 @@ def test_the_valve_sliders_of_the_live_explorer():
     ex.set(gamma1=0.7, gamma2=0.6)
     assert ex.frame.observer_message == "" and ex.frame.poles.size == 4
     ex.close()
+
+
+def test_the_static_explorer_slides_the_valve_across_the_line():
+    from uio_teach.explorers.static import static_explorer
+
+    scenario = scenario_of("quadruple_tank")
+    assert scenario.static_plant_control.name == "gamma2"
+    page = static_explorer(scenario, values=(0.2, 0.6), disturbances=("sinusoid",), narrow=False)
+    below, above = page.frames
+    assert below.caption.startswith("gamma1 + gamma2 = 0.9 < 1")
+    assert "no UIO exists" in below.caption
+    assert above.caption.startswith("gamma1 + gamma2 = 1.3 > 1") and "no UIO" not in above.caption
+    assert below.png != above.png
+    assert "gamma2 (gamma1 0.7)" in page.html

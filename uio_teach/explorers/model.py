@@ -260,9 +260,11 @@ class Scenario:
         controls.
     static_values : tuple of float
         The values of the main control in the static book's frames.
-    static_control : {"pole", "amplitude"}
-        The main control: the first movable pole, or (no movable pole) the
-        disturbance amplitude.
+    static_control : str
+        The main control: ``"pole"``, the first movable pole; ``"amplitude"``
+        (no movable pole), the disturbance amplitude; or ``"plant:<name>"``,
+        the plant control ``<name>`` of ``plant_controls`` (each of the static
+        book's frames then has its own plant).
     input_symbol : str
         The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
         the missile paper).
@@ -327,6 +329,17 @@ class Scenario:
     def invariant_zeros(self) -> np.ndarray:
         """The plant's invariant zeros from the unknown inputs to the outputs."""
         return self.existence.invariant_zeros
+
+    @property
+    def static_plant_control(self) -> PlantControl | None:
+        """The plant control the static book's slider moves (``None``: a pole or the amplitude)."""
+        if not self.static_control.startswith("plant:"):
+            return None
+        name = self.static_control.split(":", 1)[1]
+        for control in self.plant_controls:
+            if control.name == name:
+                return control
+        raise ValueError(f"static_control names no plant control: {self.static_control!r}")
 
     @property
     def discrete(self) -> bool:

@@ -423,8 +423,10 @@ def experiment_scenario(name: str, **plant_values: float) -> Scenario:
     (:func:`plant_controls`); the rest from the entry's ``explorer`` options:
     ``title``, ``samples``, ``period``, ``pole_limits``, ``frequency_limits``,
     ``period_limits``, ``noise_limits``, ``d_channels`` (``(gain, speed)`` per
-    unknown input), ``static_values`` and ``note`` (``"module:function"``
-    called with the physical parameters: a sentence on this plant).
+    unknown input), ``static_control`` and ``static_values`` (the static
+    book's slider: ``"pole"``, or ``"plant:<name>"`` for a physical
+    parameter) and ``note`` (``"module:function"`` called with the physical
+    parameters: a sentence on this plant).
 
     Parameters
     ----------
@@ -476,7 +478,7 @@ def experiment_scenario(name: str, **plant_values: float) -> Scenario:
         decay_limits=None,
         d_channels=tuple(Channel(gain=g, speed=v) for g, v in channels),
         v_channels=(),
-        static_control="pole",
+        static_control=options.pop("static_control", "pole"),
         plant_controls=plant_controls(run),
         rebuild=functools.partial(experiment_scenario, name),
         note=resolve(note)(**physical) if note else "",

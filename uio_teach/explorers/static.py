@@ -151,6 +151,10 @@ def main_control_label(scenario: Scenario, settings: Settings) -> str:
     """The label of the static slider (internal helper)."""
     if scenario.static_control == "amplitude":
         return "disturbance amplitude"
+    plant = scenario.static_plant_control
+    if plant is not None:
+        others = [f"{c.label} {c.value:g}" for c in scenario.plant_controls if c is not plant]
+        return plant.label + (f" ({', '.join(others)})" if others else "")
     name = scenario.observer_name
     others = [format_complex(p, 3) for p in settings.poles[1:]]
     if not others:
@@ -188,12 +192,15 @@ def frame_settings(
     """
     if scenario.static_control == "amplitude":
         return settings.replace(amplitude=float(value), disturbance=disturbance, mode="poles")
+    if scenario.static_plant_control is not None:  # the plant changes, the controls stay
+        return settings.replace(disturbance=disturbance, mode="poles")
     poles = (float(value), *settings.poles[1:])
     return settings.replace(poles=poles, disturbance=disturbance, mode="poles")
 
 
 def frame_caption(frame: Frame) -> str:
-    """The caption of a static frame: the disturbance, the poles, every message, the explanation.
+    """The caption of a static frame: the plant's note, the disturbance, the poles, every message,
+    the explanation.
 
     Parameters
     ----------
@@ -217,6 +224,8 @@ def frame_caption(frame: Frame) -> str:
         parts.append(f"{name} poles: {format_poles(frame.poles, 3)}")
     parts += frame.all_messages
     text = " ".join(p[:1].upper() + p[1:] + "." for p in parts)
+    if frame.scenario.note:  # a sentence on this plant, as written (it may start with a symbol)
+        text = f"{frame.scenario.note}. {text}"
     if frame.explanation:
         text = (text + " " if text else "") + frame.explanation
     return text
@@ -346,45 +355,53 @@ def static_explorer(
     bad = [d for d in disturbances if d not in DISTURBANCES]
     if bad:
         raise ValueError(f"unknown disturbance type(s) {bad}; choose from {DISTURBANCES}")
-    current = base.amplitude if scenario.static_control == "amplitude" else _first_pole(base)
+    plant_control = scenario.static_plant_control
+    if scenario.static_control == "amplitude":
+        current = base.amplitude
+    elif plant_control is not None:
+        current = plant_control.value
+    else:
+        current = _first_pole(base)
     i0 = int(np.argmin([abs(v - current) for v in values]))
     j0 = disturbances.index(base.disturbance) if base.disturbance in disturbances else 0
 
-    # static frames never use the LMI mode: the certified envelope is not in their legend
-    figure = ExplorerFigure(scenario, dpi=dpi, sticky=False, fontscale=WIDE_FONTSCALE, lmi=False)
-    phone = (
-        ExplorerFigure(
-            scenario,
-            dpi=NARROW_DPI,
-            sticky=False,
-            fontscale=NARROW_FONTSCALE,
-            narrow=True,
-            lmi=False,
+    def figures(sc: Scenario) -> tuple[ExplorerFigure, ExplorerFigure | None]:
+        # static frames never use the LMI mode: the certified envelope is not in their legend
+        wide = ExplorerFigure(sc, dpi=dpi, sticky=False, fontscale=WIDE_FONTSCALE, lmi=False)
+        if not narrow:
+            return wide, None
+        small = ExplorerFigure(
+            sc, dpi=NARROW_DPI, sticky=False, fontscale=NARROW_FONTSCALE, narrow=True, lmi=False
         )
-        if narrow
-        else None
-    )
-    frames = []
-    for j, kind in enumerate(disturbances):
-        for i, value in enumerate(values):
+        return wide, small
+
+    # a plant control remakes the plant, its zeros and the figure for each value
+    remake = plant_control is not None and scenario.rebuild is not None
+    made: dict[tuple[int, int], StaticFrame] = {}
+    figure, phone = figures(scenario)
+    for i, value in enumerate(values):
+        plant_scenario = scenario
+        if remake:
+            plant_scenario = scenario.rebuild(**{plant_control.name: value})
+            figure, phone = figures(plant_scenario)
+        for j, kind in enumerate(disturbances):
             s = frame_settings(scenario, base, value, kind)
-            frame = compute_frame(scenario, s)
+            frame = compute_frame(plant_scenario, s)
             figure.update(frame)
             small = b""
             if phone is not None:
                 phone.update(frame)
                 small = _png(phone, colors)
-            frames.append(
-                StaticFrame(
-                    index=(i, j),
-                    settings=s,
-                    png=_png(figure, colors),
-                    caption=frame_caption(frame),
-                    label=f"{value:g}",
-                    alt=frame_alt(frame, main_control_label(scenario, base), f"{value:g}"),
-                    png_narrow=small,
-                )
+            made[(i, j)] = StaticFrame(
+                index=(i, j),
+                settings=s,
+                png=_png(figure, colors),
+                caption=frame_caption(frame),
+                label=f"{value:g}",
+                alt=frame_alt(frame, main_control_label(scenario, base), f"{value:g}"),
+                png_narrow=small,
             )
+    frames = [made[(i, j)] for j in range(len(disturbances)) for i in range(len(values))]
     eid = element_id or f"uio-explorer-{scenario.name}-{next(_IDS)}"
     text = _html(scenario, base, frames, values, disturbances, i0, j0, eid)
     return StaticExplorer(html=text, frames=tuple(frames), element_id=eid)

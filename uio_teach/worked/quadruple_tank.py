@@ -315,7 +315,9 @@ EXAMPLES = (
                 "period_limits": (10.0, 300.0),
                 "noise_limits": (0.0, 0.2),
                 "d_channels": ((1.0, 1.0), (0.5, 1.5)),
-                "static_values": (-0.4, -0.2, -0.1, -0.05, -0.02, 0.02),
+                # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3)
+                "static_control": "plant:gamma2",
+                "static_values": (0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
                 "note": f"{__name__}:valve_verdict",
             }
         ),
