@@ -735,7 +735,7 @@ OBSERVER_KEYS: Mapping[str, str] = _ObserverKeys()
 def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
     """The observer that a poles key of the config sets (validated poles in, observer out).
 
-    The worked example's observer family (:attr:`uio_teach.worked.WorkedExample.family`)
+    The worked example's observer family (``WorkedExample.family``)
     is designed for the plant of its experiment with the config's values in place
     (:func:`uio_teach.worked.run_from_config`: a physical parameter such as a
     valve changes the plant); a PMO without poles takes the LMI's gain.

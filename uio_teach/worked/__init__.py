@@ -12,7 +12,7 @@ has one, its lab chapter. From these entries come
 * the figures of ``uio-teach figures`` (``uio_teach.instructor.figures``), each
   drawn from the experiment with the config's values in place
   (:func:`run_from_config`);
-* the explorer of each example (:meth:`WorkedExample.scenario`), whose sliders
+* the explorer of each example (``WorkedExample.make_scenario``), whose sliders
   for physical parameters are the experiment's fields passed to the plant
   factory that declare a ``range``.
 
@@ -121,7 +121,7 @@ class WorkedExample:
         ``"module:function"`` returning the explorer's scenario (``None``: made
         from the experiment and ``explorer`` by
         ``uio_teach.explorers.scenarios.experiment_scenario``).
-    explorer : mapping
+    explorer : dict
         The explorer's options beyond the experiment's declarations (ranges of
         the poles, the channels of ``d``, ...; see ``experiment_scenario``).
     figures : tuple of FigureEntry
@@ -229,7 +229,7 @@ def run_from_config(name: str, config: Mapping[str, Any]) -> Any:
         The worked example (a key of :data:`WORKED`).
     config : mapping
         Dotted config keys to validated values
-        (:class:`uio_teach.instructor.config.FigureConfig`).
+        (``uio_teach.instructor.config.FigureConfig``).
 
     Returns
     -------
