@@ -321,6 +321,12 @@ class Experiment:
     help, bounds), from which the term config, the lab parameters and the
     explorers are derived (:func:`experiment_params`).
 
+    Each experiment class also says ``lab``, the worked example's name in
+    :data:`uio_teach.worked.WORKED` (its config table, and its lab's id when it
+    has one), ``tables``, the comments of its config tables, and
+    ``plant_fields``, the fields passed to the worked example's plant factory
+    as keywords (physical parameters, such as the valves of the quadruple tank).
+
     Attributes
     ----------
     name : str
@@ -344,12 +350,6 @@ class Experiment:
     matrices : tuple
         The plant's own matrices as ``(name, rows)`` pairs (empty: the course's
         plant); :meth:`plant` puts them in place.
-
-    Class attributes: ``lab``, the worked example's name in
-    :data:`uio_teach.worked.WORKED` (its config table, and its lab's id when it
-    has one); ``tables``, the comments of its config tables; ``plant_fields``,
-    the fields passed to the worked example's plant factory as keywords
-    (physical parameters, such as the valves of the quadruple tank).
 
     Examples
     --------
@@ -978,8 +978,10 @@ class _FromRegistry(Mapping):
 
 
 EXPERIMENTS: Mapping[str, Experiment] = _FromRegistry("experiments")
-"""The experiment of every worked example, by name (the tables of the term config): ``PA9``,
-``CASE_STUDY``, ``MISSILE``, ... (a view of :data:`uio_teach.worked.WORKED`)."""
+"""The experiment of every worked example, by name.
+
+The names are the tables of the term config; the values ``PA9``, ``CASE_STUDY``, ``MISSILE``
+and the later worked examples' (a view of :data:`uio_teach.worked.WORKED`)."""
 
 
 LAB_PLANTS: Mapping[str, Callable[[], Plant]] = _FromRegistry("lab plants")

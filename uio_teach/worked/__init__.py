@@ -114,9 +114,9 @@ class WorkedExample:
         listed in ``Experiment.plant_fields`` are passed to it as keywords.
     experiment : str
         ``"module:NAME"`` of the experiment (:mod:`uio_teach.experiments`).
-    family : {"uio", "pmo"}
-        The observer that the experiment's ``poles`` set (``None`` poles of a
-        PMO: the LMI gain).
+    family : str
+        The observer that the experiment's ``poles`` set: ``"uio"`` or
+        ``"pmo"`` (``None`` poles of a PMO: the LMI gain).
     scenario : str or None
         ``"module:function"`` returning the explorer's scenario (``None``: made
         from the experiment and ``explorer`` by

@@ -57,8 +57,10 @@ class QuadrupleTankExperiment(Experiment):
 
     Attributes
     ----------
-    gamma1, gamma2 : float
-        The valve splits (strictly between 0 and 1); passed to the plant.
+    gamma1 : float
+        Valve 1's split (strictly between 0 and 1); passed to the plant.
+    gamma2 : float
+        Valve 2's split.
     step_size : float
         Pump 1's unknown deviation: a step of this many volts ...
     step_time : float
@@ -164,7 +166,9 @@ class QuadrupleTankExperiment(Experiment):
 QUADRUPLE_TANK = QuadrupleTankExperiment(
     name="quadruple-tank", timepts=np.linspace(0.0, 600.0, 1201)
 )
-"""The run of the quadruple tank: 600 s on 1201 points, the valves of P-, UIO poles -0.1, -0.2."""
+"""The run of the quadruple tank.
+
+600 s on 1201 points, the valves of P-, UIO poles -0.1, -0.2."""
 
 
 def valve_verdict(gamma1: float, gamma2: float) -> str:
