@@ -114,6 +114,13 @@ class _Runs:
         """The experiment of the worked example ``name`` with the config's values."""
         return run_from_config(name, self.cfg)
 
+    def shared(self, key: str, compute: Callable[[], Any]) -> Any:
+        """``compute()`` once for all the figures that ask for ``key`` (a worked example's runs)."""
+        cache = self.__dict__.setdefault("_shared", {})
+        if key not in cache:
+            cache[key] = compute()
+        return cache[key]
+
     # PA9 --------------------------------------------------------------------------------------
     @cached_property
     def pa9(self) -> dict[str, Any]:

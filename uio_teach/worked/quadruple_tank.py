@@ -38,7 +38,7 @@ from ..existence import check_existence
 from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
 from ..luenberger import luenberger_poles
 from ..observers import design_luenberger, design_uio
-from . import FigureEntry, WorkedExample, run_from_config
+from . import FigureEntry, WorkedExample
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -225,21 +225,22 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
 
 
 def _run(runs: Any) -> dict[str, Any]:
-    """The tank's run of the figures (computed once per ``runs``)."""
-    cache = runs.__dict__.setdefault("_worked", {})
-    if "quadruple_tank" not in cache:
-        run = run_from_config("quadruple_tank", runs.cfg)
+    """The tank's runs of the figures, computed once for both (``runs.shared``)."""
+
+    def compute() -> dict[str, Any]:
+        run = runs.run("quadruple_tank")
         plant = run.plant()
         uio = design_uio(plant, poles=list(run.poles))  # the config checked that it exists
         luen = design_luenberger(plant, poles=luenberger_poles(plant, uio.poles()))
-        cache["quadruple_tank"] = {
+        return {
             "run": run,
             "plant": plant,
             "uio": uio,
             "uio_run": run.simulate(uio),
             "luen_run": run.simulate(luen),
         }
-    return cache["quadruple_tank"]
+
+    return runs.shared("quadruple_tank", compute)
 
 
 def _figure_error(runs: Any) -> Figure:
