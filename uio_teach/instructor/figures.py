@@ -1,8 +1,11 @@
 """Regenerate every figure of the course, deterministically, from a small TOML configuration.
 
-This module is the registry that ``uio-teach figures`` runs (see
+This module draws what ``uio-teach figures`` runs (see
 :mod:`uio_teach.instructor.cli`).
-Each figure has a name and a one-line description in :data:`FIGURES`; the
+Each figure has a name and a one-line description in :data:`FIGURES`, read
+from the registry of worked examples (``uio_teach.worked.WORKED``): a worked
+example lists its figures in its entry, and each is drawn from its experiment
+with the config's values in place (``uio_teach.worked.run_from_config``); the
 numbers come from the package (:func:`uio_teach.simulate`,
 :func:`uio_teach.reconstruct_input`, :func:`uio_teach.catch_time`), the
 drawing from matplotlib's object API (no pyplot, no GUI backend).
