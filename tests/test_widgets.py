@@ -32,6 +32,7 @@ EXPLORERS = {
     "pa9": widgets.pa9_explorer,
     "case": widgets.case_study_explorer,
     "missile": widgets.missile_explorer,
+    "quadruple tank": lambda static=False: widgets.tank_explorer(static=static),
     "own plant": lambda static=False: widgets.explorer(
         ut.Plant(
             [[0, 1], [-2, -1]], [[1, 0], [0, 1]], E=[[0], [1]], D=[[0.5], [1]], name="my plant"
