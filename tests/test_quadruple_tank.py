@@ -224,3 +224,17 @@ def test_the_static_explorer_slides_the_valve_across_the_line():
     assert above.caption.startswith("gamma1 + gamma2 = 1.3 > 1") and "no UIO" not in above.caption
     assert below.png != above.png
     assert "gamma2 (gamma1 0.7)" in page.html
+
+
+def test_at_the_unstable_end_of_the_pole_slider_the_error_grows_and_the_words_say_so():
+    from uio_teach.explorers import error_grows
+
+    scenario = scenario_of("quadruple_tank")
+    p = scenario.pole_limits[1]
+    assert p > 0
+    frame = compute_frame(scenario, scenario.defaults.replace(poles=(p, -0.2)))
+    assert error_grows(frame.response.error)
+    assert "the error grows" in frame.observer_message
+    shown = np.abs(frame.curves["uio.error"])
+    N = shown.shape[1]
+    assert shown[:, -N // 10 :].max() > 1.5 * shown[:, : N // 10].max()

@@ -315,7 +315,7 @@ EXAMPLES = (
                 "title": "Quadruple tank",
                 "samples": 601,
                 "period": 100.0,
-                "pole_limits": (-0.5, 0.05),
+                "pole_limits": (-0.5, 0.01),
                 "frequency_limits": (0.0, 0.5),
                 "period_limits": (10.0, 300.0),
                 "noise_limits": (0.0, 0.2),
