@@ -5,10 +5,10 @@ unknown inputs (``E = B``, :func:`uio_teach.examples.quadruple_tank`). The
 valves ``gamma1, gamma2`` decide whether a UIO exists: the invariant zeros
 solve ``(1 + s T3)(1 + s T4) = (1 - gamma1)(1 - gamma2) / (gamma1 gamma2)``,
 and one of them is at the origin when ``gamma1 + gamma2 = 1`` and in the
-right half-plane below. This module is the whole of the worked example in the
-package: the experiment (:data:`QUADRUPLE_TANK`, its fields the config table
-``[quadruple_tank]``), its figures, its explorer (with a slider per valve) and
-its registry entry.
+right half-plane below. With the plant in :mod:`uio_teach.examples`, this
+module is the whole of the worked example in the package: the experiment
+(:data:`QUADRUPLE_TANK`, its fields the config table ``[quadruple_tank]``),
+its figures, its explorer's options (a slider per valve) and its registry entry.
 
 Examples
 --------
