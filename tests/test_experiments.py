@@ -84,6 +84,7 @@ def test_simulate_overrides_any_keyword():
 # one place: the figures, explorers and checks read these values --------------------------------
 
 
+@pytest.mark.subprocess
 def test_changing_an_experiment_changes_the_figures_explorers_and_checks():
     """One place: a new PA9 initial state reaches the figures, the explorer and a check."""
     code = """

@@ -254,6 +254,7 @@ def test_figure_is_updated_in_place(scenario):
     assert_same(ef.lines["lb.residual"][-1].get_ydata(), frame.curves["lb.residual"][-1])
 
 
+@pytest.mark.slow
 def test_fast_draw_matches_a_full_draw(scenario):
     """Blitting and partial redraws give (almost exactly) the picture of a full draw."""
     ef = ExplorerFigure(scenario, dpi=60)
@@ -317,6 +318,7 @@ def _settings_strategy(sc):
 
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
+@pytest.mark.slow
 def test_every_setting_gives_a_picture_or_a_message(name):
     sc = SCENARIOS[name]()
     ef = ExplorerFigure(sc, dpi=40)

@@ -5,6 +5,8 @@ decide whether it passed."""
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -380,25 +382,58 @@ def test_the_clock_check_follows_values_through_fixtures(tmp_path):
 # markers ----------------------------------------------------------------------------------------
 
 
-def test_a_test_that_reaches_a_kernel_through_a_helper_or_fixture_is_found(tmp_path):
+def test_each_process_is_classified_by_what_it_starts():
     import conftest
 
-    path = tmp_path / "test_x.py"
-    path.write_text(
-        textwrap.dedent(
-            """\
-            import nbclient
-            def execute(nb):
-                nbclient.NotebookClient(nb).execute()
-            def solved():
-                return execute({})
-            def test_runs(solved):
-                assert solved
-            def test_pure():
-                assert 1 + 1 == 2
-            """
-        )
-    )
-    reach = conftest.reached_names(path)
-    assert "nbclient" in reach["test_runs"]
-    assert "nbclient" not in reach["test_pure"]
+    python = sys.executable
+    assert conftest.needs_of([python, "-m", "ipykernel_launcher", "-f", "k.json"]) == {
+        "subprocess",
+        "kernel",
+    }
+    assert conftest.needs_of([python, "-m", "uio_teach", "grade", "a.ipynb"]) >= {"kernel"}
+    assert conftest.needs_of(["/venv/bin/jupyter-book", "build", "."]) >= {"book"}
+    assert conftest.needs_of([python, "-m", "sphinx", "-b", "html", "src", "out"]) >= {"book"}
+    driver = "/venv/lib/site-packages/playwright/driver/node"
+    assert conftest.needs_of([driver, "cli.js", "run-driver"]) >= {"browser"}
+    assert conftest.needs_of([python, "-m", "pip", "wheel", "."]) >= {"wheel"}
+    assert conftest.needs_of([python, "-c", "print(1)"]) == {"subprocess"}
+    assert conftest.needs_of("jupyter-book build .") >= {"subprocess"}
+
+
+class _Item:
+    """The parts of a test item the guard reads."""
+
+    def __init__(self, *marks: str) -> None:
+        self.nodeid = "tests/test_x.py::test_x"
+        self.stash = pytest.Stash()
+        self._marks = [getattr(pytest.mark, m).mark for m in marks]
+
+    def iter_markers(self):
+        return iter(self._marks)
+
+
+def test_a_process_started_without_its_marker_fails_the_test():
+    import conftest
+
+    book = ["jupyter-book", "build", "."]
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.book"):
+        conftest.check_launch(book, _Item())
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.subprocess"):
+        conftest.check_launch([sys.executable, "-c", "pass"], _Item("slow"))
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.kernel"):
+        conftest.check_launch([sys.executable, "-m", "ipykernel_launcher"], _Item("book"))
+    refused = _Item("browser")
+    with pytest.raises(pytest.fail.Exception):
+        conftest.check_launch(book, refused)
+    assert refused.stash[conftest._violations]  # failed even if the exception is swallowed
+    conftest.check_launch(book, _Item("book"))
+    conftest.check_launch([sys.executable, "-c", "pass"], _Item("subprocess"))
+    with pytest.raises(RuntimeError, match="at import time"):
+        conftest.check_launch(book, None)  # at collection
+    conftest.check_launch([sys.executable, "-c", "pass"], None)  # a probe of the machine
+
+
+def test_the_guard_is_installed_on_every_process_start():
+    import conftest
+
+    assert subprocess.Popen._execute_child is conftest._guarded_execute_child

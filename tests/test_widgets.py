@@ -121,6 +121,7 @@ def test_pa9_complex_pair_and_disturbance_controls():
     assert ex.frame.observer is not None
 
 
+@pytest.mark.slow
 def test_case_study_pole_and_lmi_mode():
     ex = widgets.case_study_explorer(static=False)
     ex.set(start="zero observer state")  # q(0) = 0, as simulate's default
@@ -147,6 +148,7 @@ def test_case_study_pole_and_lmi_mode():
     assert ex.figure.lines["uio.error"][0].get_xdata().size == 0
 
 
+@pytest.mark.slow
 def test_missile_filter_slider_redraws_the_reconstruction():
     ex = widgets.missile_explorer(static=False)
     ex.set(start="zero observer state")  # q(0) = 0, as simulate's default
@@ -176,6 +178,7 @@ def test_unstable_pole_message_in_the_widget():
     assert np.abs(ydata(ex, "uio.error")).max() <= ex.frame.limits["error"]
 
 
+@pytest.mark.slow
 def test_mimebundle_has_the_widget_and_the_static_frames():
     ex = widgets.case_study_explorer()
     bundle = ex._repr_mimebundle_()
@@ -186,6 +189,7 @@ def test_mimebundle_has_the_widget_and_the_static_frames():
     assert "text/html" not in widgets.case_study_explorer(static=False)._repr_mimebundle_()
 
 
+@pytest.mark.subprocess
 def test_lazy_import():
     import subprocess
     import sys
@@ -212,6 +216,7 @@ def _choices(control):
 
 
 @pytest.mark.parametrize("name", sorted(EXPLORERS))
+@pytest.mark.slow
 def test_every_control_value_gives_a_picture_or_a_message(name):
     ex = EXPLORERS[name](static=False)
 
@@ -267,6 +272,7 @@ def pa9_static():
     return static_explorer(pa9_scenario())
 
 
+@pytest.mark.slow
 def test_static_frames_count_size_and_no_external_url(pa9_static):
     page = pa9_static
     # the pole positions times two disturbance types: the default one and a contrasting one
@@ -280,6 +286,7 @@ def test_static_frames_count_size_and_no_external_url(pa9_static):
     assert len(re.findall(r'data-k="\d+-\d+"', page.html)) == 16
 
 
+@pytest.mark.slow
 def test_static_ids_are_unique_and_frames_differ():
     grid = {"values": (0.0, 0.9), "disturbances": ("sinusoid",), "narrow": False}
     a = static_explorer(case_study_scenario(), **grid)
@@ -289,6 +296,7 @@ def test_static_ids_are_unique_and_frames_differ():
     assert a.frames[0].settings.poles == (0.0,) and a.frames[1].settings.poles == (0.9,)
 
 
+@pytest.mark.slow
 def test_static_missile_page_is_light():
     page = static_explorer(missile_scenario())
     assert page.count == 16
@@ -311,6 +319,7 @@ SET_RANGE = "el => { el.value = 'VALUE'; el.dispatchEvent(new Event('input', {bu
 
 
 @pytest.mark.browser
+@pytest.mark.slow
 def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
     if not CHROMIUM.exists():
         message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
@@ -381,6 +390,7 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
 # dragging poles: ipympl canvas when available, sliders alone otherwise ----------------------
 
 
+@pytest.mark.slow
 def test_drag_uses_an_ipympl_canvas_and_redraws_after_a_resize():
     pytest.importorskip("ipympl")
     ex = widgets.pa9_explorer(static=False, drag=True)
@@ -407,6 +417,7 @@ def test_without_the_widget_backend_the_sliders_work_alone(monkeypatch):
     assert ex.settings.poles[0] == -4.0
 
 
+@pytest.mark.slow
 def test_rerunning_a_cell_frees_the_previous_explorer():
     import gc
     import weakref
