@@ -1,0 +1,70 @@
+"""Tolerances of the tests, derived from the computation compared, never from this CPU's round-off.
+
+Floating-point results differ in their last bits between CPU models, BLAS kernels and thread
+counts (the order in which a sum is taken). A comparison of two floating-point results is
+therefore bounded by what rounding *can* produce in the computation, estimated from its size:
+
+    tolerance = MARGIN * eps * terms * steps * gain * size
+
+``size``
+    the largest term that enters the result (not the result: ``x - xhat`` is as uncertain as
+    ``x`` is large, however small the difference);
+``terms``
+    the number of terms summed into each entry (``n`` for a product with an ``n``-vector, ``n**2``
+    for a matrix exponential or a factorization of an ``n``-by-``n`` matrix);
+``steps``
+    the number of dependent stages (samples of a recursion, factors of a product);
+``gain``
+    how much the computation can amplify an error made on the way (the largest norm of the
+    error dynamics' transition matrix, a condition number).
+
+``eps * terms * steps * gain * size`` is the classical worst-case bound on the rounding of such a
+computation (Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 3); any IEEE-conforming
+BLAS, whatever its summation order, stays within it. ``MARGIN`` leaves a hundredfold room above
+it, so a failure means a wrong result, not another CPU.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+EPS = float(np.finfo(float).eps)
+MARGIN = 100.0
+
+
+def roundoff(size: float, *, terms: float = 1, steps: float = 1, gain: float = 1.0) -> float:
+    """``MARGIN`` times the worst rounding error of a computation of this ``size`` and shape."""
+    return MARGIN * EPS * float(terms) * float(steps) * max(float(gain), 1.0) * float(size)
+
+
+def size_of(*arrays: object) -> float:
+    """The largest absolute entry of ``arrays`` (at least the smallest normal number)."""
+    return max([float(np.max(np.abs(a), initial=0.0)) for a in arrays] + [np.finfo(float).tiny])
+
+
+def assert_rounding_close(
+    actual: object,
+    expected: object,
+    *,
+    size: float | None = None,
+    terms: float = 1,
+    steps: float = 1,
+    gain: float = 1.0,
+    what: str = "",
+) -> None:
+    """Assert that ``actual`` and ``expected`` differ by no more than rounding can explain.
+
+    ``size`` defaults to the larger of the two compared arrays (give it when the terms that
+    entered the computation were larger than its result).
+    """
+    actual = np.asarray(actual)
+    expected = np.broadcast_to(np.asarray(expected), actual.shape)
+    if size is None:
+        size = size_of(actual, expected)
+    tol = roundoff(size, terms=terms, steps=steps, gain=gain)
+    gap = float(np.max(np.abs(actual - expected), initial=0.0))
+    assert gap <= tol, (
+        f"{what + ': ' if what else ''}differ by {gap:.3g}, more than rounding explains: "
+        f"{tol:.3g} = {MARGIN:g} x eps x {terms:g} terms x {steps:g} steps x gain "
+        f"{max(gain, 1.0):.3g} x size {size:.3g}"
+    )
