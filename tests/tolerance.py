@@ -68,3 +68,30 @@ def assert_rounding_close(
         f"{tol:.3g} = {MARGIN:g} x eps x {terms:g} terms x {steps:g} steps x gain "
         f"{max(gain, 1.0):.3g} x size {size:.3g}"
     )
+
+
+def eigenvector_condition(F: object) -> float:
+    """``cond(V)`` of ``F = V diag(lambda) V^-1``: bounds ``||exp(F t)||`` (``||F^k||``) for a
+    stable ``F``, and how far rounding in the state can be amplified on the way."""
+    F = np.atleast_2d(np.asarray(F, float))
+    if F.size == 0:
+        return 1.0
+    return float(np.linalg.cond(np.linalg.eig(F)[1]))
+
+
+def assert_same_run(actual: object, expected: object, *runs: object, what: str = "") -> None:
+    """Two simulations (or quantities drawn from them) that must agree to rounding.
+
+    The size is the largest state or estimate of ``runs`` (errors and residuals are differences
+    of those), each of the samples is a product with the ``n``-state transition matrix (itself an
+    exponential: ``n**2`` terms), and the error dynamics amplify rounding by at most the
+    condition of their eigenvectors.
+    """
+    first = runs[0]
+    n = first.states.shape[0]
+    size = size_of(*(r.states for r in runs), *(r.estimates for r in runs))
+    observer = getattr(first, "observer", None)
+    gain = eigenvector_condition(observer.error_matrix) if observer is not None else 1.0
+    assert_rounding_close(
+        actual, expected, size=size, terms=n * n, steps=first.time.size, gain=gain, what=what
+    )
