@@ -95,3 +95,15 @@ def assert_same_run(actual: object, expected: object, *runs: object, what: str =
     assert_rounding_close(
         actual, expected, size=size, terms=n * n, steps=first.time.size, gain=gain, what=what
     )
+
+
+def assert_zero(residual: object, *factors: object, terms: float, gain: float = 1.0) -> None:
+    """An identity ``R = 0`` whose residual is formed from products of ``factors``.
+
+    The size of its terms is the product of the factors' 2-norms (the largest the entries of a
+    product can be); ``gain`` is the condition number of whatever was solved to build them.
+    """
+    size = 1.0
+    for factor in factors:
+        size *= float(np.linalg.norm(np.atleast_2d(np.asarray(factor, float)), 2))
+    assert_rounding_close(residual, 0.0, size=size, terms=terms, gain=gain)
