@@ -107,3 +107,21 @@ def assert_zero(residual: object, *factors: object, terms: float, gain: float = 
     for factor in factors:
         size *= float(np.linalg.norm(np.atleast_2d(np.asarray(factor, float)), 2))
     assert_rounding_close(residual, 0.0, size=size, terms=terms, gain=gain)
+
+
+def eigenvalue_roundoff(F: object) -> float:
+    """``MARGIN`` times the worst rounding of ``F``'s computed eigenvalues (absolute).
+
+    A backward-stable eigensolver returns the eigenvalues of ``F + dF`` with
+    ``||dF|| <= n eps ||F||``; an eigenvalue moves by at most its condition number
+    ``1 / |y^H x|`` (unit left and right eigenvectors) times that.
+    """
+    import scipy.linalg as sla
+
+    F = np.atleast_2d(np.asarray(F, float))
+    _, left, right = sla.eig(F, left=True, right=True)
+    left = left / np.linalg.norm(left, axis=0)
+    right = right / np.linalg.norm(right, axis=0)
+    with np.errstate(divide="ignore"):
+        kappa = 1.0 / np.abs(np.sum(left.conj() * right, axis=0))
+    return roundoff(np.linalg.norm(F, 2), terms=F.shape[0], gain=float(np.max(kappa)))
