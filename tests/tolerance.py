@@ -38,8 +38,10 @@ def roundoff(size: float, *, terms: float = 1, steps: float = 1, gain: float = 1
 
 
 def size_of(*arrays: object) -> float:
-    """The largest absolute entry of ``arrays`` (at least the smallest normal number)."""
-    return max([float(np.max(np.abs(a), initial=0.0)) for a in arrays] + [np.finfo(float).tiny])
+    """The largest finite absolute entry of ``arrays`` (at least the smallest normal number)."""
+    sizes = [np.abs(np.asarray(a, dtype=complex if np.iscomplexobj(a) else float)) for a in arrays]
+    finite = [float(np.max(s[np.isfinite(s)], initial=0.0)) for s in sizes]
+    return max([*finite, np.finfo(float).tiny])
 
 
 def assert_rounding_close(
