@@ -42,6 +42,11 @@ import pytest
 
 matplotlib.use("Agg")
 
+# jsonschema (under nbformat) builds the grammars of an optional IRI-syntax checker when it is
+# imported: seconds of collection for a format no notebook schema uses. The test process does
+# without it (jsonschema skips that format check when the module cannot be imported).
+sys.modules.setdefault("rfc3987_syntax", None)  # type: ignore[arg-type]
+
 ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
 # A clean build executes every chapter; this is a limit against a hung kernel, not a timing.
