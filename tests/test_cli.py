@@ -298,6 +298,7 @@ def test_a_bad_config_gives_one_line_and_exit_2(case, tmp_path, capsys):
     assert not out_dir.exists()  # nothing is made before the configuration is known good
 
 
+@pytest.mark.slow
 def test_a_triple_pole_makes_every_figure(tmp_path, capsys):
     # repeated poles are valid: the designs place them (a single-output design on w C)
     config = write(tmp_path, "[pa9]\npoles = [-1, -1, -1]\n")
@@ -343,6 +344,7 @@ def test_a_config_changes_the_figures_it_concerns(tmp_path, two_runs):
     assert (out / "missile_table2.md").read_bytes() == (default / "missile_table2.md").read_bytes()
 
 
+@pytest.mark.slow
 def test_the_noise_is_seeded(tmp_path):
     config = write(tmp_path, "seed = 3\n[pa9]\nnoise = 0.05\n")
     for label in ("a", "b"):

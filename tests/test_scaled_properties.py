@@ -117,6 +117,7 @@ def test_invariant_zeros_survive_similarity_scaling(case):
         assert matched_error(z0, z) * max(1.0, float(np.max(np.abs(z0)))) <= tol
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(scaled(n_min=2, n_max=6, p=1, q=0))
 def test_lmi_on_scaled_pairs_is_certified_or_refused(case):

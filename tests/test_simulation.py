@@ -255,6 +255,7 @@ def test_missile_agrees_with_a_tight_ode_solver(family):
     assert rel(run.error, x - xhat) < 1e-7
 
 
+@pytest.mark.slow
 def test_pa9_with_known_input_agrees_with_a_tight_ode_solver():
     plant = examples.pa9()
     obs = ut.design_uio(plant, poles=[-1, -2, -3])
