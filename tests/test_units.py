@@ -253,7 +253,8 @@ def test_design_of_size_40_with_6_outputs():
         warnings.simplefilter("ignore", ut.PlacementAccuracyWarning)
         obs = ut.design_uio(plant, poles=poles)
     assert same_values(obs.poles(), poles, rtol=1e-3)
-    assert d_leak(obs, np.ones(n)) < 1e-8
+    # T E = 0 to the rounding of n-term products with gains solved from C E
+    assert d_leak(obs, np.ones(n)) <= roundoff(1.0, terms=n, gain=np.linalg.cond(plant.C @ plant.E))
 
 
 def test_residual_with_a_measurement_disturbance_is_Ce_plus_Dv():
