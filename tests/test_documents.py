@@ -248,7 +248,8 @@ def test_missile_pmo_structural_identities():
     size = size_of(A) * size_of(pmo.M) + size_of(pmo.L) * (1 + size_of(C @ pmo.M))
     assert_rounding_close(pmo.G, G, size=size, terms=16, gain=np.linalg.cond(C @ E))
     poles = pmo.poles()
-    np.testing.assert_allclose(np.sort(poles[np.abs(poles.imag) < 1e-9].real), [-120, -100])
+    real = np.abs(poles.imag) <= eigenvalue_roundoff(pmo.F)  # real up to the eigensolver's rounding
+    np.testing.assert_allclose(np.sort(poles[real].real), [-120, -100])
 
 
 def test_missile_ginverse_structural_identities():

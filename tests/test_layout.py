@@ -437,3 +437,72 @@ def test_the_guard_is_installed_on_every_process_start():
     import conftest
 
     assert subprocess.Popen._execute_child is conftest._guarded_execute_child
+
+
+# tolerances -------------------------------------------------------------------------------------
+
+COMPARISONS = {"assert_allclose", "allclose", "isclose", "approx", "assert_array_almost_equal"}
+# Below this a hand-written tolerance is about the CPU's round-off, not the computation: such a
+# comparison goes through tests/tolerance.py, which derives it from the data.
+HAND_TOLERANCE_FLOOR = 1e-8
+TOLERANCE_ARGS = {"rtol", "atol", "abs", "rel"}
+
+
+def tight_hand_tolerances(path: Path) -> list[str]:
+    """Float comparisons in ``path`` with a literal tolerance below the floor."""
+
+    def tiny(node: ast.AST) -> bool:
+        return any(
+            isinstance(c, ast.Constant)
+            and isinstance(c.value, float)
+            and 0 < c.value < HAND_TOLERANCE_FLOOR
+            for c in ast.walk(node)
+        )
+
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Call):
+            func = node.func
+            name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if name in COMPARISONS:
+                bad = [k.arg for k in node.keywords if k.arg in TOLERANCE_ARGS and tiny(k.value)]
+                if bad:
+                    found.append(f"line {node.lineno}: {name}({', '.join(bad)}=...)")
+        elif isinstance(node, ast.Compare) and any(
+            isinstance(op, ast.Lt | ast.LtE) for op in node.ops
+        ):
+            if any(tiny(c) for c in node.comparators):
+                found.append(f"line {node.lineno}: a comparison with a constant below the floor")
+    return found
+
+
+def test_no_comparison_of_results_uses_a_hand_tolerance_tuned_to_round_off():
+    offenders = {
+        path.name: found
+        for path in sorted(TESTS.glob("test_*.py"))
+        if (found := tight_hand_tolerances(path))
+    }
+    assert not offenders, (
+        "tolerances below 1e-8 written by hand (use tests/tolerance.py, which derives them from "
+        f"the size, length and conditioning of the computation): {offenders}"
+    )
+
+
+def test_a_tight_hand_tolerance_is_found(tmp_path):
+    path = tmp_path / "test_x.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            import numpy as np
+            def test_a(a, b):
+                np.testing.assert_allclose(a, b, atol=1e-12)
+                np.testing.assert_allclose(a, b, rtol=1e-6)
+                assert abs(a - b) < 1e-11 * abs(b)
+                assert a == pytest.approx(b, rel=1e-3)
+            """
+        )
+    )
+    assert tight_hand_tolerances(path) == [
+        "line 3: assert_allclose(atol=...)",
+        "line 5: a comparison with a constant below the floor",
+    ]
