@@ -69,7 +69,11 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
     names = {Path(w).name for w in words}
     text = " ".join(words)
     needs = {"subprocess"}
-    if any("ipykernel" in w for w in words) or _module_command(words, "uio_teach", "grade"):
+    if (
+        any("ipykernel" in w for w in words)
+        or _module_command(words, "uio_teach", "grade")
+        or _runs_module(words, "uio_teach.instructor.runner")  # the grader's notebook runner
+    ):
         needs.add("kernel")
     if names & {"jupyter-book", "sphinx-build"} or _runs_module(words, "jupyter_book", "sphinx"):
         needs.add("book")

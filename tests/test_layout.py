@@ -391,6 +391,8 @@ def test_each_process_is_classified_by_what_it_starts():
         "kernel",
     }
     assert conftest.needs_of([python, "-m", "uio_teach", "grade", "a.ipynb"]) >= {"kernel"}
+    runner = ["bwrap", "--die-with-parent", python, "-m", "uio_teach.instructor.runner", "--run"]
+    assert conftest.needs_of(runner) >= {"kernel"}
     assert conftest.needs_of(["/venv/bin/jupyter-book", "build", "."]) >= {"book"}
     assert conftest.needs_of([python, "-m", "sphinx", "-b", "html", "src", "out"]) >= {"book"}
     driver = "/venv/lib/site-packages/playwright/driver/node"
