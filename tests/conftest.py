@@ -68,6 +68,8 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
     words = [os.fsdecode(a) if isinstance(a, bytes | os.PathLike) else str(a) for a in argv]
     names = {Path(w).name for w in words}
     text = " ".join(words)
+    if is_probe(words):
+        return set()
     needs = {"subprocess"}
     if (
         any("ipykernel" in w for w in words)
@@ -82,6 +84,15 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
     if (names & {"pip", "pip3"} or _runs_module(words, "pip", "build")) and "wheel" in words:
         needs.add("wheel")
     return needs
+
+
+def is_probe(words: list[str]) -> bool:
+    """A library's one-off look at the machine, cached for the process: ``tool --version``
+    (jupytext asks pandoc), the sandbox's ``bwrap ... /bin/true``. Whichever test happens to come
+    first would start it, so it needs no marker."""
+    if len(words) == 2 and words[1] == "--version":
+        return True
+    return bool(words) and Path(words[0]).name == "bwrap" and words[-1] == "/bin/true"
 
 
 def _runs_module(words: list[str], *modules: str) -> bool:
