@@ -32,6 +32,7 @@ test module that starts one at import time fails its collection.
 from __future__ import annotations
 
 import os
+import shlex
 import subprocess
 import sys
 from collections.abc import Iterator, Sequence
@@ -63,8 +64,11 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
     ``kernel``; jupyter-book or Sphinx ``book``; Chromium or Playwright's driver ``browser``; a
     wheel build ``wheel``.
     """
-    if isinstance(argv, str | bytes | os.PathLike):
-        argv = [argv]
+    if isinstance(argv, str | bytes | os.PathLike):  # a shell command line, or one program
+        try:
+            argv = shlex.split(os.fsdecode(argv))
+        except ValueError:
+            argv = [argv]
     words = [os.fsdecode(a) if isinstance(a, bytes | os.PathLike) else str(a) for a in argv]
     names = {Path(w).name for w in words}
     text = " ".join(words)

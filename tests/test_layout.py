@@ -401,7 +401,7 @@ def test_each_process_is_classified_by_what_it_starts():
     assert conftest.needs_of([python, "-c", "print(1)"]) == {"subprocess"}
     assert conftest.needs_of(["pandoc", "--version"]) == set()  # a cached probe of the machine
     assert conftest.needs_of(["/usr/bin/bwrap", "--ro-bind", "/", "/", "/bin/true"]) == set()
-    assert conftest.needs_of("jupyter-book build .") >= {"subprocess"}
+    assert conftest.needs_of("jupyter-book build . -W") >= {"book"}  # a shell command line
 
 
 class _Item:
