@@ -16,15 +16,16 @@ export PATH := $(abspath $(BIN)):$(PATH)
 .PHONY: help venv book book-instructor test lint clean
 
 # What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
-# build the book or the wheel, or take long (markers set in tests/conftest.py).
-QUICK := not kernel and not browser and not book and not wheel and not slow
+# build the book or the wheel, start any other process, or take long (the markers each test
+# module declares; tests/conftest.py lists them and fails a test that starts one undeclared).
+QUICK := not kernel and not browser and not book and not wheel and not subprocess and not slow
 
 help:
 	@echo "make book   build the HTML book into _build/html (warnings are errors)"
 	@echo "make book-instructor  the instructor edition (lab solutions, tutors' notes)"
 	@echo "            into _build/instructor/_build/html"
 	@echo "make test   lint, then run every test (package, chapters, book build, browser)"
-	@echo "make check  lint, then the tests that need no kernel, browser, book or wheel build"
+	@echo "make check  lint, then the quick tests: no kernel, browser, book, wheel or process"
 	@echo "make venv   create or update $(VENV) from the lock, requirements.txt"
 	@echo "make lint   ruff check and ruff format --check"
 	@echo "make lock   regenerate requirements.txt from requirements.in (pip-tools)"

@@ -1,34 +1,41 @@
-"""Shared set-up of the tests, and markers that say what each test needs.
+"""Shared set-up of the tests: the markers each test declares, and what holds them to it.
 
 Figures are drawn off screen (matplotlib's Agg backend), once for every test module.
 
-Each test is marked by what it needs, read from the test modules themselves (their module, the
-fixtures a test uses, and what its code and its fixtures' code call), so that a new test is
-marked without anyone remembering to:
+Each test module declares what its tests need in ``pytestmark`` (a single test that needs more
+carries its own ``@pytest.mark...``):
 
 ``kernel``
     starts a Jupyter kernel (executes a notebook: the chapters, the lab notebooks, grading);
 ``book``
-    builds or executes the book;
+    builds or executes the book (the ``built_book`` fixture below, one build per run);
 ``browser``
-    drives headless Chromium over built pages (marked in the test modules);
+    drives headless Chromium (through Playwright);
 ``wheel``
     builds the package's wheel and runs it outside the checkout;
 ``subprocess``
-    starts a Python process (the command line, a fresh interpreter); also ``slow``;
+    starts any other process (the command line, a fresh interpreter, a Sphinx build);
 ``doctest``
-    runs the examples in the package's docstrings; the long ones are also ``slow``;
+    runs the examples in the package's docstrings;
 ``slow``
-    any other test that takes long (listed in ``SLOW``).
+    takes long for another reason (exhaustive sweeps, every figure drawn, every lab written).
 
-``make check`` runs what needs none of kernel, browser, book, wheel or slow; ``make test`` runs
-everything.
+``make check`` runs the tests that need none of kernel, browser, book, wheel, subprocess or
+slow; ``make test`` runs everything.
+
+A declaration is checked, not trusted: every process the test process starts is looked at while
+a test (or its fixtures) runs, and a test that starts a kernel, a book build, a browser, a wheel
+build or any process without the marker saying so fails at once, with the marker it lacks. A
+test module that starts one at import time fails its collection.
 """
 
 from __future__ import annotations
 
-import ast
-import functools
+import os
+import shlex
+import subprocess
+import sys
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -36,119 +43,187 @@ import pytest
 
 matplotlib.use("Agg")
 
-# What a whole test module needs.
-MODULE_MARKS = {
-    "test_chapters": {"kernel", "book"},
-    "test_grade": {"kernel"},
-    "test_book": {"book"},
-}
-# What a fixture or a test of a test module needs (a fixture's marks go to every test using it).
-FIXTURE_MARKS = {
-    ("test_packaging", "installed"): {"wheel", "slow"},
-}
-# The tests (or fixtures) that take over 10 s each on a busy 2-core machine: every course figure
-# drawn, every lab written, exhaustive sweeps of the explorers' controls, all static frames of an
-# explorer pre-computed, hypothesis searches over scaled plants. They are `slow`, run by
-# `make test`; the quick loop keeps the cheaper tests of the same code.
-SLOW = {
-    "test_cli": {"two_runs", "test_vector_formats_are_deterministic_too"},
-    "test_explorers": {
-        "test_every_setting_gives_a_picture_or_a_message",
-        "test_fast_draw_matches_a_full_draw",
-    },
-    "test_widgets": {
-        "test_every_control_value_gives_a_picture_or_a_message",
-        "test_mimebundle_has_the_widget_and_the_static_frames",
-        "pa9_static",
-        "test_static_missile_page_is_light",
-        "test_static_ids_are_unique_and_frames_differ",
-        "test_missile_filter_slider_redraws_the_reconstruction",
-        "test_drag_uses_an_ipympl_canvas_and_redraws_after_a_resize",
-        "test_rerunning_a_cell_frees_the_previous_explorer",
-        "test_case_study_pole_and_lmi_mode",
-    },
-    "test_scaled_properties": {"test_uio_on_scaled_plants_decouples_or_refuses"},
-    "test_lab_variants": {
-        "variants",
-        "test_another_seed_gives_other_numbers",
-        "test_the_same_seed_gives_byte_identical_files",
-    },
-    "test_instructor_output": {
-        "test_a_good_run_over_last_term_leaves_only_this_terms_files",
-        "test_the_same_run_gives_the_same_manifest",
-    },
-}
-# Names whose use in a test, its fixtures or the module's helpers they call says what it needs.
-CALL_MARKS = {
-    "nbclient": {"kernel"},
-    "NotebookClient": {"kernel"},
-    "subprocess": {"subprocess", "slow"},
-}
-# Package modules whose docstring examples take long (over 5 s on a busy 2-core machine:
-# explorers built, lab notebooks written, figures drawn).
-SLOW_DOCTESTS = {
-    "uio_teach.explorers._drag",
-    "uio_teach.explorers._figure",
-    "uio_teach.explorers.widgets",
-    "uio_teach.explorers.static",
-    "uio_teach.instructor.labs",
-    "uio_teach.instructor.figures",
-}
+# jsonschema (under nbformat) builds the grammars of an optional IRI-syntax checker when it is
+# imported: seconds of collection for a format no notebook schema uses. The test process does
+# without it (jsonschema skips that format check when the module cannot be imported).
+sys.modules.setdefault("rfc3987_syntax", None)  # type: ignore[arg-type]
+
+ROOT = Path(__file__).resolve().parents[1]
+HTML = ROOT / "_build" / "html"
+# A clean build executes every chapter; this is a limit against a hung kernel, not a timing.
+BOOK_BUILD_LIMIT = 1800  # seconds
 
 
-@functools.cache
-def reached_names(path: Path) -> dict[str, set[str]]:
-    """Each top-level function of a test module -> the names its code uses (and its arguments).
+# --- what a process needs ----------------------------------------------------------------------
 
-    The names a function reaches through the module's other functions are included, so a test
-    that calls a helper, or uses a fixture, that runs ``nbclient`` is found to need a kernel.
+
+def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
+    """The markers a test needs to start the process ``argv``.
+
+    Every process needs ``subprocess``; a Jupyter kernel (started directly, or by the grader)
+    ``kernel``; jupyter-book or Sphinx ``book``; Chromium or Playwright's driver ``browser``; a
+    wheel build ``wheel``.
     """
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    direct: dict[str, set[str]] = {}
-    for node in tree.body:
-        if isinstance(node, ast.FunctionDef):
-            names = {a.arg for a in node.args.args}
-            for sub in ast.walk(node):
-                if isinstance(sub, ast.Name):
-                    names.add(sub.id)
-                elif isinstance(sub, ast.Attribute):
-                    names.add(sub.attr)
-            direct[node.name] = names
-    reach = {name: set(names) for name, names in direct.items()}
-    changed = True
-    while changed:
-        changed = False
-        for name, names in reach.items():
-            extra = set().union(*(reach[n] for n in names & reach.keys() if n != name)) - names
-            if extra:
-                names |= extra
-                changed = True
-    return reach
+    if isinstance(argv, str | bytes | os.PathLike):  # a shell command line, or one program
+        try:
+            argv = shlex.split(os.fsdecode(argv))
+        except ValueError:
+            argv = [argv]
+    words = [os.fsdecode(a) if isinstance(a, bytes | os.PathLike) else str(a) for a in argv]
+    names = {Path(w).name for w in words}
+    text = " ".join(words)
+    if is_probe(words):
+        return set()
+    needs = {"subprocess"}
+    if (
+        any("ipykernel" in w for w in words)
+        or _module_command(words, "uio_teach", "grade")
+        or _runs_module(words, "uio_teach.instructor.runner")  # the grader's notebook runner
+    ):
+        needs.add("kernel")
+    if names & {"jupyter-book", "sphinx-build"} or _runs_module(words, "jupyter_book", "sphinx"):
+        needs.add("book")
+    if "chromium" in text or "playwright" in text:
+        needs.add("browser")
+    if (names & {"pip", "pip3"} or _runs_module(words, "pip", "build")) and "wheel" in words:
+        needs.add("wheel")
+    return needs
 
 
-def marks_for(item: pytest.Item) -> set[str]:
-    """The markers ``item`` needs, from its module, its fixtures and what its code calls."""
-    module = Path(str(item.fspath))
-    stem = module.stem
-    marks = set(MODULE_MARKS.get(stem, ()))
-    function = getattr(item, "originalname", item.name)
-    for fixture in getattr(item, "fixturenames", ()):
-        marks |= FIXTURE_MARKS.get((stem, fixture), set())
-    if SLOW.get(stem, set()) & {function, *getattr(item, "fixturenames", ())}:
-        marks.add("slow")
-    reached = reached_names(module).get(function, set())
-    for name, needs in CALL_MARKS.items():
-        if name in reached:
-            marks |= needs
-    if stem == "test_api_docs" and function == "test_docstring_examples_run":
-        marks.add("doctest")
-        if item.callspec.params.get("modname") in SLOW_DOCTESTS:
-            marks.add("slow")
-    return marks
+def is_probe(words: list[str]) -> bool:
+    """A library's one-off look at the machine, cached for the process: ``tool --version``
+    (jupytext asks pandoc), the sandbox's ``bwrap ... /bin/true``. Whichever test happens to come
+    first would start it, so it needs no marker."""
+    if len(words) == 2 and words[1] == "--version":
+        return True
+    return bool(words) and Path(words[0]).name == "bwrap" and words[-1] == "/bin/true"
+
+
+def _runs_module(words: list[str], *modules: str) -> bool:
+    """Whether ``words`` runs ``python -m <one of modules>``."""
+    return any(a == "-m" and b in modules for a, b in zip(words, words[1:], strict=False))
+
+
+def _module_command(words: list[str], module: str, command: str) -> bool:
+    """Whether ``words`` runs ``python -m module command``."""
+    return any(
+        a == "-m" and b == module and c == command
+        for a, b, c in zip(words, words[1:], words[2:], strict=False)
+    )
+
+
+# --- holding each test to its markers ----------------------------------------------------------
+
+HEAVY = {"kernel", "book", "browser", "wheel"}
+_running: list[pytest.Item] = []  # the test whose setup, call or teardown is running
+_violations: pytest.StashKey[list[str]] = pytest.StashKey()
+
+
+def check_launch(argv: object, item: pytest.Item | None) -> None:
+    """Fail when ``item`` (``None``: no test, i.e. collection) may not start ``argv``."""
+    needs = needs_of(argv)  # type: ignore[arg-type]
+    if item is None:
+        # At collection: a probe of the machine is allowed, the heavy resources are not.
+        lacking = needs - {"subprocess"}
+        if lacking:
+            raise RuntimeError(
+                f"a test module starts {_describe(argv)} at import time (needs "
+                f"{', '.join(sorted(lacking))}); start it inside a marked test or fixture"
+            )
+        return
+    declared = {mark.name for mark in item.iter_markers()}
+    if declared & HEAVY:
+        declared.add("subprocess")  # a kernel, a book build, a browser are processes
+    lacking = needs - declared
+    if lacking:
+        message = (
+            f"{item.nodeid} starts {_describe(argv)} without the marker(s) "
+            f"{', '.join(f'@pytest.mark.{m}' for m in sorted(lacking))}: declare them in the test "
+            "module's pytestmark or on the test (tests/conftest.py lists the markers)"
+        )
+        item.stash.setdefault(_violations, []).append(message)
+        pytest.fail(message, pytrace=False)
+
+
+def _describe(argv: object) -> str:
+    words = [argv] if isinstance(argv, str | bytes) else list(argv)  # type: ignore[call-overload]
+    text = " ".join(os.fsdecode(w) if isinstance(w, bytes) else str(w) for w in words)
+    return f"`{text[:160]}`"
+
+
+_execute_child = subprocess.Popen._execute_child  # type: ignore[attr-defined]
+
+
+def _guarded_execute_child(self, args, *rest, **kwargs):  # noqa: ANN001, ANN202
+    check_launch(args, _running[-1] if _running else None)
+    return _execute_child(self, args, *rest, **kwargs)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    # Every process the test process starts goes through Popen._execute_child: subprocess.run,
+    # jupyter_client's kernel launch, asyncio's subprocesses (Playwright's driver).
+    subprocess.Popen._execute_child = _guarded_execute_child  # type: ignore[attr-defined]
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    subprocess.Popen._execute_child = _execute_child  # type: ignore[attr-defined]
+
+
+# Declarations not yet written into their test module's own pytestmark: the grading tests run
+# the grader on notebooks (a kernel each). Move them into the module and empty this table.
+PENDING_DECLARATIONS = {"test_grade.py": ("kernel",)}
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
-        present = {mark.name for mark in item.iter_markers()}
-        for name in sorted(marks_for(item) - present):
+        for name in PENDING_DECLARATIONS.get(item.path.name, ()):
             item.add_marker(getattr(pytest.mark, name))
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    _running.append(item)
+    try:
+        return (yield)
+    finally:
+        _running.pop()
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> Iterator:
+    # A launch refused inside code that swallows exceptions (a thread, a retry loop) still fails
+    # the test.
+    report = yield
+    violations = item.stash.get(_violations, [])
+    if violations and report.when == "call" and report.passed:
+        report.outcome = "failed"
+        report.longrepr = "\n".join(violations)
+    return report
+
+
+# --- the book, built once per run ---------------------------------------------------------------
+
+
+def jupyter_book() -> str:
+    local = Path(sys.executable).parent / "jupyter-book"
+    return str(local) if local.exists() else "jupyter-book"
+
+
+@pytest.fixture(scope="session")
+def built_book() -> Path:
+    """Build the book once per test run, exactly as ``make book`` does; the HTML folder.
+
+    Shared by every test that reads the built pages (tests marked ``book``).
+    """
+    command = [jupyter_book(), "build", ".", "-W", "-n", "--keep-going"]
+    proc = subprocess.run(
+        command, cwd=ROOT, capture_output=True, text=True, timeout=BOOK_BUILD_LIMIT
+    )
+    if proc.returncode != 0:
+        log = (proc.stdout + proc.stderr)[-8000:]
+        pytest.fail(
+            f"`{' '.join(command)}` exited with {proc.returncode}; tracebacks of failed chapters"
+            f" are in {HTML / 'reports'}.\n{log}",
+            pytrace=False,
+        )
+    return HTML

@@ -78,14 +78,30 @@ def test_every_public_name_has_examples(qualname):
     assert ">>>" in text, f"{qualname} has no runnable example in its docstring"
 
 
+# Modules whose docstring examples take long (explorers built, lab notebooks written, figures
+# drawn): also `slow`.
+SLOW_DOCTESTS = {
+    "uio_teach.explorers._drag",
+    "uio_teach.explorers._figure",
+    "uio_teach.explorers.widgets",
+    "uio_teach.explorers.static",
+    "uio_teach.instructor.labs",
+    "uio_teach.instructor.figures",
+}
+
+
 def _modules():
     names = ["uio_teach"]
     for info in pkgutil.walk_packages(ut.__path__, prefix="uio_teach."):
         if not info.name.endswith("__main__"):
             names.append(info.name)
-    return names
+    return [
+        pytest.param(name, marks=[pytest.mark.slow] if name in SLOW_DOCTESTS else [])
+        for name in names
+    ]
 
 
+@pytest.mark.doctest
 @pytest.mark.parametrize("modname", _modules())
 def test_docstring_examples_run(modname):
     mod = importlib.import_module(modname)

@@ -16,8 +16,6 @@ from __future__ import annotations
 import functools
 import os
 import re
-import subprocess
-import sys
 import threading
 from collections.abc import Iterator
 from html.parser import HTMLParser
@@ -29,7 +27,6 @@ import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
-HTML = ROOT / "_build" / "html"
 SCREENSHOTS = ROOT / "_build" / "screenshots"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = [
@@ -72,32 +69,6 @@ def toc_pages(toc_file: Path = ROOT / "_toc.yml") -> list[str]:
 
 
 PAGES = toc_pages()
-
-
-def _jupyter_book() -> str:
-    local = Path(sys.executable).parent / "jupyter-book"
-    return str(local) if local.exists() else "jupyter-book"
-
-
-@pytest.fixture(scope="session")
-def built_book() -> Path:
-    """Build the book once per test run, exactly as ``make book`` does."""
-    command = [_jupyter_book(), "build", ".", "-W", "-n", "--keep-going"]
-    proc = subprocess.run(
-        command,
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=BUILD_TIMEOUT,
-    )
-    if proc.returncode != 0:
-        log = (proc.stdout + proc.stderr)[-8000:]
-        pytest.fail(
-            f"`{' '.join(command)}` exited with {proc.returncode}; tracebacks of failed chapters"
-            f" are in {HTML / 'reports'}.\n{log}",
-            pytrace=False,
-        )
-    return HTML
 
 
 def test_book_builds(built_book: Path) -> None:

@@ -8,6 +8,7 @@ import cvxpy as cp
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
+from tolerance import assert_same_run
 
 import uio_teach as ut
 from uio_teach import checks
@@ -386,5 +387,5 @@ def test_the_error_is_the_same_whatever_the_unknown_inputs():
     """The defining property that the simulation check relies on, shown directly."""
     quiet = sim(d=None, v=None)
     louder = sim(d=ut.signals.sinusoid(5.0, 0.3), v=staircase(3.0, 2, 9))
-    np.testing.assert_allclose(RUN.error, quiet.error, atol=1e-12)
-    np.testing.assert_allclose(louder.error, quiet.error, atol=1e-12)
+    assert_same_run(RUN.error, quiet.error, RUN, quiet)
+    assert_same_run(louder.error, quiet.error, louder, quiet)

@@ -48,6 +48,7 @@ def test_the_book_has_chapters() -> None:
 
 
 @pytest.mark.book
+@pytest.mark.kernel
 @pytest.mark.parametrize(
     "chapter", CHAPTERS, ids=[str(path.relative_to(BOOK)) for path in CHAPTERS]
 )
@@ -202,6 +203,7 @@ def test_no_hard_coded_chapter_or_equation_numbers() -> None:
 # --- each chapter as a notebook (the book's _ext/chapter_notebooks.py) --------------------------
 
 
+@pytest.mark.subprocess  # jupytext asks pandoc for its version
 def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path) -> None:
     import importlib.util
 

@@ -71,6 +71,7 @@ def test_list_names_every_figure_with_a_description(capsys):
         assert any(name.startswith(group) for name in ALL)
 
 
+@pytest.mark.subprocess
 def test_python_dash_m_entry_point_lists_the_figures():
     proc = subprocess.run(
         [sys.executable, "-m", "uio_teach", "figures", "--list"],
@@ -82,6 +83,7 @@ def test_python_dash_m_entry_point_lists_the_figures():
     assert [line.split()[0] for line in proc.stdout.strip().splitlines()] == ALL
 
 
+@pytest.mark.subprocess
 def test_console_script_is_declared():
     pyproject = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
     assert pyproject["project"]["scripts"]["uio-teach"] == "uio_teach.instructor.cli:main"
@@ -126,6 +128,7 @@ def test_usage_errors_exit_2(capsys):
 # making the figures ------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_running_figures_creates_every_file(two_runs):
     code, folder = two_runs["first"]
     assert code == 0
@@ -138,6 +141,7 @@ def test_running_figures_creates_every_file(two_runs):
             assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_a_second_run_is_byte_identical(two_runs):
     (_, first), (_, second) = two_runs["first"], two_runs["second"]
     names = sorted(p.name for p in first.iterdir())
@@ -147,6 +151,7 @@ def test_a_second_run_is_byte_identical(two_runs):
 
 
 @pytest.mark.parametrize("fmt", ["pdf", "svg"])
+@pytest.mark.slow
 def test_vector_formats_are_deterministic_too(fmt, tmp_path):
     names = ["pa9_luenberger", "case_error"]
     for run_ in ("a", "b"):
@@ -198,6 +203,7 @@ def test_dpi_sets_the_pixel_size(tmp_path):
     assert large[0] == 2 * small[0] and large[1] == 2 * small[1]
 
 
+@pytest.mark.slow
 def test_table_ii_holds_catch_times_computed_with_catch_time(two_runs):
     _, folder = two_runs["first"]
     with open(folder / "missile_table2.csv", newline="") as fh:
@@ -292,6 +298,7 @@ def test_a_bad_config_gives_one_line_and_exit_2(case, tmp_path, capsys):
     assert not out_dir.exists()  # nothing is made before the configuration is known good
 
 
+@pytest.mark.slow
 def test_a_triple_pole_makes_every_figure(tmp_path, capsys):
     # repeated poles are valid: the designs place them (a single-output design on w C)
     config = write(tmp_path, "[pa9]\npoles = [-1, -1, -1]\n")
@@ -316,6 +323,7 @@ def test_print_config_is_a_valid_commented_default_config(capsys):
     assert all("#" in line for line in out.splitlines() if "=" in line)  # every key explained
 
 
+@pytest.mark.slow
 def test_a_config_changes_the_figures_it_concerns(tmp_path, two_runs):
     config = write(
         tmp_path,
@@ -336,6 +344,7 @@ def test_a_config_changes_the_figures_it_concerns(tmp_path, two_runs):
     assert (out / "missile_table2.md").read_bytes() == (default / "missile_table2.md").read_bytes()
 
 
+@pytest.mark.slow
 def test_the_noise_is_seeded(tmp_path):
     config = write(tmp_path, "seed = 3\n[pa9]\nnoise = 0.05\n")
     for label in ("a", "b"):

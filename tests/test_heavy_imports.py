@@ -7,6 +7,8 @@ import sys
 
 import pytest
 
+pytestmark = pytest.mark.subprocess  # each test starts a fresh interpreter
+
 HEAVY = ("control", "cvxpy", "scipy.signal", "matplotlib.pyplot")
 
 SCRIPT = """

@@ -113,6 +113,7 @@ def test_a_style_file_is_read_beside_the_config_file(tmp_path, monkeypatch):
     assert manifest["config"]["style"] == os.fspath((folder / "x.mplstyle").resolve())
 
 
+@pytest.mark.slow
 def test_a_good_run_over_last_term_leaves_only_this_terms_files(tmp_path, last_term):
     config = tmp_path / "term.toml"
     config.write_text("seed = 11\n[missile]\npmo_poles = [-90, -140]\n")
@@ -180,6 +181,7 @@ def test_a_folder_that_is_not_an_earlier_output_is_left_alone(tmp_path, capsys):
     assert make(forged) == 1
 
 
+@pytest.mark.slow
 def test_the_same_run_gives_the_same_manifest(tmp_path):
     for name in ("a", "b"):
         assert make(tmp_path / name) == 0
@@ -270,6 +272,7 @@ def lab_sets(tmp_path_factory) -> dict:
 # steps of `labs --source lab_pa9.md --groups 2`: 4 notebooks (1-4), the key (5), the manifest
 # (6), the swap: before it (7), after it, before the old set is removed (8)
 @pytest.mark.parametrize("kill_at", [1, 3, 5, 6, 7, 8])
+@pytest.mark.subprocess
 def test_labs_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, lab_sets, kill_at):
     out = tmp_path / "labs"
     assert cli.main(labs_argv(out, 3)) == 0
@@ -333,6 +336,7 @@ def test_a_second_run_into_the_same_folder_is_refused_while_the_first_holds_it(
     assert leftovers(tmp_path) == []  # the lock is gone with its holder
 
 
+@pytest.mark.subprocess
 def test_a_second_process_is_refused_while_the_lock_is_held(tmp_path):
     out = tmp_path / "out"
     with output.FolderLock(out):
@@ -342,6 +346,7 @@ def test_a_second_process_is_refused_while_the_lock_is_held(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.subprocess
 def test_the_lock_of_a_dead_process_is_taken_over(tmp_path):
     dead = subprocess.run(
         [sys.executable, "-c", "import os; print(os.getpid())"],
@@ -393,6 +398,7 @@ def test_folders_get_the_users_usual_permissions(tmp_path, mask):
 # steps of figures_argv: case_error.png (1), missile_table2.csv and .md (2, 3), the manifest
 # (4), before the swap (5), after it (6)
 @pytest.mark.parametrize("kill_at", [1, 3, 4, 5, 6])
+@pytest.mark.subprocess
 def test_figures_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, kill_at):
     sets = {}
     for seed in (1, 2):
@@ -440,6 +446,7 @@ def test_a_bad_config_is_one_line_and_exit_2(tmp_path, capsys, command, what):
     assert not out.exists() and leftovers(tmp_path) == []
 
 
+@pytest.mark.subprocess
 def test_a_non_utf8_config_is_one_line_in_a_real_process_too(tmp_path):
     config = tmp_path / "term.toml"
     config.write_bytes(BAD_CONFIGS["not UTF-8"])
@@ -471,6 +478,7 @@ def test_every_option_error_is_one_line_and_exit_2(argv, capsys):
 
 
 @pytest.mark.parametrize("argv", [["figures", "--list"], ["figures", "--print-config"], ["--help"]])
+@pytest.mark.subprocess
 def test_a_closed_pipe_ends_quietly(argv):
     read, write = os.pipe()
     os.close(read)  # the reader is gone before anything is written (`... | head -0`)
@@ -569,6 +577,7 @@ def build_edition(tmp_path: Path, edition: str) -> subprocess.CompletedProcess:
 
 
 @pytest.mark.parametrize("edition", ["student", "instructor"])
+@pytest.mark.book
 def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edition):
     proc = build_edition(tmp_path, edition)
     assert proc.returncode == 0, proc.stderr
@@ -587,6 +596,7 @@ def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edi
         assert (out / "_sources").exists()
 
 
+@pytest.mark.book
 def test_an_unknown_edition_is_refused(tmp_path):
     proc = build_edition(tmp_path, "teachers")
     assert proc.returncode != 0

@@ -185,6 +185,7 @@ def variants(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_groups_give_distinct_notebooks_per_lab_named_by_group(variants):
     for lab in labs.LABS:
         seen = []
@@ -198,6 +199,7 @@ def test_groups_give_distinct_notebooks_per_lab_named_by_group(variants):
         assert len({json.dumps(p, sort_keys=True) for p in seen}) == 3
 
 
+@pytest.mark.slow
 def test_every_variant_is_a_fair_exercise(variants):
     for lab in labs.LABS.values():
         for g in ("g01", "g02", "g03"):
@@ -212,6 +214,7 @@ def test_every_variant_is_a_fair_exercise(variants):
         assert abs(variant.pole) < 1 and abs(variant.pole - 0.5) >= 0.2
 
 
+@pytest.mark.slow
 def test_the_same_seed_gives_byte_identical_files(variants, tmp_path):
     assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "5", "-q"]) == 0
     files = sorted(p.relative_to(variants) for p in variants.rglob("*") if p.is_file())
@@ -221,6 +224,7 @@ def test_the_same_seed_gives_byte_identical_files(variants, tmp_path):
         assert (variants / name).read_bytes() == (tmp_path / name).read_bytes(), name
 
 
+@pytest.mark.slow
 def test_another_seed_gives_other_numbers(variants, tmp_path):
     assert cli.main(["labs", "--out", str(tmp_path), "--groups", "3", "--seed", "6", "-q"]) == 0
     a = nbformat.read(variants / "pa9" / "student" / "pa9_g01.ipynb", 4)
@@ -228,6 +232,7 @@ def test_another_seed_gives_other_numbers(variants, tmp_path):
     assert params_of(a) != params_of(b)
 
 
+@pytest.mark.slow
 def test_the_answer_key_has_one_row_per_lab_and_group_with_the_right_answers(variants):
     with (variants / "answer_key.csv").open(newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))

@@ -216,6 +216,7 @@ def test_no_raw_myst_is_left_in_the_markdown(lab, version):
 
 
 @pytest.mark.book
+@pytest.mark.kernel
 def test_the_student_version_runs_and_its_checks_say_what_is_missing(lab, tmp_path):
     nb = execute(lab["student"], tmp_path)  # no cell may fail: TODO cells define placeholders
     checks = [c for c in nb.cells if "check" in tags(c)]
@@ -228,6 +229,7 @@ def test_the_student_version_runs_and_its_checks_say_what_is_missing(lab, tmp_pa
 
 
 @pytest.mark.book
+@pytest.mark.kernel
 def test_the_solution_version_runs_and_every_check_passes(lab, tmp_path):
     nb = execute(lab["solution"], tmp_path)
     checks = [c for c in nb.cells if "check" in tags(c)]
@@ -346,6 +348,7 @@ def small_lab(tmp_path) -> Path:
     return path
 
 
+@pytest.mark.kernel
 def test_small_lab_student_version(small_lab, tmp_path):
     nb = labs.make_notebook(small_lab, "student")
     nbformat.validate(nb)
@@ -375,6 +378,7 @@ def test_small_lab_student_version(small_lab, tmp_path):
         execute(nb, tmp_path)
 
 
+@pytest.mark.kernel
 def test_small_lab_solution_version(small_lab, tmp_path):
     nb = labs.make_notebook(small_lab, "solution")
     text = "\n".join(c.source for c in nb.cells)
@@ -479,6 +483,7 @@ def variant_dir(tmp_path_factory) -> Path:
 
 @pytest.mark.book
 @pytest.mark.parametrize("lab_id", list(labs.LABS))
+@pytest.mark.kernel
 def test_a_variant_solves_with_every_check_passing_and_its_student_form_runs(
     lab_id, variant_dir, tmp_path
 ):
@@ -622,6 +627,7 @@ def test_every_config_key_reaches_a_lab_that_reads_it_or_the_help_says_why_not(
 
 @pytest.mark.book
 @pytest.mark.parametrize("lab_id", list(labs.LABS))
+@pytest.mark.kernel
 def test_a_term_configs_solution_runs_with_every_check_passing(term_labs, lab_id, tmp_path):
     """The term's numbers (TERM_CHANGES) run through the lab: its checks pass with them."""
     nb = nbformat.read(term_labs["results"][lab_id].solution, as_version=4)

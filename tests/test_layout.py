@@ -5,6 +5,8 @@ decide whether it passed."""
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -380,25 +382,131 @@ def test_the_clock_check_follows_values_through_fixtures(tmp_path):
 # markers ----------------------------------------------------------------------------------------
 
 
-def test_a_test_that_reaches_a_kernel_through_a_helper_or_fixture_is_found(tmp_path):
+def test_each_process_is_classified_by_what_it_starts():
     import conftest
 
+    python = sys.executable
+    assert conftest.needs_of([python, "-m", "ipykernel_launcher", "-f", "k.json"]) == {
+        "subprocess",
+        "kernel",
+    }
+    assert conftest.needs_of([python, "-m", "uio_teach", "grade", "a.ipynb"]) >= {"kernel"}
+    runner = ["bwrap", "--die-with-parent", python, "-m", "uio_teach.instructor.runner", "--run"]
+    assert conftest.needs_of(runner) >= {"kernel"}
+    assert conftest.needs_of(["/venv/bin/jupyter-book", "build", "."]) >= {"book"}
+    assert conftest.needs_of([python, "-m", "sphinx", "-b", "html", "src", "out"]) >= {"book"}
+    driver = "/venv/lib/site-packages/playwright/driver/node"
+    assert conftest.needs_of([driver, "cli.js", "run-driver"]) >= {"browser"}
+    assert conftest.needs_of([python, "-m", "pip", "wheel", "."]) >= {"wheel"}
+    assert conftest.needs_of([python, "-c", "print(1)"]) == {"subprocess"}
+    assert conftest.needs_of(["pandoc", "--version"]) == set()  # a cached probe of the machine
+    assert conftest.needs_of(["/usr/bin/bwrap", "--ro-bind", "/", "/", "/bin/true"]) == set()
+    assert conftest.needs_of("jupyter-book build . -W") >= {"book"}  # a shell command line
+
+
+class _Item:
+    """The parts of a test item the guard reads."""
+
+    def __init__(self, *marks: str) -> None:
+        self.nodeid = "tests/test_x.py::test_x"
+        self.stash = pytest.Stash()
+        self._marks = [getattr(pytest.mark, m).mark for m in marks]
+
+    def iter_markers(self):
+        return iter(self._marks)
+
+
+def test_a_process_started_without_its_marker_fails_the_test():
+    import conftest
+
+    book = ["jupyter-book", "build", "."]
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.book"):
+        conftest.check_launch(book, _Item())
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.subprocess"):
+        conftest.check_launch([sys.executable, "-c", "pass"], _Item("slow"))
+    with pytest.raises(pytest.fail.Exception, match=r"@pytest\.mark\.kernel"):
+        conftest.check_launch([sys.executable, "-m", "ipykernel_launcher"], _Item("book"))
+    refused = _Item("browser")
+    with pytest.raises(pytest.fail.Exception):
+        conftest.check_launch(book, refused)
+    assert refused.stash[conftest._violations]  # failed even if the exception is swallowed
+    conftest.check_launch(book, _Item("book"))
+    conftest.check_launch([sys.executable, "-c", "pass"], _Item("subprocess"))
+    with pytest.raises(RuntimeError, match="at import time"):
+        conftest.check_launch(book, None)  # at collection
+    conftest.check_launch([sys.executable, "-c", "pass"], None)  # a probe of the machine
+
+
+def test_the_guard_is_installed_on_every_process_start():
+    import conftest
+
+    assert subprocess.Popen._execute_child is conftest._guarded_execute_child
+
+
+# tolerances -------------------------------------------------------------------------------------
+
+COMPARISONS = {"assert_allclose", "allclose", "isclose", "approx", "assert_array_almost_equal"}
+# Below this a hand-written tolerance is about the CPU's round-off, not the computation: such a
+# comparison goes through tests/tolerance.py, which derives it from the data.
+HAND_TOLERANCE_FLOOR = 1e-8
+TOLERANCE_ARGS = {"rtol", "atol", "abs", "rel"}
+
+
+def tight_hand_tolerances(path: Path) -> list[str]:
+    """Float comparisons in ``path`` with a literal tolerance below the floor."""
+
+    def tiny(node: ast.AST) -> bool:
+        return any(
+            isinstance(c, ast.Constant)
+            and isinstance(c.value, float)
+            and 0 < c.value < HAND_TOLERANCE_FLOOR
+            for c in ast.walk(node)
+        )
+
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Call):
+            func = node.func
+            name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if name in COMPARISONS:
+                bad = [k.arg for k in node.keywords if k.arg in TOLERANCE_ARGS and tiny(k.value)]
+                if bad:
+                    found.append(f"line {node.lineno}: {name}({', '.join(bad)}=...)")
+        elif isinstance(node, ast.Compare) and any(
+            isinstance(op, ast.Lt | ast.LtE) for op in node.ops
+        ):
+            if any(tiny(c) for c in node.comparators):
+                found.append(f"line {node.lineno}: a comparison with a constant below the floor")
+    return found
+
+
+def test_no_comparison_of_results_uses_a_hand_tolerance_tuned_to_round_off():
+    offenders = {
+        path.name: found
+        for path in sorted(TESTS.glob("test_*.py"))
+        if (found := tight_hand_tolerances(path))
+    }
+    assert not offenders, (
+        "tolerances below 1e-8 written by hand (use tests/tolerance.py, which derives them from "
+        f"the size, length and conditioning of the computation): {offenders}"
+    )
+
+
+def test_a_tight_hand_tolerance_is_found(tmp_path):
     path = tmp_path / "test_x.py"
     path.write_text(
         textwrap.dedent(
             """\
-            import nbclient
-            def execute(nb):
-                nbclient.NotebookClient(nb).execute()
-            def solved():
-                return execute({})
-            def test_runs(solved):
-                assert solved
-            def test_pure():
-                assert 1 + 1 == 2
+            import numpy as np
+            def test_a(a, b):
+                np.testing.assert_allclose(a, b, atol=1e-12)
+                np.testing.assert_allclose(a, b, rtol=1e-6)
+                assert abs(a - b) < 1e-11 * abs(b)
+                assert a == pytest.approx(b, rel=1e-3)
             """
         )
     )
-    reach = conftest.reached_names(path)
-    assert "nbclient" in reach["test_runs"]
-    assert "nbclient" not in reach["test_pure"]
+    assert tight_hand_tolerances(path) == [
+        "line 3: assert_allclose(atol=...)",
+        "line 5: a comparison with a constant below the floor",
+    ]

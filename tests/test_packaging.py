@@ -170,6 +170,7 @@ def _run(args, installed, **kwargs):
 
 
 @pytest.mark.slow
+@pytest.mark.wheel
 def test_the_wheel_is_the_package_imported(installed):
     target = installed[0]
     proc = _run([sys.executable, "-c", "import uio_teach; print(uio_teach.__file__)"], installed)
@@ -179,6 +180,7 @@ def test_the_wheel_is_the_package_imported(installed):
 
 
 @pytest.mark.slow
+@pytest.mark.wheel
 def test_the_wheel_lists_the_figures_from_any_folder(installed):
     target = installed[0]
     script = target / "bin" / "uio-teach"
@@ -187,6 +189,7 @@ def test_the_wheel_lists_the_figures_from_any_folder(installed):
 
 
 @pytest.mark.slow
+@pytest.mark.wheel
 def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
     from uio_teach.instructor.book import BookIndex
 
@@ -204,6 +207,7 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
 
 
 @pytest.mark.slow
+@pytest.mark.wheel
 def test_the_wheel_shows_the_pa9_explorer(installed):
     code = (
         "import uio_teach as ut; from uio_teach.explorers.widgets import pa9_explorer; "
@@ -216,6 +220,7 @@ def test_the_wheel_shows_the_pa9_explorer(installed):
 
 
 @pytest.mark.slow
+@pytest.mark.wheel
 def test_the_wheel_carries_both_licences(installed):
     target = installed[0]
     (info,) = target.glob("uio_teach-*.dist-info")

@@ -8,6 +8,7 @@ diagonal of ``S`` spread over 2 to 6 decades: mathematically the same system as
 import warnings
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linear_sum_assignment
@@ -77,6 +78,7 @@ def test_single_output_placement_is_right_or_refused(case):
     assert err <= WARN_RTOL  # silent or warned, never badly wrong
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(scaled(n_min=3, n_max=8, p=2, q=1))
 def test_uio_on_scaled_plants_decouples_or_refuses(case):
@@ -115,6 +117,7 @@ def test_invariant_zeros_survive_similarity_scaling(case):
         assert matched_error(z0, z) * max(1.0, float(np.max(np.abs(z0)))) <= tol
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(scaled(n_min=2, n_max=6, p=1, q=0))
 def test_lmi_on_scaled_pairs_is_certified_or_refused(case):

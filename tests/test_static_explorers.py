@@ -6,8 +6,8 @@ explorer keeps its height while the slider moves.
 
 Each explorer's static HTML (what the book embeds) is opened from a file in headless Chromium
 (Debian's ``/usr/bin/chromium``, driven by Playwright), with every request that leaves the page
-blocked. When the book has been built (``_build/html``, by ``tests/test_book.py`` in the same run),
-its explorer pages are measured as well.
+blocked. The explorer pages of the built book (the run's one build, ``built_book`` in
+``tests/conftest.py``) are measured as well.
 """
 
 from __future__ import annotations
@@ -34,8 +34,6 @@ from uio_teach.explorers.static import (
     static_explorer,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
-HTML = ROOT / "_build" / "html"
 CHROMIUM = Path("/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
 MAX_PAGE = 2 * 1024 * 1024
@@ -137,11 +135,10 @@ def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
         assert len({s[key] for s in seen}) == len(seen), f"{key} repeats between positions"
 
 
+@pytest.mark.book
 @pytest.mark.parametrize("chapter", sorted(SCENARIOS))
-def test_built_explorer_pages_are_small(chapter):
-    page = HTML / "book" / f"{chapter}.html"
-    if not page.exists():
-        pytest.skip("the book is not built (tests/test_book.py builds it)")
+def test_built_explorer_pages_are_small(chapter, built_book):
+    page = built_book / "book" / f"{chapter}.html"
     text = page.read_text(encoding="utf-8")
     assert "uio-static-explorer" in text
     assert "widget-state+json" not in text  # the unused widget state is left out
@@ -334,11 +331,10 @@ def test_wide_layout_is_kept(name, tmp_path):
     _check_aspect(m, name)
 
 
+@pytest.mark.book
 @pytest.mark.parametrize("chapter", sorted(SCENARIOS))
-def test_built_explorer_pages_read_on_a_phone(chapter):
-    page_file = HTML / "book" / f"{chapter}.html"
-    if not page_file.exists():
-        pytest.skip("the book is not built (tests/test_book.py builds it)")
+def test_built_explorer_pages_read_on_a_phone(chapter, built_book):
+    page_file = built_book / "book" / f"{chapter}.html"
     seen = {}
 
     def work(browser) -> None:

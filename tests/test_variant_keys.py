@@ -124,6 +124,7 @@ def test_each_group_solution_passes_its_own_key_and_fails_every_other(variants, 
     assert failed == total == GROUPS * (GROUPS - 1) * CHECKS_PER_LAB[lab]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("lab", list(LABS))
 def test_a_class_of_twelve_groups_has_twelve_keys(lab):
     own, failed, total = cross_keys(lab, draw_variants(LABS[lab], 12, seed=1))
