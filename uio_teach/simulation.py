@@ -563,9 +563,16 @@ def _real_modes(T: np.ndarray) -> list[tuple[int, int, Any]] | None:
 
 
 def _recursion(
-    Phi: np.ndarray, G0: np.ndarray, G1: np.ndarray | None, S: np.ndarray, z0: np.ndarray
+    Phi: np.ndarray,
+    G0: np.ndarray,
+    G1: np.ndarray | None,
+    S: np.ndarray,
+    z0: np.ndarray,
+    output: np.ndarray | None = None,
 ) -> np.ndarray:
     """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
+
+    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
 
     ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
     ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
@@ -600,7 +607,7 @@ def _recursion(
     T, Z = sla.schur(Phi * (scale[None, :] / scale[:, None]), output="real")
     blocks = _real_modes(T)
     if blocks is None:
-        return _recursion_complex(Phi, G0, G1, S, z0)
+        return _map(output, _recursion_complex(Phi, G0, G1, S, z0), S)
     if G1 is None:
         Gam, xi0, G1 = G0, z0, np.zeros_like(G0)
     else:
@@ -631,10 +638,22 @@ def _recursion(
             R = 2 * np.column_stack([w.real, -w.imag])
             M[:i, i:j] = M[:i, i:j] @ R
             Zout[:, i:j] = Zout[:, i:j] @ R
-    # back to the original coordinates: z = D Z zeta + G1 s
-    z = np.hstack([Zout, G1]) @ Q
-    z[:, 0] = z0  # exactly, not through the change of coordinates
-    return z
+    # back to the original coordinates, z = D Z zeta + G1 s, and on to the outputs if asked
+    W = np.hstack([Zout, G1])
+    if output is not None:
+        W = output[:, :nz] @ W
+        W[:, nz:] += output[:, nz:]
+    out = W @ Q
+    # the first column exactly, not through the change of coordinates
+    out[:, 0] = z0 if output is None else output @ np.concatenate([z0, S[:, 0]])
+    return out
+
+
+def _map(output: np.ndarray | None, z: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """``output @ [z; s]``, or ``z`` itself without an output map."""
+    if output is None:
+        return z
+    return output[:, : z.shape[0]] @ z + output[:, z.shape[0] :] @ S
 
 
 def _recursion_complex(
@@ -713,6 +732,7 @@ def linear_response(
     initial_state: np.ndarray,
     *,
     discrete: bool = False,
+    output: np.ndarray | None = None,
 ) -> np.ndarray:
     """All states of ``z' = A z + B s`` (``z[k+1] = A z[k] + B s[k]``) on a time grid.
 
@@ -734,10 +754,15 @@ def linear_response(
         Input samples.
     initial_state : numpy.ndarray, shape (nz,)
     discrete : bool
+    output : numpy.ndarray, shape (k, nz + ns), optional
+        Return ``output @ [z; s]`` (signals read off the states and the
+        inputs, such as measurements and estimates) instead of ``z``: it is
+        folded into the last change of coordinates, one product instead of
+        two passes over the states.
 
     Returns
     -------
-    numpy.ndarray, shape (nz, N)
+    numpy.ndarray, shape (nz, N) or (k, N)
         May contain non-finite values when the response overflows; callers
         check the range.
 
@@ -762,10 +787,10 @@ def linear_response(
     z0 = np.asarray(initial_state, float)
     with _one_blas_thread(), np.errstate(all="ignore"):
         if discrete:
-            return _recursion(A, B, None, S, z0)
+            return _recursion(A, B, None, S, z0, output)
         h = _uniform_step(t)
         if h is None:
-            return _stepwise(A, B, t, S, z0)
+            return _map(output, _stepwise(A, B, t, S, z0), S)
         Phi, G0, G1 = foh_matrices(A, B, h)
         if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
             poles = np.linalg.eigvals(A)
@@ -774,7 +799,7 @@ def linear_response(
                 poles[poles.real > 0],
                 float(t[min(1, t.size - 1)]),
             )
-        return _recursion(Phi, G0, G1, S, z0)
+        return _recursion(Phi, G0, G1, S, z0, output)
 
 
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
@@ -986,24 +1011,26 @@ def simulate(
     z0 = np.concatenate([x0, w0])
 
     Az, Bz = joint_system(plant, observer)
+    # the signals read off [z; s] = [x; w; u; d; v; noise], one row block each:
+    # x, w, y = C x + D v + noise and xhat = C_o w + D_y y
+    n = plant.n
+    ny = np.zeros((p, n + nw + S.shape[0]))
+    ny[:, :n] = plant.C
+    ny[:, n + nw + m + q : n + nw + m + q + r] = plant.D
+    ny[:, n + nw + m + q + r :] = np.eye(p)
+    nxhat = real.D_y @ ny
+    nxhat[:, n : n + nw] += real.C
+    output = np.vstack([np.eye(n + nw, n + nw + S.shape[0]), ny, nxhat])
     try:
-        z = linear_response(Az, Bz, t, S, z0, discrete=plant.is_discrete)
+        signals = linear_response(Az, Bz, t, S, z0, discrete=plant.is_discrete, output=output)
     except SimulationOverflowError:
         raise _overflow(Az, plant, t, 1) from None
     with np.errstate(all="ignore"):
         # overflow is detected and explained here, not left to RuntimeWarnings and NaNs
-        _check_range(z, Az, plant, t)
-        x, w = z[: plant.n], z[plant.n :]
-        y = plant.C @ x
-        if r:
-            y += plant.D @ inputs.v
-        if noise is not None:
-            y += inputs.noise
-        xhat = real.C @ w
-        xhat += real.D_y @ y
-        _check_range(np.vstack([y, xhat]), Az, plant, t)
-    for arr in (z, y, xhat):
-        arr.setflags(write=False)
+        _check_range(signals, Az, plant, t)
+    signals.setflags(write=False)
+    x, w = signals[:n], signals[n : n + nw]
+    y, xhat = signals[n + nw : n + nw + p], signals[n + nw + p :]
     return UIOResponse(
         time=t,
         states=x,

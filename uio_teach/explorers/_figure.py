@@ -237,7 +237,7 @@ class ExplorerFigure:
         self._cells: dict | None = None
         self._fresh = True
         self.sticky = sticky
-        self._legend_boxes: list[tuple[int, int, int, int]] = []
+        self._legend_boxes: dict[str, tuple[int, int, int, int]] = {}
 
     def smallest_text_pt(self) -> float:
         """The size of the smallest text drawn in the figure, in points.
@@ -631,19 +631,19 @@ class ExplorerFigure:
         for artist in self._dynamic_artists():
             if artist.get_visible() and artist not in notes:
                 artist.draw(renderer)
-        for box in self._legend_boxes:  # the legends cover the curves, as in a full draw
+        for box in self._legend_boxes.values():  # the legends cover the curves, as in a full draw
             # xy: where the stored region's corner goes (the whole figure: no shift)
             canvas.restore_region(self._background, bbox=box, xy=(0, 0))
         for note in notes:
             if note.get_visible():
                 note.draw(renderer)
 
-    def _legend_regions(self) -> list[tuple[int, int, int, int]]:
-        """The boxes of the legends inside panels, in Agg pixels (origin top left)."""
+    def _legend_regions(self) -> dict[str, tuple[int, int, int, int]]:
+        """The boxes of the legends inside panels by panel, in Agg pixels (origin top left)."""
         renderer = self.fig.canvas.get_renderer()
         H = int(round(self.fig.bbox.height))
-        out = []
-        for ax in self.axes.values():
+        out = {}
+        for name, ax in self.axes.items():
             legend = ax.get_legend()
             if legend is None or not legend.get_visible():
                 continue
@@ -652,11 +652,17 @@ class ExplorerFigure:
                 continue  # outside the panel: no curve crosses it
             x0, x1 = math.floor(box.x0), math.ceil(box.x1)
             y0, y1 = H - math.ceil(box.y1), H - math.floor(box.y0)
-            out.append((x0, y0, x1, y1))
+            out[name] = (x0, y0, x1, y1)
         return out
 
     def _redraw(self, names: list[str]) -> bool:
-        """Redraw some panels or texts into the stored background; False if one leaves its place."""
+        """Redraw some panels or texts into the stored background; False if one leaves its place.
+
+        A panel's legend does not change with its range and sits in a fixed corner: it is
+        painted back from the stored background instead of being laid out and drawn again
+        (the slowest part of a panel), and the check that the panel keeps to its cell looks
+        at the axes, ticks and labels only (nothing else in a panel moves with its range).
+        """
         canvas = self.fig.canvas
         renderer = canvas.get_renderer()
         canvas.restore_region(self._background)
@@ -674,13 +680,22 @@ class ExplorerFigure:
             )
             blank.draw(renderer)
             artist = {"title": self.title, "footer": self.footer}.get(name) or self.axes[name]
-            artist.draw(renderer)
+            legend = self._legend_boxes.get(name)
+            if legend is not None:
+                artist.get_legend().set_visible(False)
+                try:
+                    artist.draw(renderer)
+                finally:
+                    artist.get_legend().set_visible(True)
+                canvas.restore_region(self._background, bbox=legend, xy=(0, 0))
+            else:
+                artist.draw(renderer)
             if not artist.get_visible() or (
                 isinstance(artist, type(self.title)) and not artist.get_text()
             ):
                 continue
             tight = (
-                artist.get_tightbbox(renderer)
+                artist.get_tightbbox(renderer, bbox_extra_artists=[])
                 if name in self.axes
                 else artist.get_window_extent(renderer)
             )
