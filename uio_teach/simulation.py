@@ -1021,8 +1021,14 @@ def simulate(
     nxhat = real.D_y @ ny
     nxhat[:, n : n + nw] += real.C
     output = np.vstack([np.eye(n + nw, n + nw + S.shape[0]), ny, nxhat])
+    # inputs that were not given are zero and add nothing: the engine sees the others alone
+    given = [u is not None, d is not None, v is not None, noise is not None]
+    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
+    output = np.hstack([output[:, : n + nw], output[:, n + nw + keep]])
     try:
-        signals = linear_response(Az, Bz, t, S, z0, discrete=plant.is_discrete, output=output)
+        signals = linear_response(
+            Az, Bz[:, keep], t, S[keep], z0, discrete=plant.is_discrete, output=output
+        )
     except SimulationOverflowError:
         raise _overflow(Az, plant, t, 1) from None
     with np.errstate(all="ignore"):
