@@ -121,6 +121,26 @@ def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
     )
 
 
+def _titles(ax: Any) -> list:
+    """An axes' visible titles (they never change: a panel redraw paints them back)."""
+    titles = (ax.title, ax._left_title, ax._right_title)
+    return [t for t in titles if t.get_visible() and t.get_text()]
+
+
+def _pixels(box: Any, H: int, pad: int = 0) -> tuple[int, int, int, int]:
+    """A display box as an Agg region (origin top left), grown by ``pad`` pixels."""
+    return (
+        math.floor(box.x0) - pad,
+        H - math.ceil(box.y1) - pad,
+        math.ceil(box.x1) + pad,
+        H - math.floor(box.y0) + pad,
+    )
+
+
+def _meets(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
 class ExplorerFigure:
     """The explorer's figure: built once, then updated in place for each frame.
 
@@ -238,6 +258,7 @@ class ExplorerFigure:
         self._fresh = True
         self.sticky = sticky
         self._legend_boxes: dict[str, tuple[int, int, int, int]] = {}
+        self._title_boxes: dict[str, list[tuple[int, int, int, int]]] = {}
 
     def smallest_text_pt(self) -> float:
         """The size of the smallest text drawn in the figure, in points.
@@ -658,15 +679,21 @@ class ExplorerFigure:
     def _redraw(self, names: list[str]) -> bool:
         """Redraw some panels or texts into the stored background; False if one leaves its place.
 
-        A panel's legend does not change with its range and sits in a fixed corner: it is
-        painted back from the stored background instead of being laid out and drawn again
-        (the slowest part of a panel), and the check that the panel keeps to its cell looks
-        at the axes, ticks and labels only (nothing else in a panel moves with its range).
+        A panel's legend and titles do not change with its range and keep their place: they
+        are painted back from the stored background instead of being laid out and drawn again
+        (the legend is the slowest part of a panel; a title may reach over the next column),
+        and the check that the panel keeps to its cell looks at the axes, ticks and labels
+        only (nothing else in a panel moves with its range). A painted-back title that would
+        cover a redrawn panel's new ticks means a full render instead.
         """
         canvas = self.fig.canvas
         renderer = canvas.get_renderer()
         canvas.restore_region(self._background)
         color = self.fig.get_facecolor()
+        H = int(round(self.fig.bbox.height))
+        drawn: dict[str, tuple[int, int, int, int]] = {}
+        if any(name not in self._cells for name in names):
+            return False  # a panel without a cell of its own
         for name in names:
             box = self._cells[name]
             blank = Rectangle(
@@ -679,36 +706,66 @@ class ExplorerFigure:
                 antialiased=False,
             )
             blank.draw(renderer)
-            artist = {"title": self.title, "footer": self.footer}.get(name) or self.axes[name]
-            legend = self._legend_boxes.get(name)
-            if legend is not None:
-                artist.get_legend().set_visible(False)
+            if name in self.axes:
+                ax = self.axes[name]
+                legend = self._legend_boxes.get(name)
+                hidden = _titles(ax) + ([ax.get_legend()] if legend is not None else [])
+                for a in hidden:
+                    a.set_visible(False)
                 try:
-                    artist.draw(renderer)
+                    ax.draw(renderer)
+                    tight = ax.get_tightbbox(renderer, bbox_extra_artists=[])
                 finally:
-                    artist.get_legend().set_visible(True)
-                canvas.restore_region(self._background, bbox=legend, xy=(0, 0))
+                    for a in hidden:
+                        a.set_visible(True)
+                if legend is not None:
+                    canvas.restore_region(self._background, bbox=legend, xy=(0, 0))
+                if not ax.get_visible():
+                    continue
+                drawn[name] = _pixels(tight, H)
             else:
-                artist.draw(renderer)
-            if not artist.get_visible() or (
-                isinstance(artist, type(self.title)) and not artist.get_text()
-            ):
-                continue
-            tight = (
-                artist.get_tightbbox(renderer, bbox_extra_artists=[])
-                if name in self.axes
-                else artist.get_window_extent(renderer)
-            )
+                tight = None
+                text = {"title": self.title, "footer": self.footer}[name]
+                text.draw(renderer)
+                if not text.get_visible() or not text.get_text():
+                    continue
+                tight = text.get_window_extent(renderer)
+                drawn[name] = _pixels(tight, H)
             if tight is None or not _inside(tight, box):
                 return False  # a wider tick label or a longer text: render everything
+        # the panels' titles, painted back wherever a blanked cell reached them
+        cells = [_pixels(self._cells[name], H) for name in names]
+        for owner, boxes in self._title_boxes.items():
+            for tb in boxes:
+                if not any(_meets(tb, c) for c in cells):
+                    continue
+                if any(_meets(tb, d) for other, d in drawn.items() if other != owner):
+                    return False
+                canvas.restore_region(self._background, bbox=tb, xy=(0, 0))
         self.partial_draws += 1
         return True
 
     def _find_cells(self) -> dict:
-        """Each panel's cell and the title and footer bands (pixels), or {} if they overlap."""
+        """Each panel's cell and the title and footer bands (pixels), or {} if the title
+        band overlaps the panels; a panel that does not keep to a cell of its own has none."""
         renderer = self.fig.canvas.get_renderer()
         W, H = self.fig.bbox.width, self.fig.bbox.height
-        tight = {name: ax.get_tightbbox(renderer) for name, ax in self.axes.items()}
+        # the panels' titles are painted back after a redraw (see _redraw), not redrawn: a
+        # title reaching over the next column does not make the cells overlap
+        tight = {}
+        self._title_boxes = {}
+        for name, ax in self.axes.items():
+            titles = _titles(ax)
+            self._title_boxes[name] = [
+                _pixels(t.get_window_extent(renderer), round(H), pad=1) for t in titles
+            ]
+            for t in titles:
+                t.set_visible(False)
+            try:
+                tight[name] = ax.get_tightbbox(renderer)
+            finally:
+                for t in titles:
+                    t.set_visible(True)
         top = max(t.y1 for t in tight.values())
         bottom = min(t.y0 for t in tight.values())
         title = self.title.get_window_extent(renderer)
@@ -717,28 +774,42 @@ class ExplorerFigure:
         title_cut = (top + title.y0) / 2
         footer_cut = bottom - 1
         pos = {name: ax.get_position() for name, ax in self.axes.items()}
-        lefts = sorted({round(p.x0, 6) for p in pos.values()})
-        columns = [[n for n, p in pos.items() if round(p.x0, 6) == x] for x in lefts]
-        cuts = [0.0]
-        for left, right in itertools.pairwise(columns):
-            a = max(tight[n].x1 for n in left)
-            b = min(tight[n].x0 for n in right)
-            cuts.append((a + b) / 2)
-        cuts.append(W)
+
+        def beside(p: Any, q: Any) -> bool:  # share a band of rows
+            return p.y0 < q.y1 - 1e-9 and q.y0 < p.y1 - 1e-9
+
+        def stacked(p: Any, q: Any) -> bool:  # share a band of columns
+            return p.x0 < q.x1 - 1e-9 and q.x0 < p.x1 - 1e-9
+
         cells = {
             "title": Bbox.from_extents(0, title_cut, W, H),
             "footer": Bbox.from_extents(0, 0, W, footer_cut),
         }
-        for c, names in enumerate(columns):
-            for name in names:
-                p = tight[name]
-                above = [tight[n].y0 for n in names if tight[n].y0 >= p.y1 - 1e-6 and n != name]
-                below = [tight[n].y1 for n in names if tight[n].y1 <= p.y0 + 1e-6 and n != name]
-                y1 = (p.y1 + min(above)) / 2 if above else title_cut
-                y0 = (p.y0 + max(below)) / 2 if below else footer_cut
-                cells[name] = Bbox.from_extents(cuts[c], y0, cuts[c + 1], y1)
-        if any(not _inside(tight[n], cells[n]) for n in self.axes):
-            return {}
+        # each panel's cell reaches halfway to its neighbours' ticks and labels on every side
+        for name, p in pos.items():
+            t = tight[name]
+            x0, x1, y0, y1 = 0.0, W, footer_cut, title_cut
+            for other, q in pos.items():
+                u = tight[other]
+                if other == name:
+                    continue
+                if beside(p, q) and q.x1 <= p.x0 + 1e-9:
+                    x0 = max(x0, (u.x1 + t.x0) / 2)
+                if beside(p, q) and q.x0 >= p.x1 - 1e-9:
+                    x1 = min(x1, (t.x1 + u.x0) / 2)
+                if stacked(p, q) and q.y1 <= p.y0 + 1e-9:
+                    y0 = max(y0, (u.y1 + t.y0) / 2)
+                if stacked(p, q) and q.y0 >= p.y1 - 1e-9:
+                    y1 = min(y1, (t.y1 + u.y0) / 2)
+            cells[name] = Bbox.from_extents(x0, y0, x1, y1)
+        # a panel that leaves its cell or whose cell meets another's is always drawn in full
+        bad = {n for n in self.axes if not _inside(tight[n], cells[n])}
+        for m, n in itertools.combinations(self.axes, 2):
+            inter = Bbox.intersection(cells[m], cells[n])
+            if inter is not None and inter.width > 0 and inter.height > 0:
+                bad |= {m, n}
+        for n in bad:
+            del cells[n]
         return cells
 
     def _dynamic_artists(self) -> list:
