@@ -103,9 +103,10 @@ def _keep_range(
     if fresh:
         return wanted
     if lo < current[0] or hi > current[1]:
-        # grow with room to spare, so that the next slightly larger curve fits as well
+        # grow with room to spare (the span doubles), so that the next larger curves fit too:
+        # a slider swept upward rescales a few times, not at every step
         a, b = min(lo, current[0]), max(hi, current[1])
-        pad = 0.25 * (b - a)
+        pad = 0.5 * (b - a)
         return _nice_range([np.array([a - pad * (lo < current[0]), b + pad * (hi > current[1])])])
     if (hi - lo) < (current[1] - current[0]) / 3:
         return wanted
@@ -287,7 +288,7 @@ class ExplorerFigure:
         rows = self.rows
         # under the bottom panels: tick labels, the axis label, then the footer's lines
         axis_in = (15 * k * 1.3 + 8) / 72
-        footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.04
+        footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.07
         # above the panels: the title (its top 4 pt under the edge), then the pole map's legend
         # (two rows) or, on a phone, the panel titles; bands apart, so each redraws alone
         top_in = (4 + 10 * k * 1.35 + 4 + self.legend_pt * 3.4 + 6) / 72
@@ -774,42 +775,30 @@ class ExplorerFigure:
         title_cut = (top + title.y0) / 2
         footer_cut = bottom - 1
         pos = {name: ax.get_position() for name, ax in self.axes.items()}
-
-        def beside(p: Any, q: Any) -> bool:  # share a band of rows
-            return p.y0 < q.y1 - 1e-9 and q.y0 < p.y1 - 1e-9
-
-        def stacked(p: Any, q: Any) -> bool:  # share a band of columns
-            return p.x0 < q.x1 - 1e-9 and q.x0 < p.x1 - 1e-9
-
+        lefts = sorted({round(p.x0, 6) for p in pos.values()})
+        columns = [[n for n, p in pos.items() if round(p.x0, 6) == x] for x in lefts]
+        cuts = [0.0]
+        for left, right in itertools.pairwise(columns):
+            a = max(tight[n].x1 for n in left)
+            b = min(tight[n].x0 for n in right)
+            cuts.append((a + b) / 2)
+        cuts.append(W)
         cells = {
             "title": Bbox.from_extents(0, title_cut, W, H),
             "footer": Bbox.from_extents(0, 0, W, footer_cut),
         }
-        # each panel's cell reaches halfway to its neighbours' ticks and labels on every side
-        for name, p in pos.items():
-            t = tight[name]
-            x0, x1, y0, y1 = 0.0, W, footer_cut, title_cut
-            for other, q in pos.items():
-                u = tight[other]
-                if other == name:
-                    continue
-                if beside(p, q) and q.x1 <= p.x0 + 1e-9:
-                    x0 = max(x0, (u.x1 + t.x0) / 2)
-                if beside(p, q) and q.x0 >= p.x1 - 1e-9:
-                    x1 = min(x1, (t.x1 + u.x0) / 2)
-                if stacked(p, q) and q.y1 <= p.y0 + 1e-9:
-                    y0 = max(y0, (u.y1 + t.y0) / 2)
-                if stacked(p, q) and q.y0 >= p.y1 - 1e-9:
-                    y1 = min(y1, (t.y1 + u.y0) / 2)
-            cells[name] = Bbox.from_extents(x0, y0, x1, y1)
-        # a panel that leaves its cell or whose cell meets another's is always drawn in full
-        bad = {n for n in self.axes if not _inside(tight[n], cells[n])}
-        for m, n in itertools.combinations(self.axes, 2):
-            inter = Bbox.intersection(cells[m], cells[n])
-            if inter is not None and inter.width > 0 and inter.height > 0:
-                bad |= {m, n}
-        for n in bad:
-            del cells[n]
+        for c, names in enumerate(columns):
+            for name in names:
+                p = tight[name]
+                above = [tight[n].y0 for n in names if tight[n].y0 >= p.y1 - 1e-6 and n != name]
+                below = [tight[n].y1 for n in names if tight[n].y1 <= p.y0 + 1e-6 and n != name]
+                y1 = (p.y1 + min(above)) / 2 if above else title_cut
+                y0 = (p.y0 + max(below)) / 2 if below else footer_cut
+                cells[name] = Bbox.from_extents(cuts[c], y0, cuts[c + 1], y1)
+        # a panel reaching over a neighbouring column (two panels of a phone's last row) has
+        # no cell of its own: a change of its range renders everything
+        for name in [n for n in self.axes if not _inside(tight[n], cells[n])]:
+            del cells[name]
         return cells
 
     def _dynamic_artists(self) -> list:
