@@ -24,17 +24,19 @@ involved: the only approximation is the straight line drawn between input
 samples, so smooth inputs converge like ``h**2`` and piecewise-linear inputs
 are simulated exactly (to rounding).
 
-**Fast recursion.** The forcing of every step is computed with one matrix
-product over all samples. The recursion ``z[k+1] = Phi z[k] + f[k]`` is then
-run in the Schur coordinates of ``Phi = Z T Z^H`` (complex Schur form; real
-when every eigenvalue is real): ``T`` is upper triangular, so the last
-coordinate is a scalar first-order recursion, which
-:func:`scipy.signal.lfilter` runs in compiled code; the coordinate above it is
-again a scalar recursion once the ones below are known, and so on (back
-substitution). There is no Python loop over the samples. While it runs, BLAS
-is limited to one thread (with threadpoolctl, when installed): the products
-are small or thin, and on a 2-core machine OpenBLAS's worker threads made the
-whole simulation about three to ten times slower.
+**Fast recursion.** The recursion ``z[k+1] = Phi z[k] + f[k]`` is run in the
+real Schur coordinates of the balanced ``Phi`` (``Phi = D Z T Z^T D^-1``, ``D``
+a diagonal scaling by powers of 2, ``Z`` orthogonal, ``T`` block upper
+triangular). The blocks are solved last first: a block's forcing for every
+step, the inputs and the coupling to the blocks below, is one matrix product;
+a real eigenvalue is then a scalar first-order recursion and a complex pair one
+complex scalar recursion, which :func:`scipy.signal.lfilter` runs in compiled
+code. There is no Python loop over the samples. A complex pair too close to
+defective to be split into its modes is run instead in the triangular complex
+Schur form (every coordinate a scalar recursion coupled to those below). While
+it runs, BLAS is limited to one thread (with threadpoolctl, when installed):
+the products are small or thin, and on a 2-core machine OpenBLAS's worker
+threads made the whole simulation about three to ten times slower.
 """
 
 from __future__ import annotations
@@ -510,24 +512,160 @@ def _interleave(M: np.ndarray, axis: int) -> np.ndarray:
     )
 
 
+# A complex pair is run as one complex mode when its 2 x 2 eigenvector matrix has at most this
+# condition number: rounding in the pair's forcing and state then grows by at most this factor
+# (1e3 * eps = 2e-13 relative to the pair). Beyond it (a nearly defective pair: two almost equal
+# real poles split by rounding) the triangular complex Schur form is used instead.
+_PAIR_COND = 1e3
+
+
+def _pair_mode(B: np.ndarray) -> tuple[complex, np.ndarray, np.ndarray] | None:
+    """One complex mode of a real 2 x 2 block with complex eigenvalues ``mu``, ``conj(mu)``.
+
+    ``B = W diag(mu, conj(mu)) W^-1`` with ``W = [w, conj(w)]``: a real state ``zeta`` of the
+    block is ``2 Re(w eta)`` with ``eta = v . zeta`` (``v`` the first row of ``W^-1``), and
+    ``eta`` obeys the scalar recursion of ``mu``. ``None`` if ``W`` is ill-conditioned.
+    """
+    a, b, c, d = B[0, 0], B[0, 1], B[1, 0], B[1, 1]
+    disc = 0.25 * (a - d) ** 2 + b * c  # negative for a complex pair
+    if not disc < 0 or b == 0:
+        return None
+    mu = complex(0.5 * (a + d), np.sqrt(-disc))
+    w = np.array([b, mu - a])
+    w /= np.linalg.norm(w)
+    s = abs(w[0] ** 2 + w[1] ** 2)  # the singular values of W are sqrt(1 +- s)
+    if not (1 - s) * _PAIR_COND**2 > 1 + s:
+        return None
+    det = w[0] * w[1].conjugate() - w[0].conjugate() * w[1]
+    v = np.array([w[1].conjugate(), -w[0].conjugate()]) / det
+    return mu, w, v
+
+
+def _real_modes(T: np.ndarray) -> list[tuple[int, int, Any]] | None:
+    """The diagonal blocks of a real Schur form, last first: ``(start, stop, mode)``.
+
+    ``mode`` is the eigenvalue of a 1 x 1 block, or :func:`_pair_mode`'s result for a 2 x 2
+    block; ``None`` if some complex pair is too ill-conditioned to run as one complex mode.
+    """
+    nz = T.shape[0]
+    blocks = []
+    i = 0
+    while i < nz:
+        if i + 1 < nz and T[i + 1, i] != 0:
+            mode = _pair_mode(T[i : i + 2, i : i + 2])
+            if mode is None:
+                return None
+            blocks.append((i, i + 2, mode))
+            i += 2
+        else:
+            blocks.append((i, i + 1, T[i, i]))
+            i += 1
+    return blocks[::-1]
+
+
 def _recursion(
-    Phi: np.ndarray, G0: np.ndarray, G1: np.ndarray | None, S: np.ndarray, z0: np.ndarray
+    Phi: np.ndarray,
+    G0: np.ndarray,
+    G1: np.ndarray | None,
+    S: np.ndarray,
+    z0: np.ndarray,
+    output: np.ndarray | None = None,
 ) -> np.ndarray:
     """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
 
+    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
+
     ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
-    ``Gam = G0 + Phi G1``. In the Schur coordinates ``zeta = Z^H xi`` this is
-    ``zeta[k+1] = T zeta[k] + f[k]`` with ``T`` upper triangular and the
-    forcing ``f = Z^H Gam s`` of every step from one matrix product.
-    Coordinate ``i`` is the scalar recursion ``zeta_i[k+1] = T_ii zeta_i[k] +
-    f_i[k] + sum_{j>i} T_ij zeta_j[k]``, run by :func:`scipy.signal.lfilter`
-    once the coordinates below it are known (back substitution, last first).
-    Finally ``z = Re(Z zeta) + G1 s``, one more matrix product.
+    ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
+    diagonal ``D`` of powers of 2, exact), so that states of very different
+    size keep their own relative accuracy. In the real Schur coordinates
+    ``zeta = Z^T D^-1 xi`` (orthogonal ``Z``) the recursion is ``zeta[k+1] = T
+    zeta[k] + H s[k]`` with ``T`` block upper triangular: 1 x 1 blocks for real
+    eigenvalues, 2 x 2 blocks for complex pairs.
+
+    The blocks are solved last first (back substitution). A block's forcing
+    ``H_i s[k] + sum_{j below} T_ij zeta_j[k]`` for every step is one matrix
+    product with the rows already solved and the inputs. A 1 x 1 block is
+    then a real scalar recursion; a 2 x 2 block is one complex scalar
+    recursion (``zeta_i = 2 Re(w eta)``, see :func:`_pair_mode`), whose real
+    and imaginary parts are kept as the block's coordinates (the coefficients
+    that read them, ``T`` above the block and the output map, are turned to
+    match). Each recursion runs in compiled code,
+    :func:`scipy.signal.lfilter`, with no Python loop over the samples.
+    Finally ``z = D Z zeta + G1 s``, one more matrix product. A complex pair
+    with an ill-conditioned 2 x 2 eigenvector matrix (nearly defective) sends
+    the whole recursion to :func:`_recursion_complex`, which keeps the
+    triangular form.
 
     Memory is kept low (large temporaries are slow to allocate): one work
-    array ``Q = [f or zeta; s]`` holds the forcing, which each coordinate
-    overwrites with its solution, followed by the inputs; complex
-    coordinates take two real rows (real and imaginary part).
+    array ``Q = [zeta; s]`` holds the solved coordinates followed by the
+    inputs, so each block's forcing is one product with ``Q[below]``.
+    """
+    from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
+
+    nz, ns, N = Phi.shape[0], S.shape[0], S.shape[1]
+    _, (scale, _) = sla.matrix_balance(Phi, permute=False, separate=True)
+    T, Z = sla.schur(Phi * (scale[None, :] / scale[:, None]), output="real")
+    blocks = _real_modes(T)
+    if blocks is None:
+        return _map(output, _recursion_complex(Phi, G0, G1, S, z0), S)
+    if G1 is None:
+        Gam, xi0, G1 = G0, z0, np.zeros_like(G0)
+    else:
+        Gam, xi0 = G0 + Phi @ G1, z0 - G1 @ S[:, 0]
+    Zin = Z.T / scale[None, :]  # zeta = Z^T D^-1 xi
+    zeta0 = Zin @ xi0
+    # the rows of M read [zeta; s]: block i's forcing is M[i, below] @ Q[below]
+    M = np.hstack([T, Zin @ Gam])
+    Zout = scale[:, None] * Z  # xi = D Z zeta
+    Q = np.empty((nz + ns, N))
+    Q[nz:] = S
+    for i, j, mode in blocks:
+        if j == i + 1:
+            lam = mode
+            g = M[i, j:] @ Q[j:, :-1]
+            Q[i, 1:] = lfilter([1.0], [1.0, -lam], g, zi=[lam * zeta0[i]])[0]
+            Q[i, 0] = zeta0[i]
+        else:
+            mu, w, v = mode
+            # the forcing of eta = v . zeta_i, computed transposed: its rows are complex numbers
+            c = v @ M[i:j, j:]
+            g = Q[j:, :-1].T @ np.column_stack([c.real, c.imag])
+            eta0 = v @ zeta0[i:j]
+            eta = lfilter([1.0], [1.0, -mu], g.view(complex)[:, 0], zi=[mu * eta0])[0]
+            Q[i : i + 2, 1:] = eta.view(float).reshape(-1, 2).T
+            Q[i : i + 2, 0] = eta0.real, eta0.imag
+            # zeta_i = 2 Re(w eta) = R [Re eta; Im eta]: whatever reads zeta_i now reads eta
+            R = 2 * np.column_stack([w.real, -w.imag])
+            M[:i, i:j] = M[:i, i:j] @ R
+            Zout[:, i:j] = Zout[:, i:j] @ R
+    # back to the original coordinates, z = D Z zeta + G1 s, and on to the outputs if asked
+    W = np.hstack([Zout, G1])
+    if output is not None:
+        W = output[:, :nz] @ W
+        W[:, nz:] += output[:, nz:]
+    out = W @ Q
+    # the first column exactly, not through the change of coordinates
+    out[:, 0] = z0 if output is None else output @ np.concatenate([z0, S[:, 0]])
+    return out
+
+
+def _map(output: np.ndarray | None, z: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """``output @ [z; s]``, or ``z`` itself without an output map."""
+    if output is None:
+        return z
+    return output[:, : z.shape[0]] @ z + output[:, z.shape[0] :] @ S
+
+
+def _recursion_complex(
+    Phi: np.ndarray, G0: np.ndarray, G1: np.ndarray | None, S: np.ndarray, z0: np.ndarray
+) -> np.ndarray:
+    """:func:`_recursion` in the complex Schur form, triangular: for nearly defective pairs.
+
+    Every coordinate is a scalar recursion (complex ones take two real rows of
+    the work array, real and imaginary part), coupled to the coordinates below
+    it through ``T_ij``; no eigenvector matrix is formed, so its accuracy does
+    not depend on how close to defective ``Phi`` is.
     """
     from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
 
@@ -595,6 +733,7 @@ def linear_response(
     initial_state: np.ndarray,
     *,
     discrete: bool = False,
+    output: np.ndarray | None = None,
 ) -> np.ndarray:
     """All states of ``z' = A z + B s`` (``z[k+1] = A z[k] + B s[k]``) on a time grid.
 
@@ -616,10 +755,15 @@ def linear_response(
         Input samples.
     initial_state : numpy.ndarray, shape (nz,)
     discrete : bool
+    output : numpy.ndarray, shape (k, nz + ns), optional
+        Return ``output @ [z; s]`` (signals read off the states and the
+        inputs, such as measurements and estimates) instead of ``z``: it is
+        folded into the last change of coordinates, one product instead of
+        two passes over the states.
 
     Returns
     -------
-    numpy.ndarray, shape (nz, N)
+    numpy.ndarray, shape (nz, N) or (k, N)
         May contain non-finite values when the response overflows; callers
         check the range.
 
@@ -644,10 +788,10 @@ def linear_response(
     z0 = np.asarray(initial_state, float)
     with _one_blas_thread(), np.errstate(all="ignore"):
         if discrete:
-            return _recursion(A, B, None, S, z0)
+            return _recursion(A, B, None, S, z0, output)
         h = _uniform_step(t)
         if h is None:
-            return _stepwise(A, B, t, S, z0)
+            return _map(output, _stepwise(A, B, t, S, z0), S)
         Phi, G0, G1 = foh_matrices(A, B, h)
         if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
             poles = np.linalg.eigvals(A)
@@ -656,7 +800,7 @@ def linear_response(
                 poles[poles.real > 0],
                 float(t[min(1, t.size - 1)]),
             )
-        return _recursion(Phi, G0, G1, S, z0)
+        return _recursion(Phi, G0, G1, S, z0, output)
 
 
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
@@ -664,6 +808,8 @@ _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e30
 
 def _check_range(z: np.ndarray, Az: np.ndarray, plant: Plant, t: np.ndarray) -> None:
     """Raise ``SimulationOverflowError`` if the response leaves the float range."""
+    if -_BIG <= z.min() and z.max() <= _BIG:  # false for a NaN too; two passes, no temporaries
+        return
     bad = ~np.isfinite(z) | (np.abs(z) > _BIG)
     if np.any(bad):
         k = int(np.argmax(bad.any(axis=0)))
@@ -866,24 +1012,32 @@ def simulate(
     z0 = np.concatenate([x0, w0])
 
     Az, Bz = joint_system(plant, observer)
+    # the signals read off [z; s] = [x; w; u; d; v; noise], one row block each:
+    # x, w, y = C x + D v + noise and xhat = C_o w + D_y y
+    n = plant.n
+    ny = np.zeros((p, n + nw + S.shape[0]))
+    ny[:, :n] = plant.C
+    ny[:, n + nw + m + q : n + nw + m + q + r] = plant.D
+    ny[:, n + nw + m + q + r :] = np.eye(p)
+    nxhat = real.D_y @ ny
+    nxhat[:, n : n + nw] += real.C
+    output = np.vstack([np.eye(n + nw, n + nw + S.shape[0]), ny, nxhat])
+    # inputs that were not given are zero and add nothing: the engine sees the others alone
+    given = [u is not None, d is not None, v is not None, noise is not None]
+    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
+    output = np.hstack([output[:, : n + nw], output[:, n + nw + keep]])
     try:
-        z = linear_response(Az, Bz, t, S, z0, discrete=plant.is_discrete)
+        signals = linear_response(
+            Az, Bz[:, keep], t, S[keep], z0, discrete=plant.is_discrete, output=output
+        )
     except SimulationOverflowError:
         raise _overflow(Az, plant, t, 1) from None
     with np.errstate(all="ignore"):
         # overflow is detected and explained here, not left to RuntimeWarnings and NaNs
-        _check_range(z, Az, plant, t)
-        x, w = z[: plant.n], z[plant.n :]
-        y = plant.C @ x
-        if r:
-            y += plant.D @ inputs.v
-        if noise is not None:
-            y += inputs.noise
-        xhat = real.C @ w
-        xhat += real.D_y @ y
-        _check_range(np.vstack([y, xhat]), Az, plant, t)
-    for arr in (z, y, xhat):
-        arr.setflags(write=False)
+        _check_range(signals, Az, plant, t)
+    signals.setflags(write=False)
+    x, w = signals[:n], signals[n : n + nw]
+    y, xhat = signals[n + nw : n + nw + p], signals[n + nw + p :]
     return UIOResponse(
         time=t,
         states=x,

@@ -103,9 +103,10 @@ def _keep_range(
     if fresh:
         return wanted
     if lo < current[0] or hi > current[1]:
-        # grow with room to spare, so that the next slightly larger curve fits as well
+        # grow with room to spare (the span doubles), so that the next larger curves fit too:
+        # a slider swept upward rescales a few times, not at every step
         a, b = min(lo, current[0]), max(hi, current[1])
-        pad = 0.25 * (b - a)
+        pad = 0.5 * (b - a)
         return _nice_range([np.array([a - pad * (lo < current[0]), b + pad * (hi > current[1])])])
     if (hi - lo) < (current[1] - current[0]) / 3:
         return wanted
@@ -119,6 +120,26 @@ def _inside(inner: Any, outer: Any, slack: float = 1.0) -> bool:
         and inner.y0 >= outer.y0 - slack
         and inner.y1 <= outer.y1 + slack
     )
+
+
+def _titles(ax: Any) -> list:
+    """An axes' visible titles (they never change: a panel redraw paints them back)."""
+    titles = (ax.title, ax._left_title, ax._right_title)
+    return [t for t in titles if t.get_visible() and t.get_text()]
+
+
+def _pixels(box: Any, H: int, pad: int = 0) -> tuple[int, int, int, int]:
+    """A display box as an Agg region (origin top left), grown by ``pad`` pixels."""
+    return (
+        math.floor(box.x0) - pad,
+        H - math.ceil(box.y1) - pad,
+        math.ceil(box.x1) + pad,
+        H - math.floor(box.y0) + pad,
+    )
+
+
+def _meets(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 class ExplorerFigure:
@@ -237,7 +258,8 @@ class ExplorerFigure:
         self._cells: dict | None = None
         self._fresh = True
         self.sticky = sticky
-        self._legend_boxes: list[tuple[int, int, int, int]] = []
+        self._legend_boxes: dict[str, tuple[int, int, int, int]] = {}
+        self._title_boxes: dict[str, list[tuple[int, int, int, int]]] = {}
 
     def smallest_text_pt(self) -> float:
         """The size of the smallest text drawn in the figure, in points.
@@ -266,7 +288,7 @@ class ExplorerFigure:
         rows = self.rows
         # under the bottom panels: tick labels, the axis label, then the footer's lines
         axis_in = (15 * k * 1.3 + 8) / 72
-        footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.04
+        footer_in = self.footer_lines * _FOOTER_PT * k * 1.22 / 72 + 0.07
         # above the panels: the title (its top 4 pt under the edge), then the pole map's legend
         # (two rows) or, on a phone, the panel titles; bands apart, so each redraws alone
         top_in = (4 + 10 * k * 1.35 + 4 + self.legend_pt * 3.4 + 6) / 72
@@ -631,19 +653,19 @@ class ExplorerFigure:
         for artist in self._dynamic_artists():
             if artist.get_visible() and artist not in notes:
                 artist.draw(renderer)
-        for box in self._legend_boxes:  # the legends cover the curves, as in a full draw
+        for box in self._legend_boxes.values():  # the legends cover the curves, as in a full draw
             # xy: where the stored region's corner goes (the whole figure: no shift)
             canvas.restore_region(self._background, bbox=box, xy=(0, 0))
         for note in notes:
             if note.get_visible():
                 note.draw(renderer)
 
-    def _legend_regions(self) -> list[tuple[int, int, int, int]]:
-        """The boxes of the legends inside panels, in Agg pixels (origin top left)."""
+    def _legend_regions(self) -> dict[str, tuple[int, int, int, int]]:
+        """The boxes of the legends inside panels by panel, in Agg pixels (origin top left)."""
         renderer = self.fig.canvas.get_renderer()
         H = int(round(self.fig.bbox.height))
-        out = []
-        for ax in self.axes.values():
+        out = {}
+        for name, ax in self.axes.items():
             legend = ax.get_legend()
             if legend is None or not legend.get_visible():
                 continue
@@ -652,15 +674,27 @@ class ExplorerFigure:
                 continue  # outside the panel: no curve crosses it
             x0, x1 = math.floor(box.x0), math.ceil(box.x1)
             y0, y1 = H - math.ceil(box.y1), H - math.floor(box.y0)
-            out.append((x0, y0, x1, y1))
+            out[name] = (x0, y0, x1, y1)
         return out
 
     def _redraw(self, names: list[str]) -> bool:
-        """Redraw some panels or texts into the stored background; False if one leaves its place."""
+        """Redraw some panels or texts into the stored background; False if one leaves its place.
+
+        A panel's legend and titles do not change with its range and keep their place: they
+        are painted back from the stored background instead of being laid out and drawn again
+        (the legend is the slowest part of a panel; a title may reach over the next column),
+        and the check that the panel keeps to its cell looks at the axes, ticks and labels
+        only (nothing else in a panel moves with its range). A painted-back title that would
+        cover a redrawn panel's new ticks means a full render instead.
+        """
         canvas = self.fig.canvas
         renderer = canvas.get_renderer()
         canvas.restore_region(self._background)
         color = self.fig.get_facecolor()
+        H = int(round(self.fig.bbox.height))
+        drawn: dict[str, tuple[int, int, int, int]] = {}
+        if any(name not in self._cells for name in names):
+            return False  # a panel without a cell of its own
         for name in names:
             box = self._cells[name]
             blank = Rectangle(
@@ -673,27 +707,66 @@ class ExplorerFigure:
                 antialiased=False,
             )
             blank.draw(renderer)
-            artist = {"title": self.title, "footer": self.footer}.get(name) or self.axes[name]
-            artist.draw(renderer)
-            if not artist.get_visible() or (
-                isinstance(artist, type(self.title)) and not artist.get_text()
-            ):
-                continue
-            tight = (
-                artist.get_tightbbox(renderer)
-                if name in self.axes
-                else artist.get_window_extent(renderer)
-            )
+            if name in self.axes:
+                ax = self.axes[name]
+                legend = self._legend_boxes.get(name)
+                hidden = _titles(ax) + ([ax.get_legend()] if legend is not None else [])
+                for a in hidden:
+                    a.set_visible(False)
+                try:
+                    ax.draw(renderer)
+                    tight = ax.get_tightbbox(renderer, bbox_extra_artists=[])
+                finally:
+                    for a in hidden:
+                        a.set_visible(True)
+                if legend is not None:
+                    canvas.restore_region(self._background, bbox=legend, xy=(0, 0))
+                if not ax.get_visible():
+                    continue
+                drawn[name] = _pixels(tight, H)
+            else:
+                tight = None
+                text = {"title": self.title, "footer": self.footer}[name]
+                text.draw(renderer)
+                if not text.get_visible() or not text.get_text():
+                    continue
+                tight = text.get_window_extent(renderer)
+                drawn[name] = _pixels(tight, H)
             if tight is None or not _inside(tight, box):
                 return False  # a wider tick label or a longer text: render everything
+        # the panels' titles, painted back wherever a blanked cell reached them
+        cells = [_pixels(self._cells[name], H) for name in names]
+        for owner, boxes in self._title_boxes.items():
+            for tb in boxes:
+                if not any(_meets(tb, c) for c in cells):
+                    continue
+                if any(_meets(tb, d) for other, d in drawn.items() if other != owner):
+                    return False
+                canvas.restore_region(self._background, bbox=tb, xy=(0, 0))
         self.partial_draws += 1
         return True
 
     def _find_cells(self) -> dict:
-        """Each panel's cell and the title and footer bands (pixels), or {} if they overlap."""
+        """Each panel's cell and the title and footer bands (pixels), or {} if the title
+        band overlaps the panels; a panel that does not keep to a cell of its own has none."""
         renderer = self.fig.canvas.get_renderer()
         W, H = self.fig.bbox.width, self.fig.bbox.height
-        tight = {name: ax.get_tightbbox(renderer) for name, ax in self.axes.items()}
+        # the panels' titles are painted back after a redraw (see _redraw), not redrawn: a
+        # title reaching over the next column does not make the cells overlap
+        tight = {}
+        self._title_boxes = {}
+        for name, ax in self.axes.items():
+            titles = _titles(ax)
+            self._title_boxes[name] = [
+                _pixels(t.get_window_extent(renderer), round(H), pad=1) for t in titles
+            ]
+            for t in titles:
+                t.set_visible(False)
+            try:
+                tight[name] = ax.get_tightbbox(renderer)
+            finally:
+                for t in titles:
+                    t.set_visible(True)
         top = max(t.y1 for t in tight.values())
         bottom = min(t.y0 for t in tight.values())
         title = self.title.get_window_extent(renderer)
@@ -722,8 +795,10 @@ class ExplorerFigure:
                 y1 = (p.y1 + min(above)) / 2 if above else title_cut
                 y0 = (p.y0 + max(below)) / 2 if below else footer_cut
                 cells[name] = Bbox.from_extents(cuts[c], y0, cuts[c + 1], y1)
-        if any(not _inside(tight[n], cells[n]) for n in self.axes):
-            return {}
+        # a panel reaching over a neighbouring column (two panels of a phone's last row) has
+        # no cell of its own: a change of its range renders everything
+        for name in [n for n in self.axes if not _inside(tight[n], cells[n])]:
+            del cells[name]
         return cells
 
     def _dynamic_artists(self) -> list:

@@ -31,6 +31,7 @@ True
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -194,8 +195,41 @@ class Frame:
 # the pipeline: signals, designs, simulations, modes, words, display -------------------------
 
 
+_REMEMBERED = 128  # designs kept per scenario: a slider's sweep and back, several times
+
+
+def _remembered(scenario: Scenario, key: tuple, make: Callable[[], Any]) -> Any:
+    """``make()``, remembered in the scenario's cache under ``key`` (the oldest dropped first).
+
+    A design depends on the plant and the poles alone, so a change of the disturbance, the
+    noise, the start or the filter does not design the observers again.
+    """
+    cache = scenario.cache
+    try:
+        if key in cache:
+            return cache[key]
+    except TypeError:  # an unhashable control value: nothing to remember it by
+        return make()
+    value = cache[key] = make()
+    designs = [k for k in cache if isinstance(k, tuple) and k[:1] == key[:1]]
+    for old in designs[: max(0, len(designs) - _REMEMBERED)]:
+        del cache[old]
+    return value
+
+
 def _design(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list[str]]:
     """The unknown input observer, a message if it failed, and notes from its checks."""
+    if scenario.family == "ginverse":
+        key: tuple = ("design", "ginverse")
+    elif s.mode == "lmi":
+        key = ("design", "lmi", s.decay)
+    else:
+        key = ("design", s.mode, s.poles)
+    obs, message, notes = _remembered(scenario, key, lambda: _design_now(scenario, s))
+    return obs, message, list(notes)
+
+
+def _design_now(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, list[str]]:
     plant = scenario.plant
     name = scenario.observer_name
     report = scenario.existence
@@ -254,6 +288,12 @@ def _luenberger(scenario: Scenario, s: Settings, obs: Observer | None):
         # no UIO: an unstable fixed pole (an unstable zero) is no pole a Luenberger observer has
         fixed = scenario.fixed_poles
         target = np.concatenate([wanted, fixed[is_stable(fixed, scenario.discrete)]])
+    target = np.asarray(target, dtype=complex)
+    key = ("luenberger", target.tobytes())
+    return _remembered(scenario, key, lambda: _luenberger_now(plant, target))
+
+
+def _luenberger_now(plant, target: np.ndarray):
     try:
         poles = luenberger_poles(plant, target)
         with warnings.catch_warnings():
