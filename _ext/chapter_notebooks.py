@@ -22,9 +22,9 @@ from typing import Any
 
 import jupytext
 import nbformat
+from editions import is_stub
 from sphinx.application import Sphinx
 
-from editions import is_stub
 from uio_teach.instructor.book import split_front_matter
 from uio_teach.instructor.lab_notebook import make_notebook
 from uio_teach.instructor.lab_registry import LabUsageError

@@ -147,6 +147,8 @@ def _check_edition(app: Sphinx, config: Config) -> None:
         # the pages' sources hold the solutions: not copied into the site, no "show source" link
         config.html_copy_source = False
         config.html_show_sourcelink = False
+    # pages can say what holds in one edition only: ```{only} student``` or ```{only} instructor```
+    app.tags.add(config.uio_teach_edition)
     logger.info(f"[editions] building the {config.uio_teach_edition} edition of the book")
 
 
