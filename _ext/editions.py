@@ -8,8 +8,9 @@ what is rendered differs:
 
 * **student** (``make book``, the default): the solutions and the cells tagged ``solution`` or
   ``instructor`` are left out of the pages (and so out of the search index). On a lab page (one
-  with cells tagged ``solution``) every code cell after the first solution is shown unrun, with
-  a note: its output (a check's verdicts, a figure) was computed from the model solution. A
+  with cells tagged ``solution``) each solution gives way to the starting code of the student
+  notebook (its ``# TODO`` cell), and every code cell after the first solution is shown unrun,
+  with a note: its output (a check's verdicts, a figure) was computed from the model solution. A
   section of notes for the tutors keeps its title and says whom it is for; a page that is one
   such section (the instructors' page) becomes a stub with no notebook. The pages' MyST sources
   are not copied into the site, and a lab chapter's notebook link gives the student notebook
@@ -24,6 +25,7 @@ is the Sphinx setting ``uio_teach_edition``; changing it rebuilds every page.
 from __future__ import annotations
 
 import os
+import re
 from typing import Any
 
 from docutils import nodes
@@ -32,6 +34,9 @@ from sphinx.config import Config
 from sphinx.transforms import SphinxTransform
 from sphinx.util import logging
 from sphinx_exercise.nodes import solution_node
+
+from uio_teach.instructor.lab_notebook import make_notebook
+from uio_teach.instructor.lab_registry import LabUsageError
 
 EDITION_VAR = "UIO_TEACH_EDITION"
 EDITIONS = ("student", "instructor")
@@ -49,6 +54,8 @@ UNRUN_NOTE = (
     "depends on your work, so it is not shown here."
 )
 UNRUN_CLASS = "student-unrun"
+STARTER_NOTE = "Your code goes here; the lab notebook starts you with:"
+STARTER_CLASS = "student-starter"
 STUB_CLASS = "student-stub"  # the section of a page that is a stub in the student edition
 
 logger = logging.getLogger(__name__)
@@ -73,6 +80,27 @@ def _is_code_cell(node: nodes.Node) -> bool:
 
 def _tags(node: nodes.Element) -> list[str]:
     return [c[4:] for c in node.get("classes", []) if c.startswith("tag_")]
+
+
+_TODO = re.compile(r"^# TODO: Exercise [^(\n]*\(([^)\n]+)\)")
+
+
+def starters(source: str) -> dict[str, str]:
+    """The starting code of each exercise of a lab chapter, by exercise label.
+
+    It is the ``# TODO`` cell that the student notebook (``uio-teach labs``) has in place of the
+    solution; empty for a page that is not a lab chapter.
+    """
+    try:
+        notebook = make_notebook(source, "student")
+    except LabUsageError:
+        return {}
+    out = {}
+    for cell in notebook.cells:
+        m = _TODO.match(cell.source) if cell.cell_type == "code" else None
+        if m:
+            out[m.group(1)] = cell.source
+    return out
 
 
 def _outputs(cell: nodes.Element) -> list[nodes.Element]:
@@ -102,8 +130,16 @@ class StudentEdition(SphinxTransform):
             return
         cells = [node for node in self.document.findall(_is_code_cell)]
         first = next((i for i, c in enumerate(cells) if "solution" in _tags(c)), None)
+        code = starters(self.env.doc2path(self.env.docname)) if first is not None else {}
         for node in list(self.document.findall(solution_node)):
-            node.parent.remove(node)
+            start = code.get(node.get("target_label", ""))
+            if start is None:
+                node.parent.remove(node)
+                continue
+            box = nodes.container(classes=[STARTER_CLASS])
+            box += nodes.paragraph(STARTER_NOTE, STARTER_NOTE)
+            box += nodes.literal_block(start, start, language="ipython3")
+            node.replace_self(box)
         for node in cells:
             if self._attached(node) and any(tag in HIDDEN_TAGS for tag in _tags(node)):
                 node.parent.remove(node)
