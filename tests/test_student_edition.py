@@ -317,7 +317,8 @@ def test_fonts_of_the_chapters_figures() -> None:
 _SCREEN_JS = """
 () => {
   const se = document.scrollingElement;
-  const main = document.querySelector("main") || document.body;
+  // the article: the side bars are drawers off screen on a phone
+  const main = document.querySelector("article.bd-article") || document.body;
   const out = {page: se.scrollWidth, viewport: se.clientWidth, loose: [], frames: [], images: []};
   const scrolls = (el) => ["auto", "scroll"].includes(getComputedStyle(el).overflowX);
   for (const el of main.querySelectorAll("*")) {

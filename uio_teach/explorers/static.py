@@ -480,9 +480,9 @@ _JS = (
 NARROW_PX = 700
 """At this width (CSS pixels) or less (a phone), the controls stack and the phone pictures show."""
 
-WIDE_FONTSCALE = 1.55
-"""Font scale of the wide pictures (drawn 1296 px wide, shown 688 px wide in the book's column on
-a desktop, where the smallest text, 7 pt times this scale, is 11.5 CSS px)."""
+WIDE_FONTSCALE = 1.65
+"""Font scale of the wide pictures: drawn 1296 px wide and shown 688 px wide in the book's column
+on a desktop, their smallest text (the legends, 6.5 pt times this scale) is 11.4 CSS px."""
 
 NARROW_FONTSCALE = 1.25
 """Font scale of the phone pictures: 4.4 inches shown 330 px wide or more keep text >= 9 px."""
