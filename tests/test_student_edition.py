@@ -336,7 +336,8 @@ _SCREEN_JS = """
       out.loose.push(`${name} to ${Math.round(r.right)}`);
     }
   }
-  for (const el of main.querySelectorAll("pre, table, .output, .table-wrapper, mjx-container")) {
+  const boxes = "pre, table, .output, .cell_output, .table-wrapper, mjx-container";
+  for (const el of main.querySelectorAll(boxes)) {
     if (!el.checkVisibility() || el.scrollWidth <= el.clientWidth + 1 || !scrolls(el)) continue;
     const s = getComputedStyle(el);
     const cue = /gradient/.test(s.backgroundImage) || s.scrollbarWidth === "thin"

@@ -211,7 +211,7 @@ class ExplorerFigure:
         self.lmi = scenario.decay_limits is not None if lmi is None else bool(lmi)
         self.footer_lines = int(footer_lines)
         # the legends: the smallest text (on a phone as large as the tick labels)
-        self.legend_pt = (7.0 if self.narrow else 6.5) * k
+        self.legend_pt = 7.0 * k
         self.lines: dict[str, list] = {}
         self.notes: dict[str, Any] = {}  # texts drawn over the curves (none by default)
         self._layout(figsize, dpi)
