@@ -7,7 +7,12 @@ under the page title. The root page (the landing page) is not a chapter and gets
 
 In the student edition of the book (``_ext/editions.py``) a lab chapter's notebook is its student
 version, as ``uio-teach labs`` writes it (``# TODO`` cells in place of the solutions, no notes for
-the tutors); the instructor edition links the whole chapter.
+the tutors); the instructor edition links the whole chapter. A page that the student edition
+reduces to a stub (the instructors' page) gets no notebook there.
+
+The theme's download menu (top right of each page) offers the same notebook as ``.ipynb``; its
+``.md`` entry links the page's source, which only the instructor edition copies into the site
+(``_sources/``), so the student edition's menu has no ``.md`` entry.
 """
 
 from __future__ import annotations
@@ -17,6 +22,7 @@ from typing import Any
 
 import jupytext
 import nbformat
+from editions import is_stub
 from sphinx.application import Sphinx
 
 from uio_teach.instructor.book import split_front_matter
@@ -70,10 +76,13 @@ def add_notebook(
     source = chapter_source(app, pagename)
     if source is None or app.builder.format != "html" or "body" not in context:
         return
-    relative = f"{NOTEBOOK_DIR}/{Path(pagename).name}.ipynb"
     edition = getattr(app.config, "uio_teach_edition", "instructor")
+    if edition == "student" and is_stub(doctree):
+        return
+    relative = f"{NOTEBOOK_DIR}/{Path(pagename).name}.ipynb"
     write_notebook(source, Path(app.outdir) / relative, edition)
     href = context["pathto"](relative, 1)
+    context["uio_teach_notebook"] = href
     link = (
         '<p class="chapter-notebook"><a class="reference download" '
         f'href="{href}" download>{LINK_TEXT}</a></p>'
@@ -87,6 +96,42 @@ def add_notebook(
         context["body"] = body[:cut] + link + body[cut:]
 
 
+def fix_download_menu(
+    app: Sphinx, pagename: str, templatename: str, context: dict[str, Any], doctree: Any
+) -> None:
+    """The theme's download menu: the chapter's notebook, and the ``.md`` source only if copied.
+
+    Runs after the theme has made the menu (its handler has priority 501).
+    """
+    student = getattr(app.config, "uio_teach_edition", "instructor") == "student"
+    notebook = context.get("uio_teach_notebook")
+    for group in context.get("header_buttons", []):
+        if group.get("label") != "download-buttons":
+            continue
+        kept = []
+        for button in group.get("buttons", []):
+            label = button.get("label")
+            if label == "download-notebook-button":
+                continue  # replaced by the chapter's own notebook below
+            if label == "download-source-button" and (student or not app.config.html_copy_source):
+                continue
+            kept.append(button)
+        if notebook:
+            kept.insert(
+                0,
+                {
+                    "type": "link",
+                    "url": notebook,
+                    "text": ".ipynb",
+                    "icon": "fas fa-code",
+                    "tooltip": "Download this chapter as a notebook",
+                    "label": "download-notebook-button",
+                },
+            )
+        group["buttons"] = kept
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("html-page-context", add_notebook)
+    app.connect("html-page-context", fix_download_menu, priority=600)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

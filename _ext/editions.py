@@ -7,10 +7,14 @@ editions, solutions included, so the checks and the figures after an exercise st
 what is rendered differs:
 
 * **student** (``make book``, the default): the solutions and the cells tagged ``solution`` or
-  ``instructor`` are left out of the pages (and so out of the search index), an "Instructor
-  notes" section keeps its title and says where its notes are, the pages' MyST sources are not
-  copied into the site, and a lab chapter's notebook link gives the student notebook
-  (``# TODO`` cells, as ``uio-teach labs`` writes it).
+  ``instructor`` are left out of the pages (and so out of the search index). On a lab page (one
+  with cells tagged ``solution``) each solution gives way to the starting code of the student
+  notebook (its ``# TODO`` cell), and every code cell after the first solution is shown unrun,
+  with a note: its output (a check's verdicts, a figure) was computed from the model solution. A
+  section of notes for the tutors keeps its title and says whom it is for; a page that is one
+  such section (the instructors' page) becomes a stub with no notebook. The pages' MyST sources
+  are not copied into the site, and a lab chapter's notebook link gives the student notebook
+  (``# TODO`` cells, as ``uio-teach labs`` writes it). No student page names the other edition.
 * **instructor** (``make book-instructor``, that is ``UIO_TEACH_EDITION=instructor`` in the
   environment of ``jupyter-book build``): everything, as written.
 
@@ -21,6 +25,7 @@ is the Sphinx setting ``uio_teach_edition``; changing it rebuilds every page.
 from __future__ import annotations
 
 import os
+import re
 from typing import Any
 
 from docutils import nodes
@@ -30,14 +35,28 @@ from sphinx.transforms import SphinxTransform
 from sphinx.util import logging
 from sphinx_exercise.nodes import solution_node
 
+from uio_teach.instructor.lab_notebook import make_notebook
+from uio_teach.instructor.lab_registry import LabUsageError
+
 EDITION_VAR = "UIO_TEACH_EDITION"
 EDITIONS = ("student", "instructor")
 HIDDEN_TAGS = ("solution", "instructor")  # code cells with these tags are not in the student pages
-NOTE = (
-    "The notes for the tutors of this lab (what the groups should find, how to run the lab, "
-    "the common mistakes) are in the instructor edition of the book: "
+TUTORS_NOTE = (
+    "This section is for the tutors who run the lab: what the groups should find, how to run "
+    "the lab, the common mistakes."
 )
-COMMAND = "make book-instructor"
+STUB_NOTE = (
+    "This page is for those who teach the course: how to prepare a term, regenerate the "
+    "figures, hand out the lab notebooks and grade the notebooks handed in."
+)
+UNRUN_NOTE = (
+    "Run this cell in your notebook once your own code above it is written: its output "
+    "depends on your work, so it is not shown here."
+)
+UNRUN_CLASS = "student-unrun"
+STARTER_NOTE = "Your code goes here; the lab notebook starts you with:"
+STARTER_CLASS = "student-starter"
+STUB_CLASS = "student-stub"  # the section of a page that is a stub in the student edition
 
 logger = logging.getLogger(__name__)
 
@@ -55,6 +74,43 @@ def is_instructor_section(section: nodes.section) -> bool:
     return heading.startswith("instructor") or "-instructor" in labels
 
 
+def _is_code_cell(node: nodes.Node) -> bool:
+    return isinstance(node, nodes.container) and "cell" in node.get("classes", [])
+
+
+def _tags(node: nodes.Element) -> list[str]:
+    return [c[4:] for c in node.get("classes", []) if c.startswith("tag_")]
+
+
+_TODO = re.compile(r"^# TODO: Exercise [^(\n]*\(([^)\n]+)\)")
+
+
+def starters(source: str) -> dict[str, str]:
+    """The starting code of each exercise of a lab chapter, by exercise label.
+
+    It is the ``# TODO`` cell that the student notebook (``uio-teach labs``) has in place of the
+    solution; empty for a page that is not a lab chapter.
+    """
+    try:
+        notebook = make_notebook(source, "student")
+    except LabUsageError:
+        return {}
+    out = {}
+    for cell in notebook.cells:
+        m = _TODO.match(cell.source) if cell.cell_type == "code" else None
+        if m:
+            out[m.group(1)] = cell.source
+    return out
+
+
+def _outputs(cell: nodes.Element) -> list[nodes.Element]:
+    return [
+        child
+        for child in cell.children
+        if isinstance(child, nodes.container) and "cell_output" in child.get("classes", [])
+    ]
+
+
 class StudentEdition(SphinxTransform):
     """Leave the solutions and the tutors' notes out of the student edition's pages.
 
@@ -64,15 +120,39 @@ class StudentEdition(SphinxTransform):
 
     default_priority = 15
 
+    def _attached(self, node: nodes.Node) -> bool:
+        while node.parent is not None:
+            node = node.parent
+        return node is self.document
+
     def apply(self, **kwargs: Any) -> None:
         if edition_of(self.config) != "student":
             return
+        cells = [node for node in self.document.findall(_is_code_cell)]
+        first = next((i for i, c in enumerate(cells) if "solution" in _tags(c)), None)
+        code = starters(self.env.doc2path(self.env.docname)) if first is not None else {}
         for node in list(self.document.findall(solution_node)):
-            node.parent.remove(node)
-        for node in list(self.document.findall(nodes.container)):
-            classes = node.get("classes", [])
-            if node.parent is not None and any(f"tag_{tag}" in classes for tag in HIDDEN_TAGS):
+            start = code.get(node.get("target_label", ""))
+            if start is None:
                 node.parent.remove(node)
+                continue
+            box = nodes.container(classes=[STARTER_CLASS])
+            box += nodes.paragraph(STARTER_NOTE, STARTER_NOTE)
+            box += nodes.literal_block(start, start, language="ipython3")
+            node.replace_self(box)
+        for node in cells:
+            if self._attached(node) and any(tag in HIDDEN_TAGS for tag in _tags(node)):
+                node.parent.remove(node)
+        if first is not None:  # a lab page: what follows the first solution ran on the solutions
+            for cell in cells[first:]:
+                outputs = _outputs(cell)
+                if not outputs or not self._attached(cell):
+                    continue
+                for output in outputs:
+                    cell.remove(output)
+                note = nodes.paragraph(UNRUN_NOTE, "", nodes.emphasis(UNRUN_NOTE, UNRUN_NOTE))
+                note["classes"].append(UNRUN_CLASS)
+                cell += note
         for section in list(self.document.findall(nodes.section)):
             if not is_instructor_section(section):
                 continue
@@ -80,10 +160,18 @@ class StudentEdition(SphinxTransform):
             for child in list(section.children):
                 if child is not title:
                     section.remove(child)
-            note = nodes.paragraph(NOTE, NOTE)
-            note += nodes.literal(COMMAND, COMMAND)
-            note += nodes.Text(".")
-            section += note
+            top = not isinstance(section.parent, nodes.section)
+            text = STUB_NOTE if top else TUTORS_NOTE
+            if top:
+                section["classes"].append(STUB_CLASS)
+            section += nodes.paragraph(text, text)
+
+
+def is_stub(doctree: nodes.Node | None) -> bool:
+    """Is this page a stub of the student edition (no notebook, no download of its source)?"""
+    if doctree is None:
+        return False
+    return any(STUB_CLASS in s.get("classes", []) for s in doctree.findall(nodes.section))
 
 
 def _check_edition(app: Sphinx, config: Config) -> None:
@@ -95,6 +183,8 @@ def _check_edition(app: Sphinx, config: Config) -> None:
         # the pages' sources hold the solutions: not copied into the site, no "show source" link
         config.html_copy_source = False
         config.html_show_sourcelink = False
+    # pages can say what holds in one edition only: ```{only} student``` or ```{only} instructor```
+    app.tags.add(config.uio_teach_edition)
     logger.info(f"[editions] building the {config.uio_teach_edition} edition of the book")
 
 

@@ -82,7 +82,7 @@ class Decoupling:
 
     ``M = [E 0][CE D]^+ + Mv (I - [CE D][CE D]^+)``, ``A1 = (I - M C) A``,
     ``N`` (orthonormal rows) annihilates ``D`` so that gains of the form
-    ``L = L' N`` satisfy ``L D = 0``; ``pair`` is the pair ``(A1, N C)`` in
+    ``L = ell N`` satisfy ``L D = 0``; ``pair`` is the pair ``(A1, N C)`` in
     balanced units with its observability split (what a gain can move is
     decided there, so it does not depend on the units of the data).
 

@@ -68,8 +68,8 @@ UNIT = "model units"
 
 FIGURE_WIDTH = 9.0
 """Width (inches) of a new figure: drawn at 100 dpi, the book shows it at 688 of its 911 px."""
-FONT_SIZE = 10
-"""Font size (points) of legends and notes: about 10.5 px at the book's column width."""
+FONT_SIZE = 11
+"""Font size (points) of legends and notes: about 11.5 px at the book's column width (688 px)."""
 
 _ROUNDING = 1e-9
 """Relative size below which a panel's values are called zero to rounding."""

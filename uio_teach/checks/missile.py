@@ -578,7 +578,7 @@ def missile_noise(
     observer: Any = None,
     initial_state: Any = None,
 ) -> CheckResult:
-    """Check the RMS error of ``v̂`` with noise, and compare it with ``sigma rho_i / (sqrt(2) h)``.
+    """Check the RMS error of ``v̂`` with noise, and compare it with ``sigma gamma_i / (sqrt(2) h)``.
 
     Parameters
     ----------

@@ -232,7 +232,7 @@ class ExplorerFigure:
         self.lmi = scenario.decay_limits is not None if lmi is None else bool(lmi)
         self.footer_lines = int(footer_lines)
         # the legends: the smallest text (on a phone as large as the tick labels)
-        self.legend_pt = (7.0 if self.narrow else 6.5) * k
+        self.legend_pt = 7.0 * k
         self.lines: dict[str, list] = {}
         self.notes: dict[str, Any] = {}  # texts drawn over the curves (none by default)
         self._layout(figsize, dpi)
@@ -421,6 +421,7 @@ class ExplorerFigure:
         if sc.discrete:
             theta = np.linspace(0, 2 * np.pi, 181)
             pz.plot(np.cos(theta), np.sin(theta), color="0.5", lw=0.8)
+            pz.set_aspect("equal", adjustable="box")  # the unit circle drawn round
         else:
             pz.axvline(0.0, color="0.5", lw=0.8)
         pz.axhline(0.0, color="0.8", lw=0.6)
@@ -550,7 +551,8 @@ class ExplorerFigure:
                     data = [np.array([-size, size])]
                 ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), fresh))
         sig = self.axes["signals"]
-        wanted = _nice_range([frame.d, frame.v])
+        lo, hi = _nice_range([frame.d, frame.v])
+        wanted = (lo, hi + 0.5 * (hi - lo))  # room above the curves for the legend
         sig.set_ylim(*_keep_range(sig.get_ylim(), wanted, self._fresh or not self.sticky))
         self._fresh = False
         if len(t) > 1:

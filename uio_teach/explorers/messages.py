@@ -597,8 +597,10 @@ def explain(
     elif movable.size:
         what = "The LMI bound picks" if s.mode == "lmi" else "The pole controls move"
         parts.append(f"{what} the {name} poles {format_poles(movable, 3)}.")
-    else:
+    elif scenario.movable == 0:
         parts.append(f"No pole of the {name} can be moved.")
+    elif not poles.size:  # the design failed for these settings: its message says why
+        parts.append(f"No {name} could be designed for these settings; its message says why.")
     if fixed.size:
         parts.append(
             f"Fixed whatever the gain: {format_poles(fixed, 3)} (the invariant zeros, o on "

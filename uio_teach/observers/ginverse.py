@@ -99,8 +99,11 @@ class GInverseObserver(Observer):
         return self._G
 
     @property
-    def F(self) -> np.ndarray:
-        """``Av - Kv Cv``: the observer-state matrix of eq. (21)."""
+    def Fv(self) -> np.ndarray:
+        """``Av - Kv Cv``: the observer-state matrix of eq. (21).
+
+        Not the error matrix (``error_matrix``): it has ``rank(C)`` more eigenvalues, at 0.
+        """
         return read_only(self.Av - self.Kv @ self.Cv)
 
     @property
@@ -122,7 +125,7 @@ class GInverseObserver(Observer):
     def realization(self) -> ObserverRealization:
         pl = self.plant
         return ObserverRealization(
-            A=self.F,
+            A=self.Fv,
             B_u=(self.projection - self.K @ pl.C) @ pl.B,
             B_y=self.G,
             C=self.projection,

@@ -1,0 +1,422 @@
+"""The student edition, page by page: nothing of a solution anywhere, and readable on any screen.
+
+The book that ``make book`` builds (the student edition, ``_build/html``) is checked for every
+page of ``_toc.yml``:
+
+* **what a student receives**: no page shows a lab's model solutions, the tutors' notes or an
+  output computed from a solution (a lab's check cells are shown unrun); no visible text names
+  the other edition or dropdowns; the page's notebook (``_notebooks/``) and its words in the
+  search index hold nothing the page leaves out; every local link and download of the page
+  resolves (the sources are not copied into the site, and no link points to them);
+* **the screen**, in headless Chromium at 390 px (a phone) and 1280 px (a desktop): the page
+  never scrolls sideways, whatever is wider than the column scrolls in its own frame with a
+  visible cue, figure text is at least 9 CSS px on the phone and 11 px on the desktop, and a
+  figure is shown with its own aspect ratio (round circles stay round).
+
+What the pages hide is read from their MyST sources: code cells tagged ``solution`` or
+``instructor``, the text of ``{solution-start}`` ... ``{solution-end}`` blocks and of the
+"Instructor notes" sections. The book is built once per test run (``built_book``).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import unicodedata
+from html import unescape
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import unquote, urlsplit
+
+import pytest
+import test_book
+from test_book import PAGES, ROOT, SCREENSHOTS, _open_local
+
+# the book, its local server and the browser of test_book (one build per test run)
+built_book = test_book.built_book
+book_server = test_book.book_server
+browser = test_book.browser
+
+pytestmark = [pytest.mark.book]
+
+SOURCES = {page: ROOT / f"{page}.md" for page in PAGES}
+LABS = [page for page in PAGES if Path(page).name.startswith("lab_")]
+HIDDEN_TAGS = ("solution", "instructor")
+# Words no student page may show: the other edition and the dropdowns it has.
+FORBIDDEN = ("instructor edition", "book-instructor", "dropdown")
+
+# The smallest text of a figure drawn by a chapter (points) and the resolution it is drawn at:
+# book/matplotlibrc and uio_teach.plotting.FONT_SIZE; test_fonts_of_the_chapters_figures keeps the
+# chapters' own font sizes at or above it.
+FIGURE_FONT_PT = 11
+FIGURE_DPI = 100
+PHONE, DESKTOP = 390, 1280
+SMALLEST_TEXT_PX = {PHONE: 9.0, DESKTOP: 11.0}
+
+
+# --- what the sources hide ---------------------------------------------------------------------
+
+
+def _fence_blocks(lines: list[str]) -> list[tuple[int, int, str, list[str]]]:
+    """Each ```` ```{name} ```` block: (first line, last line, name, tags)."""
+    blocks = []
+    i = 0
+    while i < len(lines):
+        m = re.match(r"^(`{3,})\{([\w-]+)\}", lines[i])
+        if not m:
+            i += 1
+            continue
+        fence, name, start = m.group(1), m.group(2), i
+        tags: list[str] = []
+        i += 1
+        while i < len(lines) and lines[i].rstrip() != fence:
+            t = re.match(r"^:tags:\s*\[(.*)\]", lines[i])
+            if t:
+                tags = [s.strip().strip("'\"") for s in t.group(1).split(",")]
+            i += 1
+        blocks.append((start, i, name, tags))
+        i += 1
+    return blocks
+
+
+def hidden_and_shown(source: Path) -> tuple[list[str], set[str]]:
+    """The lines of a page's source the student edition leaves out, and the lines it keeps.
+
+    Hidden: code cells tagged ``solution``/``instructor``, everything between a
+    ``{solution-start}`` and its ``{solution-end}``, and an "Instructor notes" section (to the
+    next heading of its level or higher). Lines are stripped; only lines of 25 characters or
+    more that the shown part does not also contain (blanks ignored) are returned as hidden
+    (distinctive probes).
+    """
+    lines = source.read_text(encoding="utf-8").splitlines()
+    hidden = [False] * len(lines)
+    blocks = _fence_blocks(lines)
+    for start, end, name, tags in blocks:
+        if name == "code-cell" and any(tag in HIDDEN_TAGS for tag in tags):
+            for k in range(start, end + 1):
+                hidden[k] = True
+    inside = False
+    for k, line in enumerate(lines):
+        if line.startswith("```{solution-start}"):
+            inside = True
+        if inside:
+            hidden[k] = True
+        if line.startswith("```{solution-end}"):
+            inside = False
+    level = 0
+    for k, line in enumerate(lines):
+        m = re.match(r"^(#+)\s+(.*)$", line)
+        if m and not any(s <= k <= e for s, e, name, _ in blocks if name == "code-cell"):
+            depth = len(m.group(1))
+            if level and depth <= level:
+                level = 0
+            if m.group(2).strip().lower().startswith("instructor"):
+                level = depth
+        if level:
+            hidden[k] = True
+    shown = {line.strip() for line, h in zip(lines, hidden, strict=True) if not h}
+    everything_shown = _squash("".join(shown))
+    probes = [
+        line.strip()
+        for line, h in zip(lines, hidden, strict=True)
+        if h and len(line.strip()) >= 25 and _squash(line) not in everything_shown
+    ]
+    return probes, shown
+
+
+class _Text(HTMLParser):
+    """The text of a page (scripts and styles left out), and its local links."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.parts: list[str] = []
+        self.links: list[str] = []
+        self._skip = 0
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag in ("script", "style"):
+            self._skip += 1
+        for name, value in attrs:
+            if name in ("href", "src") and value:
+                self.links.append(value)
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in ("script", "style") and self._skip:
+            self._skip -= 1
+
+    def handle_data(self, data: str) -> None:
+        if not self._skip:
+            self.parts.append(data)
+
+
+def _squash(text: str) -> str:
+    return re.sub(r"\s+", "", unescape(text))
+
+
+def page_text(html_file: Path) -> tuple[str, list[str]]:
+    parser = _Text()
+    parser.feed(html_file.read_text(encoding="utf-8"))
+    return " ".join(parser.parts), parser.links
+
+
+def _main_text(html_file: Path) -> str:
+    """The text of the page's article (the part written from its source)."""
+    html = html_file.read_text(encoding="utf-8")
+    start = html.find('<article class="bd-article">')
+    end = html.find("</article>", start)
+    parser = _Text()
+    parser.feed(html[start:end] if start >= 0 and end > start else html)
+    return " ".join(parser.parts)
+
+
+# --- what a student receives -------------------------------------------------------------------
+
+
+def test_the_probes_find_what_a_lab_hides():
+    """The reader of hidden lines finds the lab's solutions and tutors' notes (else the
+    artefact tests below would pass on nothing)."""
+    for lab in LABS:
+        probes, _ = hidden_and_shown(SOURCES[lab])
+        assert len(probes) > 20, (lab, len(probes))
+        assert any("ut." in p or "np." in p for p in probes), lab  # solution code
+        assert any(re.search(r"[a-z]{4,} [a-z]{4,} [a-z]{4,}", p) for p in probes), lab  # prose
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_no_page_shows_what_its_source_hides(page: str, built_book: Path) -> None:
+    html = built_book / f"{page}.html"
+    text = _squash(_main_text(html))
+    probes, _ = hidden_and_shown(SOURCES[page])
+    shown = [p for p in probes if _squash(p) in text]
+    assert not shown, f"{page}: the page shows hidden lines: {shown[:5]}"
+    visible = page_text(html)[0].lower()
+    named = [w for w in FORBIDDEN if w in visible]
+    assert not named, f"{page}: names {named}"
+
+
+@pytest.mark.parametrize("page", LABS)
+def test_lab_checks_are_shown_unrun(page: str, built_book: Path) -> None:
+    """A lab's check cells have no output (their verdicts would come from the model solution)
+    and say why; no ✓/✗ verdict and no "checks passed" is on the page."""
+    html = (built_book / f"{page}.html").read_text(encoding="utf-8")
+    cells = re.split(r'<div class="cell docutils container', html)[1:]
+    checks = [c for c in cells if 'checks</span><span class="o">.</span>' in c.split("</pre>")[0]]
+    assert checks, f"{page}: no check cell found"
+    with_output = [c[:200] for c in checks if 'class="cell_output' in c]
+    assert not with_output, f"{page}: check cells with an output: {with_output[:2]}"
+    assert all("student-unrun" in c for c in checks), page
+    text = _main_text(built_book / f"{page}.html")
+    assert "checks passed" not in text and not re.search(r"[✓✗]\s+\w+", text), page
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_the_notebook_holds_nothing_the_page_leaves_out(page: str, built_book: Path) -> None:
+    """The page's notebook (``_notebooks/``): no hidden line, and every line of code in it is
+    on the page: a lab's ``# TODO`` cells are its starting code. The cells that only test the
+    page's stated numbers (tagged ``remove-cell``, never inside a solution) stay in the notebook,
+    so that it runs as the page did."""
+    notebook = built_book / "_notebooks" / f"{Path(page).name}.ipynb"
+    html = built_book / f"{page}.html"
+    text, links = page_text(html)
+    linked = [link for link in links if "_notebooks/" in link]
+    if not notebook.exists():
+        assert not linked, f"{page}: links a notebook that is not in the site: {linked}"
+        return
+    assert linked, f"{page}: its notebook is in the site but the page does not link it"
+    cells = json.loads(notebook.read_text(encoding="utf-8"))["cells"]
+    body = "\n".join("".join(c["source"]) for c in cells)
+    probes, _ = hidden_and_shown(SOURCES[page])
+    squashed = _squash(body)
+    leaked = [p for p in probes if _squash(p) in squashed]
+    assert not leaked, f"{page}: the notebook holds hidden lines: {leaked[:5]}"
+    on_page = _squash(text)
+    code = [
+        line.strip()
+        for c in cells
+        if c["cell_type"] == "code" and "remove-cell" not in c["metadata"].get("tags", [])
+        for line in "".join(c["source"]).splitlines()
+        if line.strip() and not line.strip().startswith("#")
+    ]
+    missing = [line for line in code if _squash(line) not in on_page]
+    assert not missing, f"{page}: the notebook has code the page does not show: {missing[:5]}"
+
+
+def test_the_search_index_holds_only_words_of_the_pages(built_book: Path) -> None:
+    """Every word the search index files under a page is a word of that page."""
+    from sphinx.search.en import SearchEnglish
+
+    stem = SearchEnglish({}).stem
+    raw = (built_book / "searchindex.js").read_text(encoding="utf-8")
+    index = json.loads(raw[raw.index("(") + 1 : raw.rindex(")")])
+    docs = index["docnames"]
+    words: dict[int, set[str]] = {i: set() for i in range(len(docs))}
+    for key in ("terms", "titleterms"):
+        for term, where in index[key].items():
+            for i in where if isinstance(where, list) else [where]:
+                words[i].add(term)
+    for i, doc in enumerate(docs):
+        html = built_book / f"{doc}.html"
+        if not html.exists():
+            continue
+        # the page's text, and (for raw HTML outputs, indexed as written) its markup
+        source = html.read_text(encoding="utf-8")
+        text = " ".join([page_text(html)[0], source, re.sub(r"<[^>]+>", "", source)])
+        text += " " + unicodedata.normalize("NFC", unescape(text))
+        found = set(re.findall(r"\w+", text)) | set(re.findall(r"\w+", text.lower()))
+        # words split where a letter is not ASCII ("André" indexed as "andr", "é")
+        found |= set(re.findall(r"[a-z0-9_]+", text.lower())) | set(
+            re.findall(r"[^\W\x00-\x7f]+", text)
+        )
+        stems = found | {stem(w) for w in found}
+        extra = sorted(words[i] - stems)
+        assert not extra, f"{doc}: the search index has words that are not on the page: {extra}"
+
+
+def _local_target(built_book: Path, page_file: Path, link: str) -> Path | None:
+    parts = urlsplit(link)
+    if parts.scheme or parts.netloc or link.startswith(("#", "data:", "javascript:", "mailto:")):
+        return None
+    if not parts.path:
+        return None
+    return (page_file.parent / unquote(parts.path)).resolve()
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_every_local_link_and_download_resolves(page: str, built_book: Path) -> None:
+    html = built_book / f"{page}.html"
+    _, links = page_text(html)
+    missing = []
+    for link in links:
+        target = _local_target(built_book, html, link)
+        if target is not None and not target.exists():
+            missing.append(link)
+    assert not missing, f"{page}: links to files not in the site: {sorted(set(missing))}"
+    assert not (built_book / "_sources").exists(), "the pages' sources are copied into the site"
+
+
+def test_fonts_of_the_chapters_figures() -> None:
+    """The figures' smallest text: the book's Matplotlib settings and every font size a chapter
+    or the plotting module sets are at least FIGURE_FONT_PT."""
+    from uio_teach import plotting
+
+    assert plotting.FONT_SIZE >= FIGURE_FONT_PT
+    rc = (ROOT / "book" / "matplotlibrc").read_text(encoding="utf-8")
+    sizes = {k: float(v) for k, v in re.findall(r"^([\w.]*size):\s*([\d.]+)", rc, re.M)}
+    assert sizes.get("font.size", 0) >= FIGURE_FONT_PT, sizes
+    assert min(sizes.values()) >= FIGURE_FONT_PT, sizes
+    small = []
+    for page, source in SOURCES.items():
+        for m in re.finditer(r"(fontsize|labelsize)\s*=\s*([\d.]+)", source.read_text("utf-8")):
+            if float(m.group(2)) < FIGURE_FONT_PT:
+                small.append(f"{page}: {m.group(0)}")
+    assert not small, small
+
+
+# --- the screen --------------------------------------------------------------------------------
+
+_SCREEN_JS = """
+() => {
+  const se = document.scrollingElement;
+  // the article: the side bars are drawers off screen on a phone
+  const main = document.querySelector("article.bd-article") || document.body;
+  const out = {page: se.scrollWidth, viewport: se.clientWidth, loose: [], frames: [], images: []};
+  const scrolls = (el) => ["auto", "scroll"].includes(getComputedStyle(el).overflowX);
+  for (const el of main.querySelectorAll("*")) {
+    if (!el.checkVisibility()) continue;
+    const r = el.getBoundingClientRect();
+    if (r.width === 0 || r.right <= se.clientWidth + 0.5) continue;
+    let framed = false;
+    for (let a = el.parentElement; a && a !== main; a = a.parentElement) {
+      if (["auto", "scroll", "hidden", "clip"].includes(getComputedStyle(a).overflowX)) {
+        framed = true; break;
+      }
+    }
+    if (!framed) {
+      const name = `${el.tagName}.${String(el.className).slice(0, 30)}`;
+      out.loose.push(`${name} to ${Math.round(r.right)}`);
+    }
+  }
+  const boxes = "pre, table, .output, .cell_output, .table-wrapper, mjx-container";
+  for (const el of main.querySelectorAll(boxes)) {
+    if (!el.checkVisibility() || el.scrollWidth <= el.clientWidth + 1 || !scrolls(el)) continue;
+    const s = getComputedStyle(el);
+    const cue = /gradient/.test(s.backgroundImage) || s.scrollbarWidth === "thin"
+      || el.closest(".uio-static-explorer") !== null;
+    out.frames.push({what: `${el.tagName}.${String(el.className).slice(0, 30)}`, cue});
+  }
+  for (const img of main.querySelectorAll("img")) {
+    if (!img.checkVisibility() || !img.naturalWidth) continue;
+    const r = img.getBoundingClientRect();
+    out.images.push({
+      explorer: img.closest(".uio-static-explorer") !== null,
+      output: img.closest(".cell_output") !== null,
+      natural: img.naturalWidth, naturalHeight: img.naturalHeight,
+      width: r.width, height: r.height,
+      src: (img.getAttribute("src") || "").slice(0, 60),
+    });
+  }
+  return out;
+}
+"""
+
+
+def _explorer_text_px(image: dict, width: int) -> float:
+    """The smallest text of an explorer picture as shown, in CSS pixels."""
+    from uio_teach.explorers import pa9_scenario
+    from uio_teach.explorers._figure import ExplorerFigure
+    from uio_teach.explorers.static import (
+        NARROW_DPI,
+        NARROW_FONTSCALE,
+        NARROW_PX,
+        WIDE_FONTSCALE,
+    )
+
+    narrow = width <= NARROW_PX
+    figure = ExplorerFigure(
+        pa9_scenario(),
+        dpi=NARROW_DPI if narrow else 144,
+        fontscale=NARROW_FONTSCALE if narrow else WIDE_FONTSCALE,
+        narrow=narrow,
+    )
+    return figure.smallest_text_pt() * figure.fig.dpi / 72 * image["width"] / image["natural"]
+
+
+def measure(browser, book_server: str, page: str, width: int) -> dict:
+    context, tab = _open_local(browser, book_server, page, width)
+    try:
+        m = tab.evaluate(_SCREEN_JS)
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        name = "-".join(Path(page).parts[1:] or Path(page).parts)
+        tab.screenshot(path=str(SCREENSHOTS / f"{name}-{width}px.png"), full_page=True)
+    finally:
+        context.close()
+    for image in m["images"]:
+        if image["explorer"]:
+            image["text_px"] = _explorer_text_px(image, width)
+        elif image["output"]:
+            image["text_px"] = FIGURE_FONT_PT * FIGURE_DPI / 72 * image["width"] / image["natural"]
+    return m
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("width", [PHONE, DESKTOP])
+@pytest.mark.parametrize("page", PAGES)
+def test_readable_on_a_phone_and_a_desktop(page: str, width: int, book_server, browser) -> None:
+    m = measure(browser, book_server, page, width)
+    assert m["page"] <= m["viewport"], f"{page} at {width} px scrolls sideways: {m['loose'][:5]}"
+    assert not m["loose"], f"{page} at {width} px: unframed, too wide: {m['loose'][:5]}"
+    no_cue = [f["what"] for f in m["frames"] if not f["cue"]]
+    assert not no_cue, f"{page} at {width} px: frames that scroll with no visible cue: {no_cue}"
+    least = SMALLEST_TEXT_PX[width]
+    small = [
+        f"{i['src']} shown {i['width']:.0f} of {i['natural']} px: text {i['text_px']:.1f} px"
+        for i in m["images"]
+        if "text_px" in i and i["text_px"] < least - 0.05
+    ]
+    assert not small, f"{page} at {width} px: figure text under {least} px: {small}"
+    squeezed = [
+        i["src"]
+        for i in m["images"]
+        if abs(i["height"] / i["width"] - i["naturalHeight"] / i["natural"]) > 1.5 / i["width"]
+    ]
+    assert not squeezed, f"{page} at {width} px: pictures not at their aspect ratio: {squeezed}"
