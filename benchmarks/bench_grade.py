@@ -32,7 +32,7 @@ import nbformat
 
 from uio_teach.instructor import cli, grade
 
-SETUP = "import numpy as np\nimport control as ct\nimport uio_teach as ut\nfrom uio_teach import checks\n"
+SETUP = "import numpy as np\nimport uio_teach as ut\nfrom uio_teach import checks\n"
 HOSTILE_CELLS = {
     "forks": """\
         import os, time
@@ -61,7 +61,12 @@ HOSTILE_CELLS = {
         for k in range(100):
             fig.add_axes([0, 0, 0.01, 0.01])
         """,
-    "endless": "import signal\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nwhile True:\n    pass\n",
+    "endless": """\
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        while True:
+            pass
+        """,
     "suicide": "import os, signal\nos.kill(-1, signal.SIGKILL)\n",
     "plain": "x = 1\n",
 }

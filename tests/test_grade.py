@@ -843,3 +843,36 @@ def test_no_sandbox_grades_the_same_says_so_loudly_and_no_group_is_never_ok(tmp_
     first, second = rows(out)
     assert first["status"] == "ok" and first["pa9.design"] == grade.PASS and first["total"] == "1"
     assert second["status"] == "check by hand" and "no group" in second["reason"]
+
+
+def test_a_failure_of_the_grader_on_one_hand_in_is_that_rows_and_the_run_goes_on(
+    tmp_path, monkeypatch, capsys
+):
+    def broken(nb, lab, params):
+        if any("boom" in c.source for c in nb.cells):
+            raise KeyError("a bug of the grader")
+        return real(nb, lab, params)
+
+    real = grade.prepare
+    monkeypatch.setattr(grade, "prepare", broken)
+    monkeypatch.setattr(grade, "read_handin", explode_on("pa9_g02", grade.read_handin))
+    subs = [
+        small(tmp_path / "pa9_g01.ipynb", "g01", "x = 'boom'", design=False),
+        small(tmp_path / "pa9_g02.ipynb", "g02", design=False),
+    ]
+    out = tmp_path / "grades.csv"
+    code = cli.main(["grade", *map(str, subs), "--out", str(out), "--no-sandbox", "-q"])
+    assert code == 0
+    first, second = rows(out)
+    assert first["status"] == second["status"] == "grader error"
+    assert "KeyError" in first["reason"] and "cannot be read" in second["reason"]
+    assert "2 rows need a look (2 grader error)" in capsys.readouterr().err
+
+
+def explode_on(stem: str, real):
+    def read(path, roster=None):
+        if Path(path).stem == stem:
+            raise MemoryError
+        return real(path, roster)
+
+    return read

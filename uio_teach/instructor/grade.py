@@ -1,30 +1,41 @@
-"""Grade submitted lab notebooks: each run sandboxed, its answers checked in the grader's process.
+"""Grade a class's hand-ins: each run sandboxed, its answers checked in a limited process.
 
-:func:`grade` takes the notebooks the groups handed in and, for each one:
+:func:`grade` takes the hand-in folder (or the files) and, for each hand-in:
 
-1. reads it (the submission itself is never written to) and finds its lab and
-   group: from the notebook's metadata ``{"uio_teach": {"lab": ..., "group":
-   ...}}``, else from a file name such as ``pa9_g03.ipynb``;
-2. makes a copy with every stored output cleared (a stored ✓ counts for
+1. reads it without following links (:func:`read_handin`): only a regular
+   file of the folder is read, never written; its group comes from the file
+   name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
+   notebook's metadata says is only compared with it; a clean copy of its
+   cells is made (:func:`~uio_teach.instructor.runner.clean_notebook`);
+2. compares the class (:func:`_identity_notes`): a notebook that disagrees
+   with its name, a group handing in twice, the same code from two groups or
+   no group at all is "check by hand", never ``ok``;
+3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
    data (:mod:`uio_teach.instructor.runner`);
-3. runs the copy in a fresh kernel inside a sandbox
+4. runs the copy in a fresh kernel inside a sandbox
    (:mod:`uio_teach.instructor.sandbox`: only its own copy visible, no
-   network, no other process, limits on memory, processes and time); a cell
-   that raises or loops is recorded and the next cells still run;
-4. rebuilds the answers as genuine objects in the grader's own process
-   (:mod:`uio_teach.checks.answers`) and runs the lab's checks on them with
-   **the answer key's parameters** (:mod:`uio_teach.checks.grading`). The
-   verdicts the check cells printed inside the notebook count for nothing, and
-   nothing the notebook defines (``PARAMS``, a patched class, a patched
-   module) reaches the checks: only right values pass;
-5. appends its row to the gradebook and writes its feedback text at once
-   (:mod:`uio_teach.instructor.gradebook`), so a killed run keeps every
-   finished row and ``resume=True`` grades only what is missing.
+   network, no other process, an unprivileged user when the grader is root,
+   limits on memory, processes, writes and time); a cell that raises or
+   loops is recorded and the next cells still run;
+5. checks the answers in a child process with limits of time and memory
+   (:mod:`uio_teach.instructor.checking`): answers over the size caps are not
+   rebuilt, the rest are rebuilt as genuine objects and checked with **the
+   answer key's parameters** (:mod:`uio_teach.checks.grading`). The verdicts
+   the check cells printed count for nothing, and nothing the notebook
+   defines (``PARAMS``, a patched class, a patched module) reaches the
+   checks: only right values pass;
+6. appends its row to the gradebook and writes its feedback at once
+   (:mod:`uio_teach.instructor.gradebook`), so a killed or interrupted run
+   keeps every finished row and ``resume=True`` grades only what is missing.
 
-``jobs`` submissions run at a time. The temporary folders of a run are
-removed when it ends; those of runs that were killed are removed by the next.
+Whatever fails on one hand-in (reading, preparing, running, reading back,
+checking, or the grader itself) becomes that row's status with a one-line
+reason; the run goes on. ``jobs`` hand-ins run at a time. Before the first,
+the sandbox is tested with the real interpreter and a one-cell notebook. The
+temporary folders of a run are removed when it ends; those of runs that were
+killed are removed by the next.
 
 Examples
 --------
