@@ -282,8 +282,10 @@ def graded(labs, tmp_path_factory) -> dict:
 
     # wrong: the untouched template, the checks patched, another group's parameters
     subs["student"] = folder / "pa9_g04.ipynb"
-    subs["student"].write_bytes(labs["student"]["g01"].read_bytes())
     nb = nbformat.read(labs["student"]["g01"], as_version=4)
+    nb.metadata["uio_teach"]["group"] = "g04"  # the template group 4 was given
+    nbformat.write(nb, subs["student"])
+    nb.metadata["uio_teach"]["group"] = "g06"
     add_cell(
         nb,
         """\
@@ -759,7 +761,7 @@ def test_a_cell_that_never_ends_is_stopped_and_graded_on_what_ran(tmp_path):
         "while True:\n    time.sleep(0.05)",
         design=False,
     )
-    (sub,) = grade.grade([nb], tmp_path / "grades.csv", timeout=30, cell_timeout=5)
+    (sub,) = grade.grade([nb], tmp_path / "grades.csv", timeout=20, cell_timeout=3)
     assert sub.status == "timeout" and "time limit" in sub.feedback()
 
 
@@ -833,7 +835,7 @@ def test_without_a_sandbox_grading_is_refused_unless_asked(tmp_path, monkeypatch
 
 def test_no_sandbox_grades_the_same_says_so_loudly_and_no_group_is_never_ok(tmp_path, capsys):
     nb = small(tmp_path / "pa9_g01.ipynb", "g01")
-    anonymous = small(tmp_path / "mine.ipynb", None)  # on the book's numbers, and no group
+    anonymous = small(tmp_path / "mine.ipynb", None, "x = 2")  # book's numbers, no group
     out = tmp_path / "grades.csv"
     code = cli.main(["grade", str(nb), str(anonymous), "--out", str(out), "--no-sandbox", "-q"])
     assert code == 0

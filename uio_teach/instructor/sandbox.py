@@ -269,9 +269,12 @@ def sandbox_problem() -> str | None:
 
 def _open_parents(mounts: Sequence[tuple[str, str, str]]) -> list[str]:
     """``--chmod 0755`` for every folder bwrap creates above a mount (not inside one)."""
-    bound = [Path(dest) for kind, _, dest in mounts if kind != "--symlink"]
+    every = [Path(dest) for kind, _, dest in mounts if kind != "--symlink"]
+    # a folder made inside a bound host folder is the host's (read-only); one made inside the
+    # sandbox's own /tmp or root is bwrap's, root's and closed: opened here
+    bound = [Path(d) for kind, _, d in mounts if kind in ("--bind", "--ro-bind", "--ro-bind-try")]
     made: list[str] = []
-    for dest in bound:
+    for dest in every:
         for parent in list(dest.parents)[::-1][1:]:  # "/" left out, outermost first
             inside = any(parent == b or b in parent.parents for b in bound)
             if not inside and os.fspath(parent) not in made:
