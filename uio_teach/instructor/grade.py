@@ -279,7 +279,13 @@ NEEDS_A_LOOK = (
 
 @dataclass
 class Handin:
-    """One hand-in as the grader found it, before it runs.
+    """One hand-in as the grader found it, before it runs (see :func:`read_handin`).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.grade import Handin
+    >>> Handin("pa9_g01.ipynb", "pa9", "g01").status
+    ''
 
     Attributes
     ----------
@@ -689,8 +695,8 @@ def write_gradebook(
     ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
     ...     print(csv_path.read_text(encoding="utf-8").splitlines()[1])
     ...     print(sorted(p.name for p in folder.iterdir()))
-    a.ipynb,pa9,g01,ok,✗,0,1
-    ['a.txt', 'manifest.json']
+    a.ipynb,pa9,g01,ok,,✗,0,1
+    ['a.html', 'a.txt', 'manifest.json']
     """
     columns: list[str] = []
     for sub in submissions:

@@ -238,8 +238,8 @@ def safe_cell(value: Any) -> str:
     Examples
     --------
     >>> from uio_teach.instructor.gradebook import safe_cell
-    >>> safe_cell('=HYPERLINK("http://x")'), safe_cell("-3"), safe_cell("a\\nb")
-    ('\'=HYPERLINK("http://x")', '-3', 'a b')
+    >>> print(safe_cell('=HYPERLINK("http://x")'), safe_cell("-3"), safe_cell("a\\nb"))
+    '=HYPERLINK("http://x") -3 a b
     """
     text = _CONTROL.sub(" ", str(value)).strip()
     if text[:1] in ("=", "+", "-", "@") and not _NUMBER.match(text):
@@ -409,7 +409,7 @@ class Gradebook:
     ...     with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:
     ...         book.add(Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",)))
     ...     print(out.read_text(encoding="utf-8").splitlines()[1])
-    a.ipynb,pa9,g01,ok,✗,0,1
+    a.ipynb,pa9,g01,ok,,✗,0,1
     """
 
     def __init__(

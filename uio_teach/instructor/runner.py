@@ -201,8 +201,8 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     >>> raw = {"nbformat": 4, "cells": [
     ...     {"cell_type": "code", "source": "x = 1", "metadata": {"tags": 5}}]}
     >>> nb, notes = clean_notebook(raw)
-    >>> nb.cells[0].source, nb.cells[0].metadata["tags"], notes
-    ('x = 1', [], ['a cell whose tags are not a list of names: its tags were ignored'])
+    >>> nb.cells[0].source, nb.cells[0].metadata.get("tags"), notes
+    ('x = 1', None, ['a cell whose tags are not a list of names: its tags were ignored'])
     """
     if not isinstance(raw, dict):
         raise ValueError("not a notebook (not a JSON object)")
