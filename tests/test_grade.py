@@ -770,7 +770,8 @@ def test_a_grader_killed_mid_run_resumes_without_losing_a_row(tmp_path, monkeypa
     temp = tmp_path / "tmp"
     temp.mkdir()
     subs = [
-        str(small(tmp_path / f"pa9_g{i:02d}.ipynb", f"g{i:02d}", f"x = {i}")) for i in (1, 2, 3)
+        str(small(tmp_path / f"pa9_g{i:02d}.ipynb", f"g{i:02d}", f"x = {i}", design=False))
+        for i in (1, 2)
     ]
     out = tmp_path / "grades.csv"
     env = dict(os.environ, TMPDIR=str(temp))
@@ -791,7 +792,7 @@ def test_a_grader_killed_mid_run_resumes_without_losing_a_row(tmp_path, monkeypa
         os.killpg(grader.pid, signal.SIGKILL)
         grader.wait()
     kept = rows(out)
-    assert 1 <= len(kept) < 3, grader.stderr.read().decode()
+    assert len(kept) == 1, grader.stderr.read().decode()
     assert any(p.name.startswith(grade.TEMP_PREFIX) for p in temp.iterdir())  # left by the kill
     monkeypatch.setattr("tempfile.tempdir", str(temp))
     again = grade.grade(subs, out, resume=True)
@@ -799,7 +800,7 @@ def test_a_grader_killed_mid_run_resumes_without_losing_a_row(tmp_path, monkeypa
     assert [s.file for s in again] == [f for f in subs if f not in done_before]
     final = rows(out)
     assert [r["file"] for r in final] == subs
-    assert all(r["pa9.design"] == grade.PASS and r["status"] == "ok" for r in final)
+    assert all(r["status"] == "ok" for r in final)
     assert {r["file"]: r for r in final if r["file"] in done_before} == {k["file"]: k for k in kept}
     assert list(temp.iterdir()) == []  # the killed run's folder removed, this run's too
 
