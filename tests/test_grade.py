@@ -842,7 +842,7 @@ def test_no_sandbox_grades_the_same_says_so_loudly_and_no_group_is_never_ok(tmp_
     assert code == 0
     err = capsys.readouterr().err
     assert "WARNING: --no-sandbox" in err and "your permissions" in err
-    assert "1 row need a look (1 check by hand)" in err
+    assert "1 row needs a look (1 check by hand)" in err
     first, second = rows(out)
     assert first["status"] == "ok" and first["pa9.design"] == grade.PASS and first["total"] == "1"
     assert second["status"] == "check by hand" and "no group" in second["reason"]

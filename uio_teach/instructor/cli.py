@@ -708,7 +708,8 @@ def _grade(args: argparse.Namespace) -> int:
         for sub in look:
             counts[sub.status] = counts.get(sub.status, 0) + 1
         kinds = ", ".join(f"{n} {status}" for status, n in counts.items())
-        _say(f"{len(look)} row{'s' if len(look) != 1 else ''} need a look ({kinds})", sys.stderr)
+        verb = "rows need" if len(look) != 1 else "row needs"
+        _say(f"{len(look)} {verb} a look ({kinds})", sys.stderr)
     elif not args.quiet:
         _say("no row needs a look")
     return 0
