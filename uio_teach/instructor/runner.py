@@ -570,8 +570,13 @@ def run_notebook(
     outcome.errors = errors or []
     if status == "ok" and proc.returncode != 0:
         text = tail.text()
-        lines = [line for line in text.splitlines() if line.strip()]
-        last = _one_line(lines[-1]) if lines else f"exit status {proc.returncode}"
+        noise = ("[IPKernelApp]", "WARNING", "[W ", "[I ", "To connect another client")
+        lines = [x for x in text.splitlines() if x.strip() and not x.lstrip().startswith(noise)]
+        last = (
+            _one_line(lines[-1])
+            if lines
+            else f"its processes ended early (exit status {proc.returncode})"
+        )
         if "DeadKernelError" in text or "Kernel died" in text:
             last = "the kernel died (the notebook ended its own process, or ran out of memory)"
         notes.append(f"the notebook could not be run to its end: {last}")
