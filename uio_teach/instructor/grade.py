@@ -520,39 +520,27 @@ def _error_notes(outcome: RunOutcome) -> list[str]:
     return notes + list(outcome.notes)
 
 
-def _grade_one(
-    handin: Handin,
-    key: Mapping[tuple[str, str], dict[str, Any]] | None,
-    identity: list[str],
-    *,
-    root: Path,
-    index: int,
-    sandbox: bool,
-    timeout: float,
-    cell_timeout: float,
-    check_timeout: float,
-    limits: Limits,
-    stop: threading.Event,
-) -> Submission:
+@dataclass(frozen=True)
+class _Run:
+    """The settings every hand-in of one grading run shares."""
+
+    key: Mapping[tuple[str, str], dict[str, Any]] | None
+    root: Path
+    sandbox: bool
+    timeout: float
+    cell_timeout: float
+    check_timeout: float
+    limits: Limits
+    stop: threading.Event
+
+
+def _grade_one(handin: Handin, identity: list[str], index: int, run: _Run) -> Submission:
     start = time.perf_counter()
     sub = Submission(handin.file, handin.lab, handin.group, "ok")
     if handin.lab in GRADED:
         sub.expected = tuple(c.check_id for c in GRADED[handin.lab])
     try:
-        _run_one(
-            sub,
-            handin,
-            key,
-            identity,
-            root=root,
-            index=index,
-            sandbox=sandbox,
-            timeout=timeout,
-            cell_timeout=cell_timeout,
-            check_timeout=check_timeout,
-            limits=limits,
-            stop=stop,
-        )
+        _run_one(sub, handin, identity, index, run)
     except InterruptedError:
         raise
     except Exception as exc:  # any failure of the grader on this hand-in is this row's, only
@@ -565,21 +553,8 @@ def _grade_one(
     return sub
 
 
-def _run_one(
-    sub: Submission,
-    handin: Handin,
-    key: Mapping[tuple[str, str], dict[str, Any]] | None,
-    identity: list[str],
-    *,
-    root: Path,
-    index: int,
-    sandbox: bool,
-    timeout: float,
-    cell_timeout: float,
-    check_timeout: float,
-    limits: Limits,
-    stop: threading.Event,
-) -> None:
+def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, run: _Run) -> None:
+    key, sandbox, limits, stop = run.key, run.sandbox, run.limits, run.stop
     lab, group = handin.lab, handin.group
     if handin.status:
         sub.status, sub.reason = handin.status, handin.reason
@@ -603,15 +578,15 @@ def _run_one(
         params = _defaults(lab)
     sub.params = params
     copy, positions = prepare(handin.notebook, lab, params if key is not None else None)
-    folder = root / f"{index:04d}"
+    folder = run.root / f"{index:04d}"
     try:
         outcome = run_notebook(
             copy,
             folder,
             positions=positions,
             sandbox=sandbox,
-            timeout=timeout,
-            cell_timeout=cell_timeout,
+            timeout=run.timeout,
+            cell_timeout=run.cell_timeout,
             limits=limits,
             stop=stop,
             user=sandbox_user(index + 1) if sandbox else None,
@@ -639,7 +614,9 @@ def _run_one(
         ],
         "captures": outcome.captures,
     }
-    checked = check_in_child(request, timeout=check_timeout, memory_mb=limits.memory_mb, stop=stop)
+    checked = check_in_child(
+        request, timeout=run.check_timeout, memory_mb=limits.memory_mb, stop=stop
+    )
     sub.results = {
         str(r.get("check_id")): r
         for r in checked.results
@@ -949,24 +926,16 @@ def grade(
                 json.dumps({"pid": os.getpid(), "start": _start_time(os.getpid())}),
                 encoding="utf-8",
             )
+            run = _Run(
+                key, root, sandbox, timeout, min(cell_timeout, timeout), check_timeout, limits, stop
+            )
             running: dict[Future[Submission], Handin] = {}
             queue = list(todo)
             while queue or running:
                 while queue and len(running) < jobs:
                     index, handin = queue.pop(0)
                     future = pool.submit(
-                        _grade_one,
-                        handin,
-                        key,
-                        identity.get(handin.file, []),
-                        root=root,
-                        index=index,
-                        sandbox=sandbox,
-                        timeout=timeout,
-                        cell_timeout=min(cell_timeout, timeout),
-                        check_timeout=check_timeout,
-                        limits=limits,
-                        stop=stop,
+                        _grade_one, handin, identity.get(handin.file, []), index, run
                     )
                     running[future] = handin
                 finished, _ = wait(running, timeout=0.5, return_when=FIRST_COMPLETED)
