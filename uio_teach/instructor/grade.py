@@ -1,30 +1,41 @@
-"""Grade submitted lab notebooks: each run sandboxed, its answers checked in the grader's process.
+"""Grade a class's hand-ins: each run sandboxed, its answers checked in a limited process.
 
-:func:`grade` takes the notebooks the groups handed in and, for each one:
+:func:`grade` takes the hand-in folder (or the files) and, for each hand-in:
 
-1. reads it (the submission itself is never written to) and finds its lab and
-   group: from the notebook's metadata ``{"uio_teach": {"lab": ..., "group":
-   ...}}``, else from a file name such as ``pa9_g03.ipynb``;
-2. makes a copy with every stored output cleared (a stored ✓ counts for
+1. reads it without following links (:func:`read_handin`): only a regular
+   file of the folder is read, never written; its group comes from the file
+   name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
+   notebook's metadata says is only compared with it; a clean copy of its
+   cells is made (:func:`~uio_teach.instructor.runner.clean_notebook`);
+2. compares the class (:func:`_identity_notes`): a notebook that disagrees
+   with its name, a group handing in twice, the same code from two groups or
+   no group at all is "check by hand", never ``ok``;
+3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
    data (:mod:`uio_teach.instructor.runner`);
-3. runs the copy in a fresh kernel inside a sandbox
+4. runs the copy in a fresh kernel inside a sandbox
    (:mod:`uio_teach.instructor.sandbox`: only its own copy visible, no
-   network, no other process, limits on memory, processes and time); a cell
-   that raises or loops is recorded and the next cells still run;
-4. rebuilds the answers as genuine objects in the grader's own process
-   (:mod:`uio_teach.checks.answers`) and runs the lab's checks on them with
-   **the answer key's parameters** (:mod:`uio_teach.checks.grading`). The
-   verdicts the check cells printed inside the notebook count for nothing, and
-   nothing the notebook defines (``PARAMS``, a patched class, a patched
-   module) reaches the checks: only right values pass;
-5. appends its row to the gradebook and writes its feedback text at once
-   (:mod:`uio_teach.instructor.gradebook`), so a killed run keeps every
-   finished row and ``resume=True`` grades only what is missing.
+   network, no other process, an unprivileged user when the grader is root,
+   limits on memory, processes, writes and time); a cell that raises or
+   loops is recorded and the next cells still run;
+5. checks the answers in a child process with limits of time and memory
+   (:mod:`uio_teach.instructor.checking`): answers over the size caps are not
+   rebuilt, the rest are rebuilt as genuine objects and checked with **the
+   answer key's parameters** (:mod:`uio_teach.checks.grading`). The verdicts
+   the check cells printed count for nothing, and nothing the notebook
+   defines (``PARAMS``, a patched class, a patched module) reaches the
+   checks: only right values pass;
+6. appends its row to the gradebook and writes its feedback at once
+   (:mod:`uio_teach.instructor.gradebook`), so a killed or interrupted run
+   keeps every finished row and ``resume=True`` grades only what is missing.
 
-``jobs`` submissions run at a time. The temporary folders of a run are
-removed when it ends; those of runs that were killed are removed by the next.
+Whatever fails on one hand-in (reading, preparing, running, reading back,
+checking, or the grader itself) becomes that row's status with a one-line
+reason; the run goes on. ``jobs`` hand-ins run at a time. Before the first,
+the sandbox is tested with the real interpreter and a one-cell notebook. The
+temporary folders of a run are removed when it ends; those of runs that were
+killed are removed by the next.
 
 Examples
 --------
@@ -35,27 +46,30 @@ Examples
 
 from __future__ import annotations
 
-import ast
 import csv
+import dataclasses
+import hashlib
 import json
 import os
 import re
 import shutil
 import stat
+import sys
 import tempfile
 import threading
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import nbformat
 
-from ..checks.answers import AnswerError, from_data
-from ..checks.grading import GRADED, Missing, grade_answers, lab_plant
+from ..checks.grading import GRADED
 from ..errors import UIOTeachError, UIOTeachWarning
+from .checking import check_in_child
 from .gradebook import (
     FAIL,
     PASS,
@@ -66,8 +80,8 @@ from .gradebook import (
     feedback_folder,
 )
 from .labs import LABS
-from .runner import RunOutcome, prepare, run_notebook
-from .sandbox import Limits, sandbox_problem
+from .runner import RunOutcome, clean_notebook, prepare, run_notebook
+from .sandbox import Limits, sandbox_problem, sandbox_user
 
 __all__ = [
     "GradeError",
@@ -78,6 +92,11 @@ __all__ = [
     "GradebookBusy",
     "Limits",
     "grade",
+    "Handin",
+    "read_handin",
+    "handin_files",
+    "read_roster",
+    "NEEDS_A_LOOK",
     "read_answer_key",
     "write_gradebook",
     "group_from_name",
@@ -92,7 +111,6 @@ TEMP_PREFIX = "uio-teach-grade-"
 """The name of every temporary folder of a grading run starts so."""
 _OWNER = "owner.json"
 _GROUP_NAME = re.compile(r"^(?P<lab>.+?)_(?P<group>g\d+)$")
-_CHECKING = threading.Lock()  # the checks run one at a time in the grader's process
 
 
 class GradeError(UIOTeachError, ValueError):
@@ -245,97 +263,250 @@ def clean_leftovers(root: str | os.PathLike[str] | None = None) -> list[Path]:
     return removed
 
 
-# one submission ----------------------------------------------------------------------------
+# one hand-in ------------------------------------------------------------------------------
+
+MAX_HANDIN_BYTES = 32 * 1024 * 1024
+"""The largest hand-in read (a larger file is a refused row)."""
+NEEDS_A_LOOK = (
+    "grader error",
+    "refused",
+    "unreadable",
+    "unknown lab",
+    "check by hand",
+    "over limits",
+)
+"""The statuses of rows an instructor should look at (the others are marks as they stand)."""
 
 
-def _lab_of(nb: Any, path: Path) -> tuple[str, str]:
-    meta = nb.get("metadata", {}).get("uio_teach", {}) if isinstance(nb, Mapping) else {}
-    meta = meta if isinstance(meta, Mapping) else {}
-    lab = str(meta.get("lab", "") or "")
-    group = str(meta.get("group", "") or "")
-    name_lab, name_group = group_from_name(path)
-    lab, group = lab or name_lab, group or name_group
-    if not lab:
-        source = meta.get("source")
-        stem = Path(str(source)).stem if source else path.stem
-        lab = next((k for k, v in LABS.items() if Path(v.source).stem == stem), "")
-        lab = lab or stem.removeprefix("lab_")
-    return lab, group
+@dataclass
+class Handin:
+    """One hand-in as the grader found it, before it runs (see :func:`read_handin`).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.grade import Handin
+    >>> Handin("pa9_g01.ipynb", "pa9", "g01").status
+    ''
+
+    Attributes
+    ----------
+    file : str
+        The path as given.
+    lab, group : str
+        From the roster, else from the file name (never from the notebook).
+    notebook : NotebookNode or None
+        The grader's clean copy (:func:`~uio_teach.instructor.runner.clean_notebook`).
+    status, reason : str
+        ``"refused"`` or ``"unreadable"`` and why (empty when it can run).
+    notes : list of str
+        What the grader noticed (a dropped cell, what the notebook says of itself).
+    meta_lab, meta_group : str
+        The lab and group the notebook's metadata claims.
+    code : str
+        A fingerprint of its code (for hand-ins copied between groups).
+    """
+
+    file: str
+    lab: str = ""
+    group: str = ""
+    notebook: Any = None
+    status: str = ""
+    reason: str = ""
+    notes: list[str] = field(default_factory=list)
+    meta_lab: str = ""
+    meta_group: str = ""
+    code: str = ""
 
 
-def _read(path: Path) -> tuple[Any, str, str, str]:
-    """The notebook (or None), its lab, its group, and why it is unreadable."""
+def _kind(mode: int) -> str:
+    if stat.S_ISLNK(mode):
+        return "a link, not a file: hand-ins must be regular files in the hand-in folder"
+    if stat.S_ISDIR(mode):
+        return "a folder, not a notebook file"
+    return "not a regular file (a device, a pipe or a socket)"
+
+
+def _read_bytes(path: Path) -> tuple[bytes | None, str]:
+    """The bytes of a hand-in, or why it is refused; links are never followed."""
     try:
-        nb = nbformat.reads(path.read_bytes().decode("utf-8"), as_version=4)
-        if not isinstance(nb.get("cells"), list):
-            raise ValueError("no cells")
-    except Exception as exc:
-        reason = " ".join(str(exc).split())[:200] or type(exc).__name__
-        return None, *group_from_name(path), f"not a notebook: {reason}"
-    return nb, *_lab_of(nb, path), ""
+        info = os.lstat(path)
+    except OSError as err:
+        return None, f"cannot be read ({err.strerror or type(err).__name__})"
+    if not stat.S_ISREG(info.st_mode):
+        return None, _kind(info.st_mode)
+    if info.st_nlink > 1:
+        return None, "a second name (a hard link) of another file: hand in a copy"
+    if info.st_size > MAX_HANDIN_BYTES:
+        return None, f"larger than {MAX_HANDIN_BYTES >> 20} MB"
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+    try:
+        fd = os.open(path, flags | getattr(os, "O_NOCTTY", 0))
+    except OSError as err:
+        return None, f"cannot be read ({err.strerror or type(err).__name__})"
+    with os.fdopen(fd, "rb") as fh:
+        now = os.fstat(fh.fileno())
+        if not stat.S_ISREG(now.st_mode) or (now.st_ino, now.st_dev) != (
+            info.st_ino,
+            info.st_dev,
+        ):
+            return None, "changed while it was read (it is no longer the same regular file)"
+        data = fh.read(MAX_HANDIN_BYTES + 1)
+    if len(data) > MAX_HANDIN_BYTES:
+        return None, f"larger than {MAX_HANDIN_BYTES >> 20} MB"
+    return data, ""
+
+
+def _parse(data: bytes) -> tuple[Any, str]:
+    """The JSON of a hand-in, or why it is not a notebook (never quoting its content)."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        return None, "not a notebook: not UTF-8 text"
+    try:
+        return json.loads(text), ""
+    except json.JSONDecodeError as err:
+        return None, f"not a notebook: not JSON (line {err.lineno}, column {err.colno})"
+    except (ValueError, RecursionError):
+        return None, "not a notebook: not JSON"
+
+
+def _meta(raw: Any) -> tuple[str, str, str]:
+    meta = raw.get("metadata") if isinstance(raw, dict) else None
+    meta = meta.get("uio_teach") if isinstance(meta, dict) else None
+    meta = meta if isinstance(meta, dict) else {}
+
+    def text(key: str) -> str:
+        value = meta.get(key)
+        return _one_line(value, 40) if isinstance(value, str) else ""
+
+    return text("lab"), text("group"), text("source")
+
+
+def _one_line(text: Any, limit: int = 200) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _fingerprint(nb: Any) -> str:
+    """The code of a notebook, whitespace and its parameters cell left out, hashed."""
+    parts = []
+    for cell in nb.cells:
+        tags = cell.get("metadata", {}).get("tags", [])
+        if cell.get("cell_type") != "code" or "parameters" in tags:
+            continue
+        code = "\n".join(line.rstrip() for line in cell.source.splitlines() if line.strip())
+        if code:
+            parts.append(code)
+    if not parts:
+        return ""
+    return hashlib.sha256("\n\x00".join(parts).encode()).hexdigest()
+
+
+def read_handin(
+    path: str | os.PathLike[str], roster: Mapping[str, tuple[str, str]] | None = None
+) -> Handin:
+    """Read one hand-in: refuse what is not a regular file, parse it, find its lab and group.
+
+    The file is opened without following links; a link, a folder, a device,
+    a second name of another file or a file over :data:`MAX_HANDIN_BYTES` is
+    refused, and nothing of it is read. The group and lab come from the
+    roster (by file name), else from a name like ``pa9_g03.ipynb``; what the
+    notebook's metadata says is kept only to compare.
+
+    Parameters
+    ----------
+    path : str or path-like
+    roster : mapping, optional
+        File name -> (lab, group), from :func:`read_roster`.
+
+    Returns
+    -------
+    Handin
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, os
+    >>> from uio_teach.instructor.grade import read_handin
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     link = pathlib.Path(tmp) / "pa9_g01.ipynb"
+    ...     os.symlink("/etc/passwd", link)
+    ...     h = read_handin(link)
+    >>> h.status, h.group, h.reason.split(":")[0]
+    ('refused', 'g01', 'a link, not a file')
+    """
+    file = os.fspath(path)
+    name_lab, name_group = group_from_name(file)
+    lab, group = (roster or {}).get(Path(file).name, (name_lab, name_group))
+    lab = lab or name_lab
+    handin = Handin(file, lab, group)
+    data, why = _read_bytes(Path(file))
+    if data is None:
+        handin.status, handin.reason = "refused", why
+        return handin
+    raw, why = _parse(data)
+    if raw is not None:
+        try:
+            handin.notebook, handin.notes = clean_notebook(raw)
+        except ValueError as err:
+            why = f"not a notebook: {err}".replace(
+                "not a notebook: not a notebook", "not a notebook"
+            )
+    if handin.notebook is None:
+        handin.status, handin.reason = "unreadable", why
+        return handin
+    handin.meta_lab, handin.meta_group, source = _meta(raw)
+    if not handin.lab:
+        stem = Path(source).stem if source else Path(file).stem
+        handin.lab = handin.meta_lab or next(
+            (k for k, v in LABS.items() if Path(v.source).stem == stem), ""
+        )
+    handin.code = _fingerprint(handin.notebook)
+    return handin
+
+
+def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
+    """File -> why its identity needs a look: the notebook disagrees, a group twice, a copy."""
+    notes: dict[str, list[str]] = {h.file: [] for h in handins}
+    for h in handins:
+        if h.status:
+            continue
+        if not h.group:
+            said = f" (the notebook says {h.meta_group})" if h.meta_group else ""
+            notes[h.file].append(
+                f"no group: the file name is not <lab>_<group>.ipynb and no roster names it{said}"
+            )
+        elif h.meta_group and h.meta_group != h.group:
+            notes[h.file].append(
+                f"the notebook says group {h.meta_group}, its file name or the roster {h.group}"
+            )
+        if h.meta_lab and h.lab and h.meta_lab != h.lab:
+            notes[h.file].append(f"the notebook says lab {h.meta_lab}, its file name {h.lab}")
+    by_group: dict[tuple[str, str], list[Handin]] = {}
+    by_code: dict[str, list[Handin]] = {}
+    for h in handins:
+        if h.status:
+            continue
+        if h.group:
+            by_group.setdefault((h.lab, h.group), []).append(h)
+        if h.code:
+            by_code.setdefault(h.code, []).append(h)
+    for (_, group), same in by_group.items():
+        for h in same if len(same) > 1 else ():
+            others = ", ".join(o.file for o in same if o is not h)
+            notes[h.file].append(f"group {group} handed in more than once (also {others})")
+    for same in by_code.values():
+        if len({h.group for h in same}) < 2:
+            continue
+        for h in same:
+            others = ", ".join(
+                f"{o.file} ({o.group or 'no group'})" for o in same if o.group != h.group
+            )
+            notes[h.file].append(f"the same code as another group's hand-in: {others}")
+    return notes
 
 
 def _defaults(lab: str) -> dict[str, Any]:
     return LABS[lab].params().to_params()
-
-
-def _assigns(source: str, name: str) -> bool:
-    """Whether the code ``source`` assigns ``name`` (at any depth; ``=``, ``for``, ``with``...)."""
-    try:
-        tree = ast.parse(source)
-    except SyntaxError:
-        return re.search(rf"^\s*{re.escape(name)}\s*=(?!=)", source, re.M) is not None
-    return any(
-        isinstance(node, ast.Name) and node.id == name and isinstance(node.ctx, ast.Store)
-        for node in ast.walk(tree)
-    )
-
-
-def _missing(name: str, position: int | None, outcome: RunOutcome) -> Missing:
-    """Why ``name`` is absent at ``position``: the cell that raised before it, if any."""
-    before = [e for e in outcome.errors if position is None or e.position < position]
-    if not before:
-        return Missing(name)
-    culprit = next((e for e in reversed(before) if _assigns(e.source, name)), None)
-    if culprit is None:  # a check cell's error follows from an earlier one
-        culprit = ([e for e in before if not e.is_check] or before)[-1]
-    return Missing(name, culprit.cell, culprit.ename, culprit.evalue)
-
-
-def _answers(
-    lab: str, outcome: RunOutcome, plant: Any
-) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """The answers at the end, and those captured after each check cell, rebuilt."""
-    cache: dict[tuple[str, str], Any] = {}
-
-    def rebuild(tag: str, name: str) -> Any:
-        if (tag, name) not in cache:
-            raw = outcome.captures[tag]
-            if name not in raw:
-                cache[(tag, name)] = _missing(name, outcome.positions.get(tag), outcome)
-            else:
-                try:
-                    cache[(tag, name)] = from_data(raw[name], plant=plant)
-                except (AnswerError, ValueError, TypeError) as err:
-                    why = err if isinstance(err, AnswerError) else type(err).__name__
-                    cache[(tag, name)] = Missing(
-                        name, reason=f"its value could not be read ({why})"
-                    )
-        return cache[(tag, name)]
-
-    every = sorted({n for check in GRADED[lab] for n in check.names})
-    if "final" in outcome.captures:
-        final = {n: rebuild("final", n) for n in every}
-    else:
-        final = {n: _missing(n, None, outcome) for n in every}
-    per_check = []
-    for index, check in enumerate(GRADED[lab]):
-        tag = str(index)
-        if tag in outcome.captures:
-            per_check.append({n: rebuild(tag, n) for n in check.names})
-        else:  # its check cell was deleted or never reached: what the notebook ended with
-            per_check.append({n: final[n] for n in check.names})
-    return final, per_check
 
 
 def _error_notes(outcome: RunOutcome) -> list[str]:
@@ -350,69 +521,119 @@ def _error_notes(outcome: RunOutcome) -> list[str]:
     return notes + list(outcome.notes)
 
 
-def _grade_one(
-    path: Path,
-    key: Mapping[tuple[str, str], dict[str, Any]] | None,
-    *,
-    root: Path,
-    index: int,
-    sandbox: bool,
-    timeout: float,
-    cell_timeout: float,
-    limits: Limits,
-    stop: threading.Event,
-) -> Submission:
+@dataclass(frozen=True)
+class _Run:
+    """The settings every hand-in of one grading run shares."""
+
+    key: Mapping[tuple[str, str], dict[str, Any]] | None
+    root: Path
+    sandbox: bool
+    timeout: float
+    cell_timeout: float
+    check_timeout: float
+    limits: Limits
+    stop: threading.Event
+
+
+def _grade_one(handin: Handin, identity: list[str], index: int, run: _Run) -> Submission:
     start = time.perf_counter()
-    nb, lab, group, unreadable = _read(path)
-    sub = Submission(os.fspath(path), lab, group, "ok")
-    if lab in GRADED:
-        sub.expected = tuple(c.check_id for c in GRADED[lab])
-    if nb is None:
-        sub.status, sub.errors = "unreadable", [unreadable]
-        return sub
+    sub = Submission(handin.file, handin.lab, handin.group, "ok")
+    if handin.lab in GRADED:
+        sub.expected = tuple(c.check_id for c in GRADED[handin.lab])
+    try:
+        _run_one(sub, handin, identity, index, run)
+    except InterruptedError:
+        raise
+    except Exception as exc:  # any failure of the grader on this hand-in is this row's, only
+        sub.status = "grader error"
+        sub.reason = (
+            f"the grader failed on this hand-in ({type(exc).__name__}: {_one_line(exc, 120)})"
+        )
+        sub.errors.append(sub.reason)
+    sub.seconds = time.perf_counter() - start
+    return sub
+
+
+def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, run: _Run) -> None:
+    key, sandbox, limits, stop = run.key, run.sandbox, run.limits, run.stop
+    lab, group = handin.lab, handin.group
+    if handin.status:
+        sub.status, sub.reason = handin.status, handin.reason
+        sub.errors.append(handin.reason)
+        return
+    sub.errors += handin.notes
+    sub.errors += identity
     if lab not in GRADED:
         sub.status = "unknown lab"
-        sub.errors.append(
-            f"lab {lab!r} is not one of the course's labs ({', '.join(GRADED)}): not run"
-        )
-        return sub
+        sub.reason = f"lab {lab!r} is not one of the course's labs ({', '.join(GRADED)}): not run"
+        sub.errors.append(sub.reason)
+        return
     params = None if key is None else key.get((lab, group))
+    if key is not None and params is None:
+        sub.status = "check by hand"
+        why = identity[0] if not group and identity else f"group {group!r} is not in the answer key"
+        sub.reason = f"{why}; not run: name the file <lab>_<group>.ipynb or list it in --roster"
+        sub.errors.append(sub.reason)
+        return
     if params is None:
         params = _defaults(lab)
-        if key is not None:
-            sub.errors.append(
-                f"no parameters for lab {lab!r}, group {group!r} in the answer key: graded "
-                "with the course's own numbers"
-            )
     sub.params = params
-    copy, positions = prepare(nb, lab, params if key is not None else None)
-    folder = root / f"{index:04d}"
+    copy, positions = prepare(handin.notebook, lab, params if key is not None else None)
+    folder = run.root / f"{index:04d}"
     try:
         outcome = run_notebook(
             copy,
             folder,
             positions=positions,
             sandbox=sandbox,
-            timeout=timeout,
-            cell_timeout=cell_timeout,
+            timeout=run.timeout,
+            cell_timeout=run.cell_timeout,
             limits=limits,
             stop=stop,
+            user=sandbox_user(index + 1) if sandbox else None,
         )
     finally:
         _remove(folder)
+    if outcome.status == "interrupted":
+        raise InterruptedError("the grading run was interrupted")
     sub.status = outcome.status
     sub.errors += _error_notes(outcome)
-    with _CHECKING:
-        try:
-            plant = lab_plant(lab, params)
-            final, per_check = _answers(lab, outcome, plant)
-            results = grade_answers(lab, final, params, plant=plant, per_check=per_check)
-        except Exception as exc:  # the key itself is wrong: no verdict, one line
-            sub.errors.append(f"the grader could not check this lab ({type(exc).__name__})")
-            results = []
-    sub.results = {r.check_id: r.to_dict() for r in results if r.check_id}
-    sub.seconds = time.perf_counter() - start
-    return sub
+    request = {
+        "lab": lab,
+        "params": params,
+        "positions": outcome.positions,
+        "errors": [
+            {
+                "cell": e.cell,
+                "position": e.position,
+                "ename": e.ename,
+                "evalue": e.evalue,
+                "source": e.source,
+                "is_check": e.is_check,
+            }
+            for e in outcome.errors
+        ],
+        "captures": outcome.captures,
+    }
+    checked = check_in_child(
+        request, timeout=run.check_timeout, memory_mb=limits.memory_mb, stop=stop
+    )
+    sub.results = {
+        str(r.get("check_id")): r
+        for r in checked.results
+        if isinstance(r, dict) and r.get("check_id")
+    }
+    sub.errors += checked.notes
+    over = [n for n in outcome.notes if "more than" in n or "larger than" in n]
+    if checked.over or sub.status == "over limits":
+        sub.status = "over limits"
+        sub.reason = (checked.notes or over or ["a limit was reached"])[0]
+    if identity:
+        sub.status, sub.reason = "check by hand", identity[0]
+    elif not group:
+        sub.status, sub.reason = "check by hand", "no group: graded with the course's own numbers"
+    if sub.status in ("error", "timeout") and not sub.reason:
+        sub.reason = (sub.errors or [sub.status])[0]
 
 
 # the run ----------------------------------------------------------------------------------
@@ -452,8 +673,8 @@ def write_gradebook(
     ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
     ...     print(csv_path.read_text(encoding="utf-8").splitlines()[1])
     ...     print(sorted(p.name for p in folder.iterdir()))
-    a.ipynb,pa9,g01,ok,✗,0,1
-    ['a.txt', 'manifest.json']
+    a.ipynb,pa9,g01,ok,,✗,0,1
+    ['a.html', 'a.txt', 'manifest.json']
     """
     columns: list[str] = []
     for sub in submissions:
@@ -469,64 +690,183 @@ def _positive(name: str, value: Any) -> None:
         raise GradeError(f"{name}: must be > 0 s, got {value!r}")
 
 
+def read_roster(
+    path: str | os.PathLike[str],
+) -> tuple[dict[str, tuple[str, str]], dict[str, list[tuple[str, str]]]]:
+    """The groups of a roster CSV: which hand-in is whose, and who is in each group.
+
+    The CSV has a column ``group`` and at least one of ``file`` (the name of a
+    hand-in, e.g. ``notebook (3).ipynb``) and ``student`` (a student's id in
+    the LMS, e.g. its SIS user id); ``lab`` and ``name`` are optional. A row
+    with a file says that file is the group's hand-in; a row with a student
+    puts the student in the group (for the Canvas export).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    (dict, dict)
+        File name -> (lab, group), and group -> list of (student, name).
+
+    Raises
+    ------
+    GradeError
+        The file is missing or unreadable, lacks the columns, or names a file twice.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.instructor.grade import read_roster
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     roster = pathlib.Path(tmp) / "groups.csv"
+    ...     _ = roster.write_text("file,lab,group,student,name\\nx.ipynb,pa9,g01,s1,Ann\\n")
+    ...     read_roster(roster)
+    ({'x.ipynb': ('pa9', 'g01')}, {'g01': [('s1', 'Ann')]})
+    """
+    name = os.fspath(path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.DictReader(fh))
+    except FileNotFoundError:
+        raise GradeError(f"{name}: no such file") from None
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise GradeError(f"{name}: cannot read it ({err})") from None
+    files: dict[str, tuple[str, str]] = {}
+    students: dict[str, list[tuple[str, str]]] = {}
+    for number, row in enumerate(rows, start=2):
+        group = (row.get("group") or "").strip()
+        file = (row.get("file") or "").strip()
+        student = (row.get("student") or "").strip()
+        if not group or not (file or student):
+            raise GradeError(f"{name}: line {number}: needs a group and a file or a student")
+        if file:
+            entry = ((row.get("lab") or "").strip(), group)
+            if files.get(file, entry) != entry:
+                raise GradeError(f"{name}: line {number}: {file} is listed for two groups")
+            files[file] = entry
+        if student:
+            students.setdefault(group, []).append((student, (row.get("name") or "").strip()))
+    return files, students
+
+
+_SELF_TEST: dict[tuple[Any, ...], str | None] = {}
+
+
+def _self_test(limits: Limits) -> str | None:
+    """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None."""
+    key = (sys.executable, dataclasses.replace(limits, cpu_seconds=0))  # CPU time aside
+    if key in _SELF_TEST:
+        return _SELF_TEST[key]
+    problem = sandbox_problem()
+    if problem is None:
+        nb = nbformat.v4.new_notebook()
+        nb.metadata["kernelspec"] = {
+            "name": "python3",
+            "display_name": "Python 3",
+            "language": "python",
+        }
+        nb.cells.append(nbformat.v4.new_code_cell("import uio_teach\nx = 1 + 1"))
+        copy, positions = prepare(nb, "", None)
+        root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
+        try:
+            outcome = run_notebook(
+                copy,
+                root / "self-test",
+                positions=positions,
+                sandbox=True,
+                timeout=180,
+                cell_timeout=120,
+                limits=limits,
+                user=sandbox_user(0),
+            )
+        finally:
+            _remove(root)
+        if outcome.status != "ok" or "final" not in outcome.captures:
+            why = "; ".join(_error_notes(outcome)) or outcome.status
+            problem = f"a one-cell notebook does not run in the sandbox ({_one_line(why, 300)})"
+    _SELF_TEST[key] = problem
+    return problem
+
+
 def grade(
-    submissions: Sequence[str | os.PathLike[str]],
+    submissions: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
     out: str | os.PathLike[str],
     *,
     answer_key: str | os.PathLike[str] | None = None,
+    roster: str | os.PathLike[str] | None = None,
     timeout: float = 300.0,
     cell_timeout: float = 60.0,
+    check_timeout: float = 120.0,
     progress: Callable[[int, int, Submission], None] | None = None,
     resume: bool = False,
     jobs: int = 1,
     sandbox: bool = True,
     limits: Limits | None = None,
 ) -> list[Submission]:
-    """Grade submitted notebooks; write the gradebook ``out`` (CSV) and the feedback texts.
+    """Grade hand-ins; write the gradebook ``out`` (CSV), its exports and the feedback.
+
+    Every hand-in gets its row, whatever happens to it: a file that is not a
+    regular file of the hand-in folder is refused, a file that is not a
+    notebook is unreadable, a notebook whose identity disagrees (its metadata
+    against its file name or the roster, a group handing in twice, the same
+    code from two groups, no group) is "check by hand", answers over the
+    caps or checks over their limits are "over limits", and any failure of
+    the grader itself on one hand-in is that row's "grader error". The run
+    goes on; see :data:`NEEDS_A_LOOK`.
 
     Parameters
     ----------
-    submissions : sequence of path
-        The notebooks handed in. They are only read.
+    submissions : path or sequence of path
+        The hand-in folder (every ``*.ipynb`` in it), or the hand-ins. They are only read.
     out : path
-        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it.
-        Each row is written as soon as its submission is graded.
+        The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it,
+        the LMS exports to ``<stem>_canvas.csv`` and ``<stem>_groups.csv``.
+        Each row is written as soon as its hand-in is graded.
     answer_key : path, optional
-        ``answer_key.csv`` of ``uio-teach labs --groups``: each submission is
+        ``answer_key.csv`` of ``uio-teach labs --groups``: each hand-in is
         graded with its group's parameters (and runs with them). Without it,
         with the course's own numbers.
+    roster : path, optional
+        A CSV naming each hand-in's group (see :func:`read_roster`).
     timeout : float
         Seconds a notebook may run in all; then every process of its run is
         killed and it is graded on what it computed ("timeout").
     cell_timeout : float
         Seconds a cell may run; then it is interrupted, and the next cells run.
+    check_timeout : float
+        Seconds the checks of one hand-in may take (in their own process).
     progress : callable, optional
         ``progress(index, total, submission)`` after each notebook.
     resume : bool
-        Keep the rows of ``out`` and grade only the submissions that have none.
+        Keep the rows of ``out`` and grade only the hand-ins that have none.
     jobs : int
-        How many submissions run at a time.
+        How many hand-ins run at a time.
     sandbox : bool
-        Run each submission in the sandbox (refused where it is unavailable).
+        Run each hand-in in the sandbox (refused where it is unavailable).
         ``False`` runs the students' code with your permissions, with a
         :class:`UnsandboxedWarning`.
     limits : Limits, optional
-        Memory, processes, file size and CPU time of a run.
+        Memory, processes, file size, CPU time and writes of a run.
 
     Returns
     -------
     list of Submission
-        The submissions graded by this call (with ``resume``, not those kept).
+        The hand-ins graded by this call (with ``resume``, not those kept).
 
     Raises
     ------
     GradeError
-        The answer key cannot be read, an option is out of range.
+        The answer key or the roster cannot be read, an option is out of range.
     SandboxRefused
-        The sandbox is unavailable and ``sandbox`` is True.
+        The sandbox is unavailable (or cannot run a one-cell notebook) and
+        ``sandbox`` is True.
     uio_teach.instructor.output.OutputError
         ``out`` is a folder, its feedback folder is not ours, or another run
         is writing it (checked before any notebook runs).
+    KeyboardInterrupt
+        The run was interrupted: every run is stopped at once, the finished rows are kept.
 
     Examples
     --------
@@ -539,15 +879,18 @@ def grade(
     """
     _positive("timeout", timeout)
     _positive("cell_timeout", cell_timeout)
+    _positive("check_timeout", check_timeout)
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise GradeError(f"jobs: must be a whole number >= 1, got {jobs!r}")
     key = read_answer_key(answer_key) if answer_key is not None else None
+    files_roster, students = read_roster(roster) if roster is not None else ({}, {})
     check_gradebook_target(out)  # before the notebooks run, not after
+    limits = limits or Limits(cpu_seconds=int(timeout) + 60)
     if sandbox:
-        problem = sandbox_problem()
+        problem = _self_test(limits)
         if problem is not None:
             raise SandboxRefused(
-                f"cannot isolate the submissions: {problem}. Grading runs the students' code; "
+                f"cannot isolate the hand-ins: {problem}. Grading runs the students' code; "
                 "--no-sandbox runs it with your permissions (only for notebooks you trust)"
             )
     else:
@@ -557,58 +900,86 @@ def grade(
             UnsandboxedWarning,
             stacklevel=2,
         )
-    limits = limits or Limits(cpu_seconds=int(timeout) + 60)
     clean_leftovers()
-    files = [os.fspath(p) for p in submissions]
-    labs = [_read(Path(f))[1] for f in files]
+    files = handin_files(submissions)
+    handins = []
+    for file in files:
+        try:
+            handins.append(read_handin(file, files_roster))
+        except Exception as exc:  # never stops the run: the row says so
+            handins.append(
+                Handin(file, status="grader error", reason=f"cannot be read ({type(exc).__name__})")
+            )
+    identity = _identity_notes(handins)
     columns: list[str] = []
-    for lab in labs:
-        columns += [c.check_id for c in GRADED.get(lab, ()) if c.check_id not in columns]
+    for h in handins:
+        columns += [c.check_id for c in GRADED.get(h.lab, ()) if c.check_id not in columns]
     graded: list[Submission] = []
-    with Gradebook(out, files, columns, resume=resume) as book:
-        todo = [(i, f) for i, f in enumerate(files) if f not in book.done]
-        todo = [(i, f) for n, (i, f) in enumerate(todo) if f not in {g for _, g in todo[:n]}]
+    with Gradebook(out, files, columns, resume=resume, students=students) as book:
+        todo = [(i, h) for i, h in enumerate(handins) if not book.has(h.file)]
+        seen: set[str] = set()
+        todo = [(i, h) for i, h in todo if not (h.file in seen or seen.add(h.file))]
         root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
+        stop = threading.Event()
+        pool = ThreadPoolExecutor(max_workers=jobs)
         try:
             (root / _OWNER).write_text(
                 json.dumps({"pid": os.getpid(), "start": _start_time(os.getpid())}),
                 encoding="utf-8",
             )
-            stop = threading.Event()
-            with ThreadPoolExecutor(max_workers=jobs) as pool:
-                running: dict[Future[Submission], str] = {}
-                queue = list(todo)
-                try:
-                    while queue or running:
-                        while queue and len(running) < jobs:
-                            index, file = queue.pop(0)
-                            future = pool.submit(
-                                _grade_one,
-                                Path(file),
-                                key,
-                                root=root,
-                                index=index,
-                                sandbox=sandbox,
-                                timeout=timeout,
-                                cell_timeout=min(cell_timeout, timeout),
-                                limits=limits,
-                                stop=stop,
-                            )
-                            running[future] = file
-                        finished, _ = wait(running, return_when=FIRST_COMPLETED)
-                        for future in finished:
-                            running.pop(future)
-                            sub = future.result()
-                            book.add(sub)
-                            graded.append(sub)
-                            if progress is not None:
-                                progress(len(graded), len(todo), sub)
-                finally:  # interrupted: stop every run still going, keep the finished rows
-                    stop.set()
-                    for future in running:
-                        future.cancel()
-        finally:
+            run = _Run(
+                key, root, sandbox, timeout, min(cell_timeout, timeout), check_timeout, limits, stop
+            )
+            running: dict[Future[Submission], Handin] = {}
+            queue = list(todo)
+            while queue or running:
+                while queue and len(running) < jobs:
+                    index, handin = queue.pop(0)
+                    future = pool.submit(
+                        _grade_one, handin, identity.get(handin.file, []), index, run
+                    )
+                    running[future] = handin
+                finished, _ = wait(running, timeout=0.5, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    running.pop(future)
+                    sub = future.result()
+                    book.add(sub)
+                    graded.append(sub)
+                    if progress is not None:
+                        progress(len(graded), len(todo), sub)
+        finally:  # interrupted: stop every run still going at once, keep the finished rows
+            stop.set()
+            pool.shutdown(wait=True, cancel_futures=True)
             _remove(root)
     order = {f: i for i, f in enumerate(files)}
     graded.sort(key=lambda s: order[s.file])
     return graded
+
+
+def handin_files(
+    submissions: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
+) -> list[str]:
+    """The hand-ins: each ``*.ipynb`` entry of a folder (links and folders too), or the paths.
+
+    Parameters
+    ----------
+    submissions : path or sequence of path
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.grade import handin_files
+    >>> handin_files(["b.ipynb", "a.ipynb"])
+    ['b.ipynb', 'a.ipynb']
+    """
+    if isinstance(submissions, (str, os.PathLike)):
+        folder = Path(submissions)
+        if not folder.is_dir() or folder.is_symlink():
+            return [os.fspath(folder)]
+        return sorted(
+            os.fspath(folder / e.name) for e in os.scandir(folder) if e.name.endswith(".ipynb")
+        )
+    return [os.fspath(p) for p in submissions]

@@ -31,9 +31,11 @@ Examples
 from __future__ import annotations
 
 import csv
+import html
 import io
 import json
 import os
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,6 +59,8 @@ __all__ = [
     "feedback_folder",
     "check_gradebook_target",
     "feedback_names",
+    "export_path",
+    "safe_cell",
     "PASS",
     "FAIL",
     "COMMAND",
@@ -65,7 +69,10 @@ __all__ = [
 PASS, FAIL = "✓", "✗"
 COMMAND = "uio-teach grade"
 """The command recorded in the feedback folder's manifest."""
-_FIRST = ["file", "lab", "group", "status"]
+_FIRST = ["file", "lab", "group", "status", "reason"]
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]+")
+_NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$")
+_GOOD = ("ok", "error", "timeout")  # rows whose marks stand as they are
 _LAST = ["total", "out_of"]
 
 
@@ -87,8 +94,13 @@ class Submission:
         The group id ("" when unknown).
     status : str
         ``"ok"``, ``"error"`` (some cells raised, or the run did not reach its
-        end), ``"timeout"`` (stopped at the time limit), ``"unreadable"`` (not
-        a notebook) or ``"unknown lab"``.
+        end), ``"timeout"`` (stopped at the time limit), and the rows that need
+        a look: ``"check by hand"`` (its identity disagrees or is missing),
+        ``"over limits"``, ``"refused"`` (not a regular file of the hand-in
+        folder), ``"unreadable"`` (not a notebook), ``"unknown lab"`` and
+        ``"grader error"``.
+    reason : str
+        Why the row has that status, on one line ("" for ``ok``).
     results : dict
         Check id -> the check's result as a dict (``CheckResult.to_dict()``).
     errors : list of str
@@ -108,13 +120,14 @@ class Submission:
     >>> s = Submission("pa9_g01.ipynb", "pa9", "g01", "unreadable",
     ...                errors=["not a notebook"], expected=("pa9.design",))
     >>> s.row(["pa9.design"])
-    ['pa9_g01.ipynb', 'pa9', 'g01', 'unreadable', '✗', 0, 1]
+    ['pa9_g01.ipynb', 'pa9', 'g01', 'unreadable', '', '✗', 0, 1]
     """
 
     file: str
     lab: str
     group: str
     status: str
+    reason: str = ""
     results: dict[str, dict[str, Any]] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)
     params: dict[str, Any] | None = None
@@ -132,11 +145,17 @@ class Submission:
         """The number of checks passed."""
         return sum(self.verdicts().values())
 
+    @property
+    def needs_a_look(self) -> bool:
+        """Whether an instructor should look at this row before its marks count."""
+        return self.status not in _GOOD
+
     def feedback(self) -> str:
         """The feedback text for the group: every check's messages, then the grader's notes."""
         lines = [
             f"Submission: {self.file}",
             f"Lab: {self.lab or 'unknown'}    Group: {self.group or 'unknown'}",
+            f"Status: {self.status}" + (f" ({self.reason})" if self.reason else ""),
         ]
         if self.params is not None:
             lines.append(f"Parameters of this group: {json.dumps(self.params)}")
@@ -157,11 +176,75 @@ class Submission:
             lines += [f"  - {e}" for e in self.errors]
         return "\n".join(lines) + "\n"
 
+    def feedback_html(self) -> str:
+        """The feedback as a small HTML page (every text escaped)."""
+        e = html.escape
+        verdicts = self.verdicts()
+        parts = [
+            "<!DOCTYPE html>",
+            '<html lang="en"><head><meta charset="utf-8">',
+            f"<title>Feedback: {e(Path(self.file).name)}</title>",
+            "<style>body{font-family:sans-serif;max-width:50em;margin:2em auto}"
+            ".ok{color:#06602a}.no{color:#a3001b}li{margin:.2em 0}</style></head><body>",
+            f"<h1>Lab {e(self.lab or 'unknown')}, group {e(self.group or 'unknown')}</h1>",
+            f"<p>Hand-in: <code>{e(self.file)}</code><br>Status: <strong>{e(self.status)}"
+            f"</strong>{e(' (' + self.reason + ')') if self.reason else ''}<br>"
+            f"Checks passed: {self.total} of {len(verdicts)}</p>",
+        ]
+        if self.params is not None:
+            parts.append(
+                f"<p>Parameters of this group: <code>{e(json.dumps(self.params))}</code></p>"
+            )
+        for check_id, ok in verdicts.items():
+            result = self.results.get(check_id) or {}
+            mark = f'<span class="{"ok" if ok else "no"}">{PASS if ok else FAIL}</span>'
+            title = result.get("title", "")
+            parts.append(f"<h2>{mark} {e(check_id)}{e(': ' + title) if title else ''}</h2><ul>")
+            if not result:
+                parts.append("<li>not graded: the notebook could not be run</li>")
+            for item in result.get("items", []):
+                sign = {True: PASS, False: FAIL}.get(item.get("ok"), "•")
+                parts.append(f"<li>{e(sign)} {e(str(item.get('message', '')))}</li>")
+            parts.append("</ul>")
+        if self.errors:
+            parts.append("<h2>Problems while running the notebook</h2><ul>")
+            parts += [f"<li>{e(str(x))}</li>" for x in self.errors]
+            parts.append("</ul>")
+        parts.append("</body></html>")
+        return "\n".join(parts) + "\n"
+
     def row(self, columns: Sequence[str]) -> list[Any]:
         """The CSV row under the check columns ``columns`` (empty for a check of another lab)."""
         verdicts = self.verdicts()
         marks = ["" if c not in verdicts else (PASS if verdicts[c] else FAIL) for c in columns]
-        return [self.file, self.lab, self.group, self.status, *marks, self.total, len(verdicts)]
+        first = [self.file, self.lab, self.group, self.status, self.reason]
+        return [*first, *marks, self.total, len(verdicts)]
+
+
+def safe_cell(value: Any) -> str:
+    """A CSV cell a spreadsheet shows as text: one line, never a formula.
+
+    Control characters and line breaks become spaces; a cell that starts with
+    ``=``, ``+``, ``-`` or ``@`` and is not a number gets a leading ``'``.
+
+    Parameters
+    ----------
+    value : object
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.gradebook import safe_cell
+    >>> print(safe_cell('=HYPERLINK("http://x")'), safe_cell("-3"), safe_cell("a\\nb"))
+    '=HYPERLINK("http://x") -3 a b
+    """
+    text = _CONTROL.sub(" ", str(value)).strip()
+    if text[:1] in ("=", "+", "-", "@") and not _NUMBER.match(text):
+        text = "'" + text
+    return text
 
 
 def feedback_folder(out: str | os.PathLike[str]) -> Path:
@@ -255,6 +338,28 @@ def feedback_names(files: Sequence[str]) -> dict[str, str]:
     return names
 
 
+def export_path(out: str | os.PathLike[str], kind: str) -> Path:
+    """The export ``kind`` (``"canvas"`` or ``"groups"``) beside the gradebook ``out``.
+
+    Parameters
+    ----------
+    out : str or path-like
+    kind : str
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.gradebook import export_path
+    >>> export_path("marks/grades.csv", "canvas").as_posix()
+    'marks/grades_canvas.csv'
+    """
+    out = Path(out)
+    return out.with_name(f"{out.stem}_{kind}.csv")
+
+
 def _write_atomic(path: Path, text: str) -> None:
     part = path.with_name(f".{path.name}.part")
     with open(part, "w", encoding="utf-8", newline="") as fh:
@@ -284,7 +389,9 @@ class Gradebook:
     columns : sequence of str
         The check ids (one column each).
     resume : bool
-        Keep the rows already there; :attr:`done` lists their files.
+        Keep the rows already there; :meth:`has` says which hand-ins have one.
+    students : dict, optional
+        Group -> list of (student id, name), for the Canvas export.
 
     Raises
     ------
@@ -302,7 +409,7 @@ class Gradebook:
     ...     with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:
     ...         book.add(Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",)))
     ...     print(out.read_text(encoding="utf-8").splitlines()[1])
-    a.ipynb,pa9,g01,ok,✗,0,1
+    a.ipynb,pa9,g01,ok,,✗,0,1
     """
 
     def __init__(
@@ -312,8 +419,11 @@ class Gradebook:
         columns: Sequence[str],
         *,
         resume: bool = False,
+        students: dict[str, list[tuple[str, str]]] | None = None,
     ) -> None:
         self.out = Path(out)
+        self.students = dict(students or {})
+        self.subs: dict[str, Submission] = {}
         self.folder = feedback_folder(self.out)
         self.files = list(files)
         self.columns = list(columns)
@@ -366,11 +476,11 @@ class Gradebook:
         kept: list[list[str]] = []
         if self.resume:
             header, kept = self._read_rows()
-            wanted = set(self.files)
+            wanted = {safe_cell(f) for f in self.files}
             kept = [row for row in kept if row[0] in wanted]
         else:  # a new grading: the texts of the earlier one go
             for old in self.folder.iterdir():
-                if old.is_file() and (old.suffix == ".txt" or old.name == MANIFEST):
+                if old.is_file() and (old.suffix in (".txt", ".html") or old.name == MANIFEST):
                     old.unlink()
         old_columns = header[len(_FIRST) : -len(_LAST)] if header else []
         self.columns = old_columns + [c for c in self.columns if c not in old_columns]
@@ -378,9 +488,10 @@ class Gradebook:
             width = len(self.columns) - len(old_columns)
             kept = [row[: -len(_LAST)] + [""] * width + row[-len(_LAST) :] for row in kept]
         self.done = {row[0]: row for row in kept}
-        for file in list(self.done):  # a row whose feedback text is lost is graded again
-            if not (self.folder / self.names[file]).is_file():
-                del self.done[file]
+        names = {safe_cell(f): n for f, n in self.names.items()}
+        for cell in list(self.done):  # a row whose feedback text is lost is graded again
+            if not (self.folder / names[cell]).is_file():
+                del self.done[cell]
         kept = [row for row in kept if row[0] in self.done]
         _write_atomic(self.out, _csv_text([self._header(), *kept]))
         write_manifest(self.folder, command=COMMAND, config=self._config(), options=self._options())
@@ -395,6 +506,10 @@ class Gradebook:
     def _options(self) -> dict[str, Any]:
         return {"submissions": self.files}
 
+    def has(self, file: str) -> bool:
+        """Whether the hand-in ``file`` has its row already (kept by ``resume``, or added)."""
+        return safe_cell(file) in self.done
+
     # writing ------------------------------------------------------------------------------
     def add(self, sub: Submission) -> None:
         """Write ``sub``'s feedback text and append its row (flushed and synced).
@@ -406,21 +521,63 @@ class Gradebook:
         name = self.names.get(sub.file) or feedback_names([sub.file])[sub.file]
         path = self.folder / name
         _write_atomic(path, sub.feedback())
+        _write_atomic(path.with_suffix(".html"), sub.feedback_html())
         sub.feedback_file = path
-        row = [str(v) for v in sub.row(self.columns)]
+        row = [safe_cell(v) for v in sub.row(self.columns)]
         self._csv.write(_csv_text([row]))
         self._csv.flush()
         os.fsync(self._csv.fileno())
-        self.done[sub.file] = row
+        self.done[row[0]] = row
+        self.subs[row[0]] = sub
 
     def finish(self) -> None:
         """Rewrite the CSV in the submissions' order and write the feedback manifest."""
-        rows = [self.done[f] for f in self.files if f in self.done]
+        rows = [
+            self.done[c] for c in dict.fromkeys(safe_cell(f) for f in self.files) if c in self.done
+        ]
         self._csv.close()
         _write_atomic(self.out, _csv_text([self._header(), *rows]))
+        by_group, canvas = self._exports(rows)
+        _write_atomic(export_path(self.out, "groups"), _csv_text(by_group))
+        _write_atomic(export_path(self.out, "canvas"), _csv_text(canvas))
         self._csv = open(self.out, "a", encoding="utf-8", newline="")
         config = {**self._config(), "gradebook_sha256": sha256_file(self.out)}
         write_manifest(self.folder, command=COMMAND, config=config, options=self._options())
+
+    def _exports(self, rows: list[list[str]]) -> tuple[list[list[str]], list[list[str]]]:
+        """The plain export keyed by group and Canvas's, from the final rows."""
+        header = self._header()
+        at = {name: i for i, name in enumerate(header)}
+        labs: dict[str, str] = {}
+        groups: dict[tuple[str, str], list[list[str]]] = {}
+        for row in rows:
+            lab, group = row[at["lab"]], row[at["group"]]
+            if lab:
+                labs.setdefault(lab, row[at["out_of"]])
+            if lab and group:
+                groups.setdefault((lab, group), []).append(row)
+        plain = [["group", "lab", "total", "out_of", "status", "reason", "file"]]
+        scores: dict[tuple[str, str], str] = {}
+        for (lab, group), same in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+            row = same[0]
+            status, reason = row[at["status"]], row[at["reason"]]
+            if len(same) > 1:
+                status, reason = "check by hand", "more than one hand-in"
+            score = row[at["total"]] if status in _GOOD else ""
+            scores[(lab, group)] = score
+            files = "; ".join(r[at["file"]] for r in same)
+            plain.append([group, lab, score, row[at["out_of"]], status, reason, files])
+        names = [f"{lab} (uio-teach)" for lab in labs]
+        canvas = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", *names]]
+        canvas.append(["Points Possible", "", "", "", "", *labs.values()])
+        for group in sorted({g for _, g in groups}):
+            marks = [scores.get((lab, group), "") for lab in labs]
+            for student, name in self.students.get(group, []) or [("", group)]:
+                canvas.append([name or student, "", student, "", group, *marks])
+        return (
+            [[safe_cell(c) for c in r] for r in plain],
+            [[safe_cell(c) for c in r] for r in canvas],
+        )
 
     def _unlock(self) -> None:
         self._lock.release()

@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import ctypes
 import errno
-import fcntl
 import glob
 import hashlib
 import json
@@ -350,11 +349,24 @@ def read_manifest(folder: str | os.PathLike[str]) -> dict[str, Any] | None:
     return data
 
 
+def _lock_nowait(fd: int) -> None:
+    """Lock the open file ``fd`` for this process, or raise OSError at once if another holds it."""
+    if sys.platform == "win32":  # pragma: no cover - the package is tested on Linux
+        import msvcrt  # deferred on purpose: Windows only
+
+        msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+    else:
+        import fcntl  # deferred on purpose: POSIX only, so the package imports everywhere
+
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
 class FolderLock:
     """Hold the lock of an output folder: one run at a time writes it.
 
     The lock is the file ``.<name>.lock`` beside the folder, locked with
-    :func:`fcntl.flock` and holding the process id of its holder. The kernel
+    an advisory lock of the system (``flock`` on POSIX, ``msvcrt.locking`` on
+    Windows) and holding the process id of its holder. The kernel
     releases the lock when its holder ends, however it ends, so the lock file
     of a killed run is simply taken over by the next one; a lock held by a
     live process is refused with :class:`OutputError` naming that process.
@@ -406,7 +418,7 @@ class FolderLock:
                     f"{err.strerror or err}"
                 ) from None
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                _lock_nowait(fd)
             except OSError:
                 holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
                 os.close(fd)

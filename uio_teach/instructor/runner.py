@@ -12,10 +12,19 @@ the end that writes every answer variable of the lab to ``answers/final.json``
 :func:`run_notebook` runs that copy in a fresh kernel, in a separate process,
 inside the :class:`~uio_teach.instructor.sandbox.Sandbox` (unless told not to),
 with a time limit per cell (the cell is interrupted, the next ones run) and
-for the whole notebook (then every process of the run is killed). It reads
-back only data: the answer files (regular files, no links, bounded size) and
-the executed notebook (for the cells that raised). Nothing the notebook
-prints decides anything.
+for the whole notebook (then every process of the run is killed), and a cap
+on all it writes into its folder (the run is stopped beyond). It reads back
+only data: the answer files (regular files, no links, bounded size, kept as
+text for the checking process) and the errors of the executed copy, read as
+plain JSON and matched against the grader's own copy (a copy the notebook
+rewrote gives no cell errors, never a crash). Nothing the notebook prints
+decides anything, and the runner's own output is kept to its last lines.
+
+:func:`clean_notebook` turns the JSON of a hand-in into a fresh notebook of the
+grader's own: code, markdown and raw cells with their source and their string
+tags, nothing else; whatever odd value the hand-in carries (tags that are a
+number, a source that is a dict) is dropped there, with a note, before
+anything else reads it.
 
 Examples
 --------
@@ -26,6 +35,7 @@ Examples
 
 from __future__ import annotations
 
+import collections
 import json
 import os
 import re
@@ -43,25 +53,29 @@ from typing import Any
 
 import nbformat
 
-from ..checks.answers import AnswerError, parse
 from ..checks.grading import GRADED
-from .sandbox import HOME, Limits, Sandbox
+from .sandbox import HOME, Limits, Sandbox, drop_privileges
 
 __all__ = [
     "RunOutcome",
     "CellError",
+    "clean_notebook",
     "prepare",
     "run_notebook",
     "check_function",
     "read_limited",
     "GRADING_TAG",
     "MAX_FILE_BYTES",
+    "MAX_ANSWER_BYTES",
 ]
 
 GRADING_TAG = "uio-teach-grade"
 """The tag of the cells the grader adds."""
 MAX_FILE_BYTES = 256 * 1024 * 1024
-"""The largest answer file or executed notebook read back."""
+"""The largest executed notebook read back."""
+MAX_ANSWER_BYTES = 64 * 1024 * 1024
+"""The largest answer file read back (a larger one is a row "over limits")."""
+_TAIL_BYTES = 64 * 1024
 _CALL = re.compile(r"\bchecks\.(\w+)\s*\(")
 _SETUP = """\
 def _uio_export(_uio_tag, _uio_names):
@@ -106,18 +120,19 @@ class RunOutcome:
     Attributes
     ----------
     status : str
-        ``"ok"``, ``"error"`` or ``"timeout"``.
+        ``"ok"``, ``"error"``, ``"timeout"``, ``"over limits"`` or ``"interrupted"``.
     captures : dict
-        Capture tag (``"0"``, ``"1"``, ... per check, ``"final"``) -> name -> plain data.
+        Capture tag (``"0"``, ``"1"``, ... per check, ``"final"``) -> the text of
+        its answer file, unparsed (the checking process parses it, under limits).
     positions : dict
         Capture tag -> index of its cell in the prepared notebook.
     errors : list of CellError
     notes : list of str
-        The grader's notes on the run (a killed run, a dead kernel).
+        The grader's notes on the run (a killed run, a dead kernel, a limit).
     """
 
     status: str
-    captures: dict[str, dict[str, Any]] = field(default_factory=dict)
+    captures: dict[str, str] = field(default_factory=dict)
     positions: dict[str, int] = field(default_factory=dict)
     errors: list[CellError] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -139,7 +154,8 @@ def check_function(source: str) -> str | None:
 
 
 def _tags(cell: Any) -> list[str]:
-    return list(cell.get("metadata", {}).get("tags", []) or [])
+    tags = cell.get("metadata", {}).get("tags", []) if isinstance(cell, Mapping) else []
+    return [t for t in tags if isinstance(t, str)] if isinstance(tags, list) else []
 
 
 def _ours(source: str) -> Any:
@@ -148,13 +164,91 @@ def _ours(source: str) -> Any:
     return cell
 
 
+def _source(value: Any) -> str | None:
+    if isinstance(value, str):
+        return value
+    if isinstance(value, list) and all(isinstance(line, str) for line in value):
+        return "".join(value)
+    return None
+
+
+def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
+    """A fresh notebook of the grader's own from the JSON of a hand-in, and what was dropped.
+
+    Only the cells are kept: each code, markdown or raw cell with its source
+    (a string or a list of strings) and its string tags. A cell of another
+    kind, a source of another type, or tags that are not a list of strings
+    are dropped, and each such drop is noted once; outputs, attachments and
+    all other metadata are left behind.
+
+    Parameters
+    ----------
+    raw : object
+        The hand-in's JSON, as :func:`json.loads` gave it.
+
+    Returns
+    -------
+    (NotebookNode, list of str)
+
+    Raises
+    ------
+    ValueError
+        ``raw`` is not a notebook of format 4 (one line).
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.runner import clean_notebook
+    >>> raw = {"nbformat": 4, "cells": [
+    ...     {"cell_type": "code", "source": "x = 1", "metadata": {"tags": 5}}]}
+    >>> nb, notes = clean_notebook(raw)
+    >>> nb.cells[0].source, nb.cells[0].metadata.get("tags"), notes
+    ('x = 1', None, ['a cell whose tags are not a list of names: its tags were ignored'])
+    """
+    if not isinstance(raw, dict):
+        raise ValueError("not a notebook (not a JSON object)")
+    if raw.get("nbformat") != 4 or not isinstance(raw.get("cells"), list):
+        raise ValueError("not a notebook of format 4 (no list of cells)")
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {
+        "name": "python3",
+        "display_name": "Python 3",
+        "language": "python",
+    }
+    notes: list[str] = []
+
+    def note(text: str) -> None:
+        if text not in notes:
+            notes.append(text)
+
+    for cell in raw["cells"]:
+        kind = cell.get("cell_type") if isinstance(cell, dict) else None
+        source = _source(cell.get("source", "")) if isinstance(cell, dict) else None
+        if kind not in ("code", "markdown", "raw") or source is None:
+            note("a cell that is not a code, markdown or raw cell with text: it was left out")
+            continue
+        metadata = cell.get("metadata", {})
+        tags = metadata.get("tags", []) if isinstance(metadata, dict) else []
+        if not (isinstance(tags, list) and all(isinstance(t, str) for t in tags)):
+            note("a cell whose tags are not a list of names: its tags were ignored")
+            tags = []
+        made = {
+            "code": nbformat.v4.new_code_cell,
+            "markdown": nbformat.v4.new_markdown_cell,
+            "raw": nbformat.v4.new_raw_cell,
+        }[kind](source)
+        if tags:
+            made.metadata["tags"] = list(tags)
+        nb.cells.append(made)
+    return nb, notes
+
+
 def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, dict[str, int]]:
     """The copy to run: outputs cleared, the key's parameters set, the export cells added.
 
     Parameters
     ----------
     nb : nbformat.NotebookNode
-        The submission (modified in place and returned).
+        The hand-in, as :func:`clean_notebook` made it (modified in place and returned).
     lab : str
         Its lab (a key of :data:`uio_teach.checks.grading.GRADED`; another
         lab gets no export cells).
@@ -228,30 +322,37 @@ def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes | None:
         return fh.read(limit + 1)[:limit]
 
 
-def _one_line(text: str, limit: int = 200) -> str:
+def _one_line(text: Any, limit: int = 200) -> str:
     text = " ".join(str(text).split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _errors(executed: Any) -> list[CellError]:
+def _errors(executed: Any, prepared: Any) -> list[CellError] | None:
+    """The student's cells that raised, from the executed copy's JSON (None if it was rewritten).
+
+    The cells' code and tags come from ``prepared`` (the grader's own copy);
+    only the error outputs are read from ``executed``, and only as strings.
+    """
+    cells = executed.get("cells") if isinstance(executed, dict) else None
+    if not isinstance(cells, list) or len(cells) != len(prepared.cells):
+        return None
     out = []
     number = 0
-    for position, cell in enumerate(executed.cells):
-        if cell.get("cell_type") != "code":
-            continue
-        if GRADING_TAG in _tags(cell):
+    for position, (cell, mine) in enumerate(zip(cells, prepared.cells, strict=True)):
+        if mine.get("cell_type") != "code" or GRADING_TAG in _tags(mine):
             continue
         number += 1
-        for output in cell.get("outputs", []):
-            if output.get("output_type") == "error":
+        outputs = cell.get("outputs", []) if isinstance(cell, dict) else []
+        for output in outputs if isinstance(outputs, list) else []:
+            if isinstance(output, dict) and output.get("output_type") == "error":
                 out.append(
                     CellError(
                         number,
                         position,
                         _one_line(output.get("ename", ""), 60),
                         _one_line(output.get("evalue", "")),
-                        str(cell.get("source", "")),
-                        "check" in _tags(cell),
+                        str(mine.get("source", "")),
+                        "check" in _tags(mine),
                     )
                 )
                 break
@@ -292,6 +393,63 @@ def _matplotlib_cache(work: Path) -> None:
         shutil.copy2(font_list, target / font_list.name)
 
 
+def disk_usage(folder: Path, *, most: int = 100_000) -> int:
+    """Bytes used under ``folder`` (links not followed); past ``most`` entries, a huge number.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+    most : int
+        How many entries to look at: a folder with more counts as over any cap.
+
+    Returns
+    -------
+    int
+    """
+    total, seen, stack = 0, 0, [os.fspath(folder)]
+    while stack:
+        try:
+            entries = os.scandir(stack.pop())
+        except OSError:
+            continue
+        with entries:
+            for entry in entries:
+                seen += 1
+                if seen > most:
+                    return 1 << 62
+                try:
+                    info = entry.stat(follow_symlinks=False)
+                except OSError:
+                    continue
+                total += getattr(info, "st_blocks", 0) * 512 or info.st_size
+                if stat.S_ISDIR(info.st_mode):
+                    stack.append(entry.path)
+    return total
+
+
+class _Tail(threading.Thread):
+    """Read a pipe to its end, keeping only its last bytes (a chatty run fills no disk)."""
+
+    def __init__(self, stream: Any) -> None:
+        super().__init__(daemon=True)
+        self.stream = stream
+        self.chunks: collections.deque[bytes] = collections.deque()
+        self.size = 0
+
+    def run(self) -> None:
+        try:
+            while chunk := self.stream.read1(65536) if hasattr(self.stream, "read1") else b"":
+                self.chunks.append(chunk)
+                self.size += len(chunk)
+                while self.size - len(self.chunks[0]) > _TAIL_BYTES:
+                    self.size -= len(self.chunks.popleft())
+        except (OSError, ValueError):
+            pass
+
+    def text(self) -> str:
+        return b"".join(self.chunks)[-_TAIL_BYTES:].decode("utf-8", "replace")
+
+
 def run_notebook(
     nb: Any,
     folder: Path,
@@ -302,6 +460,7 @@ def run_notebook(
     cell_timeout: float,
     limits: Limits,
     stop: threading.Event | None = None,
+    user: int | None = None,
 ) -> RunOutcome:
     """Run a prepared copy in ``folder`` (ours, emptied by the caller); read back its data.
 
@@ -318,9 +477,12 @@ def run_notebook(
     timeout, cell_timeout : float
         Seconds for the whole notebook and for one cell.
     limits : Limits
-        Resource limits applied by the runner before the kernel starts.
+        Resource limits applied by the runner before the kernel starts; its
+        ``disk_mb`` caps all the run writes into its folder.
     stop : threading.Event, optional
         When set (the grader was interrupted), the run is killed at once.
+    user : int, optional
+        The user id the sandbox runs as (:func:`~uio_teach.instructor.sandbox.sandbox_user`).
 
     Returns
     -------
@@ -330,9 +492,13 @@ def run_notebook(
     (work / "answers").mkdir(parents=True)
     _matplotlib_cache(work)
     nbformat.write(nb, work / "submission.ipynb")
+    if sandbox and user is not None:  # the sandbox's own user writes its folder, nothing else
+        for path in [work, *work.rglob("*")]:
+            os.chown(path, user, user, follow_symlinks=False)
     inside = Path(HOME) if sandbox else work
     pid_file = folder / "kernel.pid"
     limit_arg = f"{limits.memory_mb},{limits.processes},{limits.file_mb},{limits.cpu_seconds}"
+    limit_arg += f",{user if sandbox and user is not None else ''}"
     command = [
         sys.executable,
         "-m",
@@ -344,73 +510,93 @@ def run_notebook(
         limit_arg,
         "" if sandbox else os.fspath(pid_file),
     ]
-    err_path = folder / "runner.err"
     status = "ok"
     notes: list[str] = []
-    with open(err_path, "wb") as err:
-        if sandbox:
-            proc = Sandbox(work).popen(command, stdin=subprocess.DEVNULL, stdout=err, stderr=err)
-        else:
-            env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
-            env["MPLCONFIGDIR"] = os.fspath(work / ".config" / "matplotlib")
-            proc = subprocess.Popen(
-                command,
-                cwd=work,
-                env=env,
-                stdin=subprocess.DEVNULL,
-                stdout=err,
-                stderr=err,
-                start_new_session=True,
-            )
-        deadline = time.monotonic() + timeout
-        try:
-            while proc.poll() is None:
-                if stop is not None and stop.is_set():
-                    status = "interrupted"
-                    break
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    status = "timeout"
+    pipes = {"stdin": subprocess.DEVNULL, "stdout": subprocess.PIPE, "stderr": subprocess.STDOUT}
+    if sandbox:
+        proc = Sandbox(work, limits=limits, user=user).popen(command, **pipes)
+    else:
+        env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
+        env["MPLCONFIGDIR"] = os.fspath(work / ".config" / "matplotlib")
+        proc = subprocess.Popen(command, cwd=work, env=env, start_new_session=True, **pipes)
+    tail = _Tail(proc.stdout)
+    tail.start()
+    deadline = time.monotonic() + timeout
+    next_measure = 0.0
+    cap = limits.disk_mb * 1024 * 1024
+    try:
+        while proc.poll() is None:
+            if stop is not None and stop.is_set():
+                status = "interrupted"
+                break
+            now = time.monotonic()
+            if now >= next_measure:
+                next_measure = now + 0.5
+                if disk_usage(work) > cap:
+                    status = "over limits"
                     notes.append(
-                        f"the notebook ran longer than the time limit of {timeout:g} s and was "
-                        "stopped; it is graded on what it computed until then"
+                        f"the notebook wrote more than {limits.disk_mb} MB into its folder and "
+                        "was stopped; it is graded on what it computed until then"
                     )
                     break
-                try:
-                    proc.wait(timeout=min(left, 0.5))
-                except subprocess.TimeoutExpired:
-                    pass
-        finally:
-            if not sandbox:
-                _kill_child_kernel(pid_file, proc.pid)
-            _kill_group(proc.pid)  # the sandbox's own session: everything it started
-            proc.wait()
+            left = deadline - now
+            if left <= 0:
+                status = "timeout"
+                notes.append(
+                    f"the notebook ran longer than the time limit of {timeout:g} s and was "
+                    "stopped; it is graded on what it computed until then"
+                )
+                break
+            try:
+                proc.wait(timeout=min(left, 0.25))
+            except subprocess.TimeoutExpired:
+                pass
+    finally:
+        if not sandbox:
+            _kill_child_kernel(pid_file, proc.pid)
+        _kill_group(proc.pid)  # the sandbox's own session: everything it started
+        proc.wait()
+        tail.join(timeout=5)
     outcome = RunOutcome(status, positions=dict(positions), notes=notes)
     raw = read_limited(work / "executed.ipynb")
-    executed = None
+    errors = None
     if raw is not None:
         try:
-            executed = nbformat.reads(raw.decode("utf-8"), as_version=4)
-        except Exception:  # a half-written or tampered file: no cell errors to report
-            executed = None
-    if executed is not None:
-        outcome.errors = _errors(executed)
+            errors = _errors(json.loads(raw.decode("utf-8")), nb)
+        except (ValueError, RecursionError):  # half written or rewritten: no cell errors
+            errors = None
+    if errors is None and raw is not None:
+        notes.append("the executed copy was changed by the notebook: its cell errors are unknown")
+    outcome.errors = errors or []
     if status == "ok" and proc.returncode != 0:
-        text = (read_limited(err_path, 1 << 20) or b"").decode("utf-8", "replace")
-        lines = [line for line in text.splitlines() if line.strip()]
-        last = _one_line(lines[-1]) if lines else f"exit status {proc.returncode}"
+        text = tail.text()
+        noise = ("[IPKernelApp]", "WARNING", "[W ", "[I ", "To connect another client")
+        lines = [x for x in text.splitlines() if x.strip() and not x.lstrip().startswith(noise)]
+        last = (
+            _one_line(lines[-1])
+            if lines
+            else f"its processes ended early (exit status {proc.returncode})"
+        )
         if "DeadKernelError" in text or "Kernel died" in text:
             last = "the kernel died (the notebook ended its own process, or ran out of memory)"
         notes.append(f"the notebook could not be run to its end: {last}")
         status = "error"
     for tag in positions:
-        data = read_limited(work / "answers" / f"{tag}.json")
+        path = work / "answers" / f"{tag}.json"
+        data = read_limited(path, MAX_ANSWER_BYTES)
         if data is None:
+            try:
+                too_large = path.lstat().st_size > MAX_ANSWER_BYTES
+            except OSError:
+                too_large = False
+            if too_large:
+                status = "over limits"
+                notes.append(
+                    f"the answers after one check are larger than {MAX_ANSWER_BYTES >> 20} MB: "
+                    "not graded"
+                )
             continue
-        try:
-            outcome.captures[tag] = parse(data)
-        except AnswerError as err:
-            notes.append(f"the answers after one check could not be read ({err})")
+        outcome.captures[tag] = data.decode("utf-8", "replace")
     if status == "ok" and "final" not in outcome.captures:
         status = "error"
         notes.append("the notebook did not run to its end")
@@ -425,7 +611,9 @@ def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str
     """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts)."""
     from nbclient import NotebookClient  # deferred on purpose: only the runner needs it
 
-    memory, processes, file_mb, cpu = (int(v) for v in limits.split(","))
+    *numbers, user = limits.split(",")
+    drop_privileges(int(user) if user else None)  # before anything else: no root, no capability
+    memory, processes, file_mb, cpu = (int(v) for v in numbers)
     Limits(memory, processes, file_mb, cpu).apply()
     nb = nbformat.read(src, as_version=4)
     client = NotebookClient(

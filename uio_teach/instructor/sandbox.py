@@ -1,4 +1,4 @@
-"""The sandbox a submission runs in: bubblewrap, with only its own folder visible.
+"""The sandbox a hand-in runs in: bubblewrap, with only its own folder visible.
 
 :class:`Sandbox` turns a command into one run under ``bwrap`` (Debian package
 ``bubblewrap``) with
@@ -6,8 +6,10 @@
 * its own mount namespace holding only: the read-only system folders
   (``/usr`` and the ``/bin``, ``/lib`` links, a few files of ``/etc``), the
   read-only Python installation and virtual environment, the read-only
-  ``uio_teach`` package, and the submission's own work folder (writable, as
-  ``/home/student``); a fresh ``/tmp`` (in memory), ``/dev`` and ``/proc``;
+  ``uio_teach`` package, and the hand-in's own work folder (writable, as
+  ``/home/student``); a fresh ``/tmp`` in memory with a size cap, ``/dev``
+  and ``/proc``. The mounts are made parents first, so none hides another:
+  an environment or a checkout under ``/tmp`` or ``/home`` is still there;
 * its own process-id namespace (it sees no process of the grader; when the
   run ends, every process it started ends with it), network namespace (no
   network at all), IPC, UTS and user namespaces, and a new session (no
@@ -15,10 +17,17 @@
 * an emptied environment (only ``PATH``, ``HOME``, ``PYTHONPATH`` and the
   settings of matplotlib and Jupyter);
 * resource limits (``setrlimit``, inherited by everything it starts): address
-  space, number of processes, size of a written file, CPU time, no core dumps.
+  space, number of processes, size of a written file, CPU time, no core dumps;
+* when the grader runs as root, an unprivileged user id of its own
+  (:func:`sandbox_user`, taken by :func:`drop_privileges` before any of the
+  hand-in's code runs): root is exempt from the limit on processes, and the
+  sandbox then holds no capability and no privilege on the host's files.
 
-:func:`sandbox_problem` says why isolation is unavailable (no ``bwrap``, or
-user namespaces disabled), or ``None``.
+The total written into the work folder is capped by the runner
+(:mod:`uio_teach.instructor.runner`), which stops a run that exceeds it.
+:func:`sandbox_problem` says why isolation is unavailable (no ``bwrap``, user
+namespaces disabled, or the real interpreter cannot start or import the
+package inside), or ``None``.
 
 Examples
 --------
@@ -31,7 +40,6 @@ from __future__ import annotations
 
 import functools
 import os
-import resource
 import shutil
 import subprocess
 import sys
@@ -43,12 +51,25 @@ import uio_teach
 
 from ..errors import UIOTeachError
 
-__all__ = ["Limits", "Sandbox", "SandboxUnavailable", "sandbox_problem", "BWRAP", "HOME"]
+__all__ = [
+    "Limits",
+    "Sandbox",
+    "SandboxUnavailable",
+    "sandbox_problem",
+    "sandbox_user",
+    "drop_privileges",
+    "BWRAP",
+    "HOME",
+    "UID_BASE",
+]
 
 BWRAP = "bwrap"
 """The bubblewrap program (looked up on ``PATH``, then ``/usr/bin/bwrap``)."""
 HOME = "/home/student"
 """Where the work folder appears inside the sandbox (also ``HOME`` and the working folder)."""
+UID_BASE = 1_700_000_000
+"""When the grader runs as root, hand-in ``k`` runs as user id ``UID_BASE + k``: far above any
+login account, one per hand-in, so the limit on processes of one never counts another's."""
 _PACKAGE_ROOT = "/opt/uio-teach"
 _ETC = (
     "/etc/ld.so.cache",
@@ -76,23 +97,30 @@ class Limits:
     memory_mb : int
         Address space of each process (MiB).
     processes : int
-        Processes and threads of the user (``RLIMIT_NPROC``).
+        Processes and threads of the sandbox's user (``RLIMIT_NPROC``; a user
+        of its own when the grader runs as root).
     file_mb : int
         Largest file a process may write (MiB).
     cpu_seconds : int
         CPU time of each process (a safety net under the wall-clock limit).
+    tmp_mb : int
+        Size of the sandbox's ``/tmp`` (in memory).
+    disk_mb : int
+        All a run may write into its work folder; the run is stopped beyond.
 
     Examples
     --------
     >>> from uio_teach.instructor.sandbox import Limits
     >>> Limits(memory_mb=2048).memory_mb, Limits().processes
-    (2048, 1024)
+    (2048, 256)
     """
 
     memory_mb: int = 4096
-    processes: int = 1024
+    processes: int = 256
     file_mb: int = 256
     cpu_seconds: int = 3600
+    tmp_mb: int = 256
+    disk_mb: int = 512
 
     def apply(self) -> None:
         """Set the limits on the calling process; everything it starts inherits them.
@@ -101,6 +129,8 @@ class Limits:
         the soft one ends the process with a signal), so the student's code
         cannot raise them again.
         """
+        import resource  # deferred on purpose: POSIX only, so the package imports everywhere
+
         mib = 1024 * 1024
         for what, value in (
             (resource.RLIMIT_AS, self.memory_mb * mib),
@@ -125,8 +155,106 @@ def _bwrap() -> str | None:
 
 
 @functools.lru_cache(maxsize=1)
+def _bwrap_has_size() -> bool:
+    """Whether this bubblewrap caps a tmpfs (``--size``, bubblewrap 0.8 and later)."""
+    program = _bwrap()
+    try:
+        done = subprocess.run([program or BWRAP, "--help"], capture_output=True, text=True)
+    except OSError:
+        return False
+    return "--size" in done.stdout + done.stderr
+
+
+def sandbox_user(index: int) -> int | None:
+    """The user id hand-in ``index`` runs as: its own when the grader is root, else None (yours).
+
+    Parameters
+    ----------
+    index : int
+        The hand-in's number in the run.
+
+    Returns
+    -------
+    int or None
+
+    Examples
+    --------
+    >>> import os
+    >>> from uio_teach.instructor.sandbox import UID_BASE, sandbox_user
+    >>> sandbox_user(3) == (UID_BASE + 3 if os.geteuid() == 0 else None)
+    True
+    """
+    if not hasattr(os, "geteuid") or os.geteuid() != 0:
+        return None
+    return UID_BASE + int(index)
+
+
+def _probe_command(user: int | None) -> list[str]:
+    """The real interpreter, importing the package and the notebook runner, as a hand-in would."""
+    code = (
+        "from uio_teach.instructor.sandbox import drop_privileges; "
+        f"drop_privileges({user!r}); "
+        "import uio_teach, nbclient, ipykernel, numpy; "
+        "open('/tmp/probe', 'w').write('x'); open('probe', 'w').write('x'); "
+        "print('uio-teach sandbox ok')"
+    )
+    return [sys.executable, "-c", code]
+
+
+@functools.lru_cache(maxsize=4)
+def _problem(user: int | None) -> str | None:
+    if not sys.platform.startswith("linux"):
+        return "the sandbox needs Linux namespaces (bubblewrap); this system is not Linux"
+    program = _bwrap()
+    if program is None:
+        return (
+            "bubblewrap (bwrap) is not installed: install it (Debian/Ubuntu: "
+            "apt-get install bubblewrap)"
+        )
+    import tempfile  # deferred on purpose: only the probe needs a folder
+
+    with tempfile.TemporaryDirectory(prefix="uio-teach-probe-") as tmp:
+        work = Path(tmp) / "work"
+        work.mkdir()
+        if user is not None:
+            os.chown(work, user, user)
+        sandbox = Sandbox(work, user=user)
+        try:
+            proc = sandbox.popen(
+                _probe_command(user), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            )
+        except OSError as err:
+            return f"bubblewrap cannot run: {err}"
+        try:
+            stdout, stderr = proc.communicate(timeout=120)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+            return "bubblewrap did not start Python within 120 s"
+        done = subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr)
+    if done.returncode == 0 and "uio-teach sandbox ok" in done.stdout:
+        return None
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    why = lines[-1].strip() if lines else f"exit status {done.returncode}"
+    if why.startswith("bwrap:") and ("namespace" in why or "Operation not permitted" in why):
+        return (
+            f"bubblewrap cannot create the namespaces ({why}); user namespaces may be "
+            "disabled (sysctl kernel.unprivileged_userns_clone) or forbidden in this container"
+        )
+    return (
+        f"the interpreter {sys.executable} cannot run inside the sandbox with the package "
+        f"{Path(uio_teach.__file__).parent} ({why[:300]}); when grading as root, they must "
+        "be readable by every user"
+    )
+
+
 def sandbox_problem() -> str | None:
-    """Why submissions cannot be isolated here, or ``None`` when they can.
+    """Why hand-ins cannot be isolated here, or ``None`` when they can.
+
+    The probe runs the real interpreter inside the sandbox, as a hand-in
+    runs (as an unprivileged user when the grader is root): it starts
+    Python, imports the package, the notebook runner and NumPy, and writes
+    into its ``/tmp``. The answer is kept for the life of the process.
 
     Returns
     -------
@@ -138,27 +266,22 @@ def sandbox_problem() -> str | None:
     >>> sandbox_problem() is None or isinstance(sandbox_problem(), str)
     True
     """
-    if not sys.platform.startswith("linux"):
-        return "the sandbox needs Linux namespaces (bubblewrap); this system is not Linux"
-    program = _bwrap()
-    if program is None:
-        return (
-            "bubblewrap (bwrap) is not installed: install it (Debian/Ubuntu: "
-            "apt-get install bubblewrap)"
-        )
-    probe = Sandbox(Path("/")).wrap(["/bin/true"], bind_work=False)
-    try:
-        done = subprocess.run(probe, capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.TimeoutExpired) as err:
-        return f"bubblewrap cannot run: {err}"
-    if done.returncode != 0:
-        lines = [line for line in done.stderr.splitlines() if line.strip()]
-        why = lines[-1] if lines else f"exit status {done.returncode}"
-        return (
-            f"bubblewrap cannot create the namespaces ({why}); user namespaces may be "
-            "disabled (sysctl kernel.unprivileged_userns_clone) or forbidden in this container"
-        )
-    return None
+    return _problem(sandbox_user(0))
+
+
+def _open_parents(mounts: Sequence[tuple[str, str, str]]) -> list[str]:
+    """``--chmod 0755`` for every folder bwrap creates above a mount (not inside one)."""
+    every = [Path(dest) for kind, _, dest in mounts if kind != "--symlink"]
+    # a folder made inside a bound host folder is the host's (read-only); one made inside the
+    # sandbox's own /tmp or root is bwrap's, root's and closed: opened here
+    bound = [Path(d) for kind, _, d in mounts if kind in ("--bind", "--ro-bind", "--ro-bind-try")]
+    made: list[str] = []
+    for dest in every:
+        for parent in list(dest.parents)[::-1][1:]:  # "/" left out, outermost first
+            inside = any(parent == b or b in parent.parents for b in bound)
+            if not inside and os.fspath(parent) not in made:
+                made.append(os.fspath(parent))
+    return [arg for path in made for arg in ("--chmod", "0755", path)]
 
 
 class Sandbox:
@@ -167,8 +290,12 @@ class Sandbox:
     Parameters
     ----------
     work : path
-        The submission's work folder: the only writable place, seen inside as
-        :data:`HOME`.
+        The hand-in's work folder: the only writable place on disk, seen
+        inside as :data:`HOME`.
+    limits : Limits, optional
+        Only its ``tmp_mb`` is used here (the size of ``/tmp``).
+    user : int, optional
+        The user id to run as (:func:`sandbox_user`); None keeps yours.
 
     Examples
     --------
@@ -177,55 +304,88 @@ class Sandbox:
     >>> cmd = Sandbox(Path("/tmp/x")).wrap(["python3", "-c", "pass"])
     >>> "--unshare-net" in cmd and "--unshare-pid" in cmd
     True
+    >>> cmd.index("/tmp") < cmd.index("/home/student")  # parents first: nothing hidden
+    True
     """
 
-    def __init__(self, work: Path) -> None:
+    def __init__(self, work: Path, *, limits: Limits | None = None, user: int | None = None):
         self.work = Path(work)
+        self.limits = limits or Limits()
+        self.user = user
 
-    def wrap(self, command: Sequence[str], *, bind_work: bool = True) -> list[str]:
+    def _mounts(self) -> list[tuple[str, str, str]]:
+        """Every mount as (kind, source, destination), parents before children."""
+        mounts: list[tuple[str, str, str]] = [("--ro-bind", "/usr", "/usr")]
+        for name in ("bin", "lib", "lib32", "lib64", "sbin"):
+            path = Path("/") / name
+            if path.is_symlink():
+                mounts.append(("--symlink", os.readlink(path), f"/{name}"))
+            elif path.is_dir():
+                mounts.append(("--ro-bind", f"/{name}", f"/{name}"))
+        for path in _ETC:
+            mounts.append(("--ro-bind-try", path, path))
+        for prefix in sorted({sys.base_prefix, sys.prefix, sys.exec_prefix}):
+            if not prefix.startswith("/usr/"):
+                mounts.append(("--ro-bind", prefix, prefix))
+        package = os.fspath(Path(uio_teach.__file__).resolve().parent)
+        mounts.append(("--ro-bind", package, f"{_PACKAGE_ROOT}/uio_teach"))
+        mounts += [
+            ("--proc", "", "/proc"),
+            ("--dev", "", "/dev"),
+            ("--tmpfs", "", "/tmp"),
+            ("--bind", os.fspath(self.work), HOME),
+        ]
+        # parents first: a tmpfs on /tmp made after the environment would hide an environment
+        # that lives under /tmp; sorted by depth, every mount is made on top of its parents
+        mounts.sort(key=lambda m: len(Path(m[2]).parts))
+        return mounts
+
+    def wrap(self, command: Sequence[str]) -> list[str]:
         """The bwrap command line that runs ``command`` inside the sandbox.
 
         Parameters
         ----------
         command : sequence of str
             The program and its arguments (paths as seen inside).
-        bind_work : bool
-            Mount the work folder (False for a probe).
 
         Returns
         -------
         list of str
         """
-        args = [_bwrap() or BWRAP, "--unshare-user-try", "--unshare-ipc", "--unshare-pid"]
-        args += ["--unshare-net", "--unshare-uts", "--unshare-cgroup-try"]
-        args += ["--die-with-parent", "--new-session"]
-        args += ["--ro-bind", "/usr", "/usr"]
-        for name in ("bin", "lib", "lib32", "lib64", "sbin"):
-            path = Path("/") / name
-            if path.is_symlink():
-                args += ["--symlink", os.readlink(path), f"/{name}"]
-            elif path.is_dir():
-                args += ["--ro-bind", f"/{name}", f"/{name}"]
-        for path in _ETC:
-            args += ["--ro-bind-try", path, path]
-        for prefix in sorted({sys.base_prefix, sys.prefix, sys.exec_prefix}):
-            if not prefix.startswith("/usr"):
-                args += ["--ro-bind", prefix, prefix]
-        package = Path(uio_teach.__file__).resolve().parent
-        args += ["--ro-bind", os.fspath(package), f"{_PACKAGE_ROOT}/uio_teach"]
-        args += ["--proc", "/proc", "--dev", "/dev", "--tmpfs", "/tmp"]
-        if bind_work:
-            args += ["--bind", os.fspath(self.work), HOME, "--chdir", HOME]
-        args += ["--clearenv"]
+        args = [_bwrap() or BWRAP]
+        if self.user is None:  # a user namespace of its own
+            args += ["--unshare-user-try"]
+        else:  # root: only the right to become the unprivileged `user` (on the host), then none
+            args += ["--cap-drop", "ALL", "--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID"]
+        args += ["--unshare-ipc", "--unshare-pid", "--unshare-net", "--unshare-uts"]
+        args += ["--unshare-cgroup-try", "--die-with-parent", "--new-session"]
+        for kind, source, dest in self._mounts():
+            if kind in ("--proc", "--dev"):
+                args += [kind, dest]
+            elif kind == "--tmpfs":
+                if _bwrap_has_size():
+                    args += ["--size", str(self.limits.tmp_mb * 1024 * 1024)]
+                args += [kind, dest]
+            elif kind == "--symlink":
+                args += [kind, source, dest]
+            else:
+                args += [kind, source, dest]
+        if self.user is not None:  # the folders bwrap made on the way are root's: open them
+            args += [*_open_parents(self._mounts()), "--chmod", "1777", "/tmp"]
+        args += ["--chdir", HOME, "--clearenv"]
         env = {
             "PATH": f"{Path(sys.executable).parent}:/usr/local/bin:/usr/bin:/bin",
-            "HOME": HOME if bind_work else "/tmp",
+            "HOME": HOME,
+            "USER": "student",
+            "LOGNAME": "student",
             "PYTHONPATH": _PACKAGE_ROOT,
             "PYTHONHASHSEED": "0",
+            "PYTHONDONTWRITEBYTECODE": "1",
             "MPLBACKEND": "Agg",
-            "MPLCONFIGDIR": f"{HOME}/.config/matplotlib" if bind_work else "/tmp",
+            "MPLCONFIGDIR": f"{HOME}/.config/matplotlib",
             "JUPYTER_RUNTIME_DIR": "/tmp/jupyter",
             "JUPYTER_PLATFORM_DIRS": "1",
+            "TMPDIR": "/tmp",
             "OMP_NUM_THREADS": "1",
             "OPENBLAS_NUM_THREADS": "1",
             "LANG": "C.UTF-8",
@@ -238,8 +398,8 @@ class Sandbox:
         """Start ``command`` in the sandbox, in a new session of its own.
 
         The limits are applied by the command itself (the grading runner calls
-        :meth:`Limits.apply` first thing), not here: ``preexec_fn`` is unsafe
-        with the grader's threads.
+        :func:`drop_privileges` and :meth:`Limits.apply` first thing), not
+        here: ``preexec_fn`` is unsafe with the grader's threads.
 
         Parameters
         ----------
@@ -252,3 +412,33 @@ class Sandbox:
         subprocess.Popen
         """
         return subprocess.Popen(self.wrap(command), start_new_session=True, **kwargs)
+
+
+def drop_privileges(user: int | None) -> None:
+    """Become the unprivileged ``user`` for good (the first act inside a root grader's sandbox).
+
+    Inside the sandbox of a grader running as root, the process starts as
+    root with only the capabilities to change its user; it then takes the
+    user id ``user`` (group alike, no supplementary groups), which leaves it
+    no capability at all, and bubblewrap's *no new privileges* keeps
+    set-user-id programs from giving any back.
+
+    Parameters
+    ----------
+    user : int or None
+        None does nothing (the grader is not root: the sandbox already runs as its user).
+
+    Raises
+    ------
+    PermissionError
+        The user could not be taken, or the process still holds a capability.
+    """
+    if user is None:
+        return
+    os.setgroups([])
+    os.setgid(user)
+    os.setuid(user)
+    status = Path("/proc/self/status").read_text()
+    held = [line for line in status.splitlines() if line.startswith(("CapEff", "CapPrm"))]
+    if os.getuid() != user or any(int(line.split()[1], 16) for line in held):
+        raise PermissionError(f"could not drop to the unprivileged user {user}")
