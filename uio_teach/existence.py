@@ -13,7 +13,7 @@ from .linalg import (
     DROP_MARGIN,
     MARGIN,
     ObservabilitySplit,
-    invariant_zeros,
+    checked_zeros,
     is_stable,
     left_null,
     pinv,
@@ -62,6 +62,9 @@ class Condition:
     rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
     threshold, that ratio (threshold / dropped value); below ``uio_teach.linalg.MARGIN`` the
     verdict hangs on round-off and the reason says so. A rank-0 verdict carries it too."""
+    undecided: bool = False
+    """True when the verdict cannot be decided at this precision (``holds`` is then ``None``
+    and the reason says why)."""
 
     @property
     def marginal(self) -> bool:
@@ -73,6 +76,8 @@ class Condition:
         """The verdict in one character; ✓, ✗, – (not evaluated) or ○ (info, not met)."""
         if not self.required and self.holds is False:
             return "○"
+        if self.undecided:
+            return "?"
         return {True: "✓", False: "✗", None: "–"}[self.holds]
 
 
@@ -226,9 +231,23 @@ class ExistenceReport:
         return all(c.holds for c in self.conditions if c.required)
 
     @property
+    def decided(self) -> bool:
+        """False when a required condition cannot be decided at this precision."""
+        return not any(c.undecided for c in self.conditions if c.required)
+
+    @property
+    def verdict(self) -> str:
+        """The conclusion in words."""
+        if self.ok:
+            return "a UIO exists"
+        if not self.decided and not any(c.holds is False for c in self.conditions if c.required):
+            return "cannot be decided at this precision"
+        return "no UIO with stable error dynamics exists"
+
+    @property
     def failed(self) -> tuple[Condition, ...]:
-        """The required conditions that do not hold."""
-        return tuple(c for c in self.conditions if c.required and c.holds is False)
+        """The required conditions that do not hold or cannot be decided."""
+        return tuple(c for c in self.conditions if c.required and (c.holds is False or c.undecided))
 
     def __getitem__(self, name: str) -> Condition:
         for c in self.conditions:
@@ -248,8 +267,7 @@ class ExistenceReport:
             text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
             # wrap long reasons under their column so the table fits the book's column
             lines.append(fit_lines(text, indent=indent))
-        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
-        lines.append(f"  => {verdict}")
+        lines.append(f"  => {self.verdict}")
         return "\n".join(lines)
 
     __repr__ = __str__
@@ -260,7 +278,7 @@ class ExistenceReport:
             f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
             for c in self.conditions
         )
-        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
+        verdict = self.verdict
         return (
             f"<div><b>Existence of an unknown input observer</b> for "
             f"{html.escape(repr(self.plant))}<table>"
@@ -402,8 +420,21 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     return cond, rE
 
 
-def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
+def zero_condition(
+    zeros: np.ndarray,
+    discrete: bool,
+    size: float,
+    doubtful: np.ndarray | None = None,
+    residuals: np.ndarray | None = None,
+    radius: np.ndarray | None = None,
+) -> Condition:
     """The condition "invariant zeros stable" for the given zeros.
+
+    ``doubtful`` lists values that are zeros of plants within round-off of the data but not
+    certainly of this one (:class:`uio_teach.linalg.ZeroSet`), with ``residuals`` the
+    Rosenbrock matrix's smallest singular value there relative to the round-off threshold. When
+    such a value, or a zero within the numerical margin of the stability boundary, would change
+    the verdict, the condition is not decided (``holds=None``) and the reason says why.
 
     Examples
     --------
@@ -412,6 +443,11 @@ def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
     True
     """
     region = _region(discrete)
+    doubtful = np.zeros(0, complex) if doubtful is None else np.asarray(doubtful, complex)
+    zeros = np.asarray(zeros, complex)
+    undecided = _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius)
+    if undecided:
+        return Condition("invariant zeros stable", None, undecided, margin=1.0, undecided=True)
     if not len(zeros):
         return Condition("invariant zeros stable", True, "no invariant zeros")
     bad = zeros[~is_stable(zeros, discrete)]
@@ -427,6 +463,46 @@ def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
         f"invariant zero(s) {listed} outside {region}: they are observer poles "
         "no gain can move, so the error would not decay" + note,
     )
+
+
+def _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius=None) -> str:
+    """Why the zero condition cannot be decided at this precision ('' when it can)."""
+    stable = is_stable(zeros, discrete)
+    dist = np.abs(np.abs(zeros) - 1.0) if discrete else np.abs(zeros.real)
+    if radius is not None and len(radius) == len(zeros):
+        # how far round-off of the data can move each zero (its condition number)
+        near = dist <= np.asarray(radius, float)
+    else:
+        near = dist <= ZERO_MARGIN * max(1.0, float(size))
+    if np.all(stable):
+        # the verdict "stable" would change with a doubtful unstable value or a zero on the edge
+        flip = doubtful[~is_stable(doubtful, discrete)] if doubtful.size else doubtful
+        edge = zeros[near]
+    else:
+        # "unstable" is certain when one unstable zero is certain and clear of the boundary
+        if np.any(~stable & ~near):
+            return ""
+        flip, edge = np.zeros(0, complex), zeros[~stable]
+    if not flip.size and not edge.size:
+        return ""
+    where = "unit circle" if discrete else "imaginary axis"
+    parts = []
+    if flip.size:
+        res = np.asarray(residuals if residuals is not None else [], float)
+        how = (
+            f" (singular to {float(np.min(res)):.2g} times the round-off threshold)"
+            if res.size
+            else ""
+        )
+        parts.append(
+            f"{format_poles(flip, braces=True)} outside {_region(discrete)} is an invariant zero "
+            f"of a plant within round-off of the data{how}, not certainly of this one"
+        )
+    if edge.size:
+        parts.append(
+            f"zero(s) {format_poles(edge, braces=True)} lie within round-off of the {where}"
+        )
+    return "cannot be decided at this precision: " + "; ".join(parts)
 
 
 def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
@@ -461,12 +537,25 @@ def detectability_conditions(
         margin, "a singular value of the observability staircase"
     )
     if not _agreeing_modes(fixed, zeros, dec.pair.sigma):
-        margin = min(margin, 1.0)
-        note += (
-            f" (within the numerical margin: the {len(fixed)} unobservable mode(s) and the "
-            f"{len(zeros)} invariant zero(s) should coincide but do not to round-off, so "
-            "this verdict hangs on round-off)"
+        # in exact arithmetic the fixed modes are the invariant zeros; the zeros are computed
+        # with every decision checked (uio_teach.linalg.checked_zeros), the staircase is not
+        found = format_poles(fixed, braces=True, empty="none")
+        zero_cond = zero_condition(zeros, discrete, size)
+        listed_zeros = format_poles(zeros, braces=True, empty="none")
+        why = (
+            f"the fixed modes are the invariant zeros {listed_zeros}"
+            f" (the observability staircase of {pair} finds {found}: its rank decisions do not "
+            "resolve them)"
         )
+        det = Condition(
+            f"detectable {pair}",
+            zero_cond.holds,
+            why,
+            margin=min(margin, 1.0),
+            undecided=zero_cond.undecided,
+        )
+        obs = Condition(f"observable {pair}", not len(zeros), why, required=False, margin=1.0)
+        return [det, obs], zeros, plant.n - len(zeros)
     listed = format_poles(fixed if not len(unstable) else unstable, braces=True, empty="none")
     if not len(unstable):
         reason = (
@@ -546,8 +635,11 @@ def check_existence(plant: Plant) -> ExistenceReport:
     conds = [rank_cond]
     Bz = np.hstack([bal.E, np.zeros((plant.n, plant.nv))])
     Dz = np.hstack([np.zeros((plant.p, plant.q)), bal.D])
-    zeros = sort_poles(invariant_zeros(bal.A, Bz, bal.C, Dz) * sigma)
-    conds.append(zero_condition(zeros, discrete, size))
+    zs = checked_zeros(bal.A, Bz, bal.C, Dz)
+    zeros = sort_poles(zs.zeros * sigma)
+    conds.append(
+        zero_condition(zeros, discrete, size, zs.doubtful * sigma, zs.residuals, zs.radius * sigma)
+    )
     fixed = np.zeros(0, complex)
     movable = 0
     if rank_cond.holds:
