@@ -25,6 +25,7 @@ it obtained with what it promised:
 from __future__ import annotations
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -43,6 +44,13 @@ __all__ = [
     "relative_residual",
     "product_bound",
     "check_fixed_modes",
+    "LEAK_RTOL",
+    "LEAK_REFUSE",
+    "DecouplingLeak",
+    "DecouplingWarning",
+    "DecouplingError",
+    "decoupling_leak",
+    "check_decoupling",
 ]
 
 POLE_RTOL = 1e-6
@@ -326,3 +334,167 @@ def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
             f"{_fmt(nearest)}): the error would depend on the unknown input, so the observer "
             "is refused"
         )
+
+
+LEAK_RTOL = 1e-6
+"""A design is returned without a word when the unknown input's gain to the estimation error is
+certainly below ``LEAK_RTOL`` times its gain to the state (round-off included)."""
+
+LEAK_REFUSE = 1e-3
+"""A design whose computed leak exceeds this fraction of the state's response is refused."""
+
+
+class DecouplingWarning(UserWarning):
+    """The design decouples only to a stated fraction: it amplifies round-off (a small ``C E``)."""
+
+
+class DecouplingError(PlacementAccuracyError):
+    """The returned matrices do not decouple the estimation error from the unknown input."""
+
+
+class DecouplingLeak(NamedTuple):
+    """How much of the unknown input reaches the estimation error (:func:`decoupling_leak`).
+
+    Attributes
+    ----------
+    leak : float
+        Largest ratio ``||G_de(s)|| / ||G_dx(s)||`` over the test points, computed from the
+        stored matrices (round-off of the check itself included).
+    bound : float
+        The same with every residual replaced by its size plus its round-off bound: what the
+        stored matrices can leak at most.
+    amplification : float
+        How much the realization amplifies round-off: ``bound / eps`` for residuals at round-off.
+    """
+
+    leak: float
+    bound: float
+    amplification: float
+
+
+def decoupling_leak(A, E, C, theta, F, K, Co, discrete: bool = False) -> DecouplingLeak:
+    """The unknown input's path to an observer's estimation error, from first principles.
+
+    The observer ``w' = F w + K y + ...``, ``xhat = Co w + Dy y`` estimates ``theta x`` with its
+    state when ``Co theta + Dy C = I``; then ``eps = theta x - w`` obeys
+    ``eps' = F eps + R x + theta E d`` with ``R = theta A - F theta - K C``, and the estimation
+    error is ``Co eps``. Both residuals are zero for an observer that decouples; their effect is
+    evaluated at frequencies ``s = j w`` spread over the plant's and the observer's (``z = e^jw``
+    in discrete time): ``G_de(s) = Co (sI - F)^-1 (R (sI - A)^-1 E + theta E)``, its largest
+    gain against the largest gain of ``G_dx = (sI - A)^-1 E``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> from uio_teach.verify import decoupling_leak
+    >>> obs = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3])
+    >>> pl = obs.plant
+    >>> res = decoupling_leak(pl.A, pl.E, pl.C, obs.T, obs.F, obs.K, np.eye(3))
+    >>> bool(res.bound < 1e-12)
+    True
+    """
+    A, E, C, theta, F, K, Co = (np.asarray(X, float) for X in (A, E, C, theta, F, K, Co))
+    n, q = E.shape
+    if q == 0 or n == 0:
+        return DecouplingLeak(0.0, 0.0, 0.0)
+    with np.errstate(all="ignore"):
+        R = theta @ A - F @ theta - K @ C
+        R1 = theta @ E
+        aT, aA, aF, aK, aC, aE = (np.abs(X) for X in (theta, A, F, K, C, E))
+        gamma = 4 * (n + 2) * _EPS
+        Rb = np.abs(R) + gamma * (aT @ aA + aF @ aT + aK @ aC)
+        R1b = np.abs(R1) + gamma * (aT @ aE)
+        if not (np.all(np.isfinite(Rb)) and np.all(np.isfinite(R1b))):
+            return DecouplingLeak(np.inf, np.inf, np.inf)
+        lam = np.concatenate([np.linalg.eigvals(A), np.linalg.eigvals(F)])
+    if discrete:
+        points = np.exp(1j * np.linspace(0.0, np.pi, 7))
+    else:
+        mags = np.abs(lam[np.isfinite(lam)])
+        mags = mags[mags > 0]
+        lo, hi = (float(mags.min()), float(mags.max())) if mags.size else (1.0, 1.0)
+        points = 1j * np.concatenate([[0.0], np.geomspace(lo, hi, 6) if hi > lo else [lo]])
+    leak = bound = gain = 0.0
+    eye = np.eye(n)
+    for z in points:
+        try:
+            X = np.linalg.solve(z * eye - A, E)
+            Y = Co @ np.linalg.inv(z * eye - F)
+        except np.linalg.LinAlgError:
+            continue
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(Y))):
+            continue
+        gain = max(gain, float(np.linalg.norm(X, 2)))
+        leak = max(leak, float(np.linalg.norm(Y @ (R @ X + R1), 2)))
+        bound = max(bound, float(np.linalg.norm(np.abs(Y) @ (Rb @ np.abs(X) + R1b), 2)))
+    if gain == 0:
+        return DecouplingLeak(0.0, 0.0, 0.0)
+    return DecouplingLeak(leak / gain, bound / gain, bound / gain / _EPS)
+
+
+def check_decoupling(
+    A,
+    E,
+    C,
+    theta,
+    F,
+    K,
+    Co,
+    *,
+    discrete: bool = False,
+    what: str = "the observer",
+    cause: str = "",
+    stacklevel: int = 3,
+) -> DecouplingLeak:
+    """Refuse a design that leaks; warn when it decouples only to more than ``LEAK_RTOL``.
+
+    Parameters
+    ----------
+    A, E, C : array_like
+        The plant.
+    theta, F, K, Co : array_like
+        The observer (see :func:`decoupling_leak`).
+    what : str
+        How the design is called in messages.
+    cause : str
+        What makes the realization amplify round-off (e.g. the size of ``H``), for the messages.
+
+    Raises
+    ------
+    DecouplingError
+        The stored matrices leak more than ``LEAK_REFUSE`` of the state's response.
+
+    Warns
+    -----
+    DecouplingWarning
+        The leak is certainly below ``LEAK_REFUSE`` but not below ``LEAK_RTOL``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import check_decoupling
+    >>> A = np.diag([-1.0, -2.0]); E = np.array([[1.0], [0.0]]); C = np.array([[1.0, 0.0]])
+    >>> theta = np.array([[0.0, 0.0], [0.0, 1.0]])
+    >>> check_decoupling(A, E, C, theta, A, np.zeros((2, 1)), np.eye(2)).bound < 1e-12
+    True
+    """
+    res = decoupling_leak(A, E, C, theta, F, K, Co, discrete)
+    if res.bound <= LEAK_RTOL:
+        return res
+    why = f"the realization amplifies round-off by {res.amplification:.2g}" + (
+        f" ({cause})" if cause else ""
+    )
+    if not res.leak <= LEAK_REFUSE:
+        raise DecouplingError(
+            f"{what} does not decouple: the unknown input reaches the estimation error with "
+            f"{res.leak:.2g} of its gain on the state (judged on the returned matrices); "
+            f"{why}. The design is refused"
+        )
+    warnings.warn(
+        f"{what} decouples only approximately: the unknown input may reach the estimation error "
+        f"with up to {res.bound:.2g} of its gain on the state; {why}",
+        DecouplingWarning,
+        stacklevel=stacklevel,
+    )
+    return res

@@ -9,7 +9,7 @@ import numpy as np
 from .._validation import as_matrix, read_only
 from ..linalg import pinv, rank, sort_poles
 from ..plant import Plant, check_plant
-from ..verify import check_fixed_modes, check_identity, product_bound
+from ..verify import check_decoupling, check_fixed_modes, check_identity, product_bound
 from .base import Observer, ObserverRealization
 from .projection import require_existence
 
@@ -46,7 +46,10 @@ class GInverseObserver(Observer):
         n, p = plant.n, plant.p
         A, C, E = plant.A, plant.C, plant.E
         Cg = pinv(C)
-        Pc = np.eye(n) - Cg @ C
+        # the orthogonal projection onto ker C from an orthonormal basis of it: exactly 0 for an
+        # invertible C (I - C^+ C would be round-off of size eps cond(C))
+        Vn = _null_basis(C)
+        Pc = Vn @ Vn.T
         CE = C @ E
         CEg = pinv(CE)
         W = np.eye(p) - CE @ CEg
@@ -62,6 +65,7 @@ class GInverseObserver(Observer):
         # orthonormal basis of range(Pc): the error lives there
         U, s, _ = np.linalg.svd(Pc)
         self._basis = U[:, : n - rank(C)]
+        self._leak = None
 
     @property
     def Cg(self) -> np.ndarray:
@@ -130,6 +134,13 @@ class GInverseObserver(Observer):
         )
 
 
+def _null_basis(C: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (columns) of ker C, its dimension decided by ``rank``."""
+    n = C.shape[1]
+    _, _, Vt = np.linalg.svd(C, full_matrices=True)
+    return Vt[rank(C) :].T.copy() if n else np.zeros((0, 0))
+
+
 def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> None:
     """Verify a g-inverse observer on the data as given (identity and fixed modes)."""
     pl = obs.plant
@@ -144,6 +155,20 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
     poles = obs.poles()
     if fixed is not None and len(fixed) <= len(poles):
         check_fixed_modes(poles, fixed, what="the g-inverse observer")
+    # from first principles: the observer state tracks (I - K C) x, xhat = Pc w + Dy y
+    theta = np.eye(pl.n) - K @ pl.C
+    obs._leak = check_decoupling(
+        pl.A,
+        pl.E,
+        pl.C,
+        theta,
+        obs.F,
+        obs.G,
+        Pc,
+        discrete=pl.is_discrete,
+        what="the g-inverse observer",
+        stacklevel=4,
+    )
 
 
 def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:

@@ -193,7 +193,7 @@ def design_pmo(
     else:
         L = decoupled_gain("L", plant, L)
     obs = PMO(plant, dec.M, L, Mv, certificate)
-    verify_projection(obs, "the PMO", dec.pair.fixed_modes)
+    verify_projection(obs, "the PMO", report.fixed_modes)
     if requested is not None:
         check_poles(obs.F, requested, what="the PMO", stacklevel=3)
     obs.warn_if_unstable()

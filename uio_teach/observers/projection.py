@@ -18,7 +18,13 @@ from .._validation import as_matrix, read_only
 from ..existence import ExistenceReport, UIOExistenceError, check_existence
 from ..linalg import pinv
 from ..plant import Plant
-from ..verify import check_fixed_modes, check_identity, product_bound
+from ..verify import (
+    DecouplingLeak,
+    check_decoupling,
+    check_fixed_modes,
+    check_identity,
+    product_bound,
+)
 from .base import Observer, ObserverRealization
 
 __all__ = [
@@ -46,10 +52,17 @@ class ProjectionObserver(Observer):
         self._K1 = read_only(K1)
         self._F = read_only(self._T @ plant.A - K1 @ plant.C)
         self._K2 = read_only(self._F @ H)
+        self._leak: DecouplingLeak | None = None
 
     @property
     def error_matrix(self) -> np.ndarray:
         return self._F
+
+    @property
+    def leak(self) -> DecouplingLeak | None:
+        """How much of the unknown input can reach the estimation error, judged on the returned
+        matrices (:func:`uio_teach.verify.decoupling_leak`); set by the design."""
+        return self._leak
 
     def realization(self) -> ObserverRealization:
         pl = self.plant
@@ -84,6 +97,23 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
     # an error matrix without them does not decouple, whatever the identities say
     if fixed is not None:
         check_fixed_modes(obs.poles(), fixed, what=what)
+    # from first principles, on the matrices returned: the unknown input's path to the error
+    H, K = obs._H, obs._K1 + obs._K2
+    amp = float(np.linalg.norm(obs._F, 2) * np.linalg.norm(H, 2))
+    cause = f"||F|| ||H|| = {amp:.2g}: a C E small next to E makes H large" if amp > 1e6 else ""
+    obs._leak = check_decoupling(
+        pl.A,
+        pl.E,
+        pl.C,
+        obs._T,
+        obs._F,
+        K,
+        np.eye(pl.n),
+        discrete=pl.is_discrete,
+        what=what,
+        cause=cause,
+        stacklevel=4,
+    )
 
 
 def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:

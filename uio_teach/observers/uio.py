@@ -132,7 +132,7 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     else:
         K1 = decoupled_gain("K1", plant, K1)
     obs = UIO(plant, dec.M, K1)
-    verify_projection(obs, "the UIO", dec.pair.fixed_modes)
+    verify_projection(obs, "the UIO", report.fixed_modes)
     if requested is not None:
         check_poles(obs.F, requested, what="the UIO", stacklevel=3)
     obs.warn_if_unstable()
