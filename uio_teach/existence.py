@@ -301,6 +301,10 @@ RANK_RTOL = 100.0
 """The rank condition's thresholds are ``RANK_RTOL * eps`` (``RANK_RTOL * n * eps`` for the
 product ``C E``) times the size of the balanced data: round-off stays well below them."""
 
+AMPLIFICATION_LIMIT = 1e6
+"""Above this, the report says that any UIO of the plant amplifies round-off: ``H`` with
+``H C E = E`` has ``||H|| ||C|| >= ||E|| ||C|| / ||C E||``-sized entries (a small ``C E``)."""
+
 ZERO_MARGIN = 1e-6
 """A zero or fixed mode closer than this (relative to ``max(1, ||A||)`` in balanced units) to
 the stability boundary is reported as marginal: round-off of the data could move it across."""
@@ -584,6 +588,41 @@ def detectability_conditions(
     return [det, obs], fixed, movable
 
 
+def conditioning_condition(bal: Plant) -> Condition:
+    """How much any UIO of the (balanced) plant amplifies round-off (information).
+
+    Every UIO has ``H`` with ``H C E = E`` and ``T = I - H C``; the smallest such ``H`` is
+    ``E (C E)^+``, so the decoupling multiplies the data's round-off by at least
+    ``||E|| ||C|| / sigma_min(C E)`` (in balanced units). Above ``AMPLIFICATION_LIMIT`` the UIO
+    exists but is ill-conditioned: its matrices hold their identities only to that many
+    rounding errors, and a design's check says how much the result leaks.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.check_existence(ut.examples.pa9())["well-conditioned decoupling"].holds
+    True
+    """
+    E, C = bal.E, bal.C
+    G = np.hstack([C @ E, bal.D])
+    s = np.linalg.svd(G, compute_uv=False) if G.size else np.zeros(0)
+    rG = rank_decision(
+        G, scale=max(float(np.linalg.norm(C, 2) * np.linalg.norm(E, 2)), 1e-300)
+    ).rank
+    smin = float(s[rG - 1]) if rG else 0.0
+    top = float(np.linalg.norm(E, 2) * np.linalg.norm(C, 2)) if E.size and C.size else 0.0
+    amp = top / smin if smin > 0 else np.inf
+    ok = bool(amp <= AMPLIFICATION_LIMIT)
+    if ok:
+        reason = f"any UIO amplifies round-off by about {amp:.2g} at most"
+    else:
+        reason = (
+            f"a UIO exists only ill-conditioned: C E is {1 / amp:.2g} of ||C|| ||E||, so H "
+            f"(H C E = E) is large and any realization amplifies round-off by about {amp:.2g}"
+        )
+    return Condition("well-conditioned decoupling", ok, reason, required=False)
+
+
 def check_existence(plant: Plant) -> ExistenceReport:
     """Check the conditions under which an unknown input observer exists.
 
@@ -652,6 +691,8 @@ def check_existence(plant: Plant) -> ExistenceReport:
         pair = _pair_name(plant)
         conds.append(Condition(f"detectable {pair}", None, why))
         conds.append(Condition(f"observable {pair}", None, why, required=False))
+    if rank_cond.holds and plant.q:
+        conds.append(conditioning_condition(bal))
     if plant.q:
         full = rE == plant.q
         reason = (

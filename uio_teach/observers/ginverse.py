@@ -68,6 +68,12 @@ class GInverseObserver(Observer):
         self._leak = None
 
     @property
+    def leak(self):
+        """How much of the unknown input can reach the estimation error, judged on the returned
+        matrices (:func:`uio_teach.verify.decoupling_leak`); set by the design."""
+        return self._leak
+
+    @property
     def Cg(self) -> np.ndarray:
         """``C^g``, the Moore-Penrose inverse of ``C``."""
         return self._Cg
