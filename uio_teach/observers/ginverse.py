@@ -162,15 +162,16 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
     if fixed is not None and len(fixed) <= len(poles):
         check_fixed_modes(poles, fixed, what="the g-inverse observer")
     # from first principles: the observer state tracks (I - K C) x, xhat = Pc w + Dy y
-    theta = np.eye(pl.n) - K @ pl.C
+    real = obs.realization()
     obs._leak = check_decoupling(
         pl.A,
         pl.E,
         pl.C,
-        theta,
-        obs.F,
-        obs.G,
-        Pc,
+        real.A,
+        real.B_y,
+        real.C,
+        real.D_y,
+        K,
         discrete=pl.is_discrete,
         what="the g-inverse observer",
         stacklevel=4,

@@ -99,16 +99,25 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
         check_fixed_modes(obs.poles(), fixed, what=what)
     # from first principles, on the matrices returned: the unknown input's path to the error
     H, K = obs._H, obs._K1 + obs._K2
-    amp = float(np.linalg.norm(obs._F, 2) * np.linalg.norm(H, 2))
-    cause = f"||F|| ||H|| = {amp:.2g}: a C E small next to E makes H large" if amp > 1e6 else ""
+    nH, nC, nK = (float(np.linalg.norm(X, 2)) for X in (H, pl.C, obs._K1))
+    nA = float(np.linalg.norm(pl.A, 2))
+    if nH * nC > 1e6:
+        cause = f"||H|| ||C|| = {nH * nC:.2g}: a C E small next to E makes H large"
+    elif nK * nC > 1e6 * max(nA, 1e-300):
+        cause = (
+            f"||K1|| ||C|| = {nK * nC:.2g} against ||A|| = {nA:.2g}: the placement needs a "
+            "large gain (many states per output, poles close together or far from the plant's)"
+        )
+    else:
+        cause = ""
     obs._leak = check_decoupling(
         pl.A,
         pl.E,
         pl.C,
-        obs._T,
         obs._F,
         K,
         np.eye(pl.n),
+        H,
         discrete=pl.is_discrete,
         what=what,
         cause=cause,
