@@ -16,6 +16,7 @@ from .linalg import (
     checked_zeros,
     is_stable,
     left_null,
+    one_blas_thread,
     pinv,
     rank_decision,
     sort_poles,
@@ -310,7 +311,9 @@ ZERO_MARGIN = 1e-6
 the stability boundary is reported as marginal: round-off of the data could move it across."""
 
 
-def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
+def boundary_note(
+    values: np.ndarray, discrete: bool, size: float, radius: np.ndarray | None = None
+) -> str:
     """A note for values within the numerical margin of the stability boundary.
 
     Parameters
@@ -322,6 +325,9 @@ def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
     size : float
         The size of the plant's balanced ``A``; the margin is
         ``ZERO_MARGIN * max(1, size)``.
+    radius : array_like, optional
+        For each value, how far round-off of the data can move it
+        (:class:`uio_teach.linalg.ZeroSet`); the margin is then ``MARGIN`` times that.
 
     Returns
     -------
@@ -338,7 +344,10 @@ def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
         return ""
     values = np.asarray(values, complex)
     dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
-    close = dist <= ZERO_MARGIN * max(1.0, float(size))
+    if radius is not None and len(radius) == len(values):
+        close = dist <= MARGIN * np.asarray(radius, float)
+    else:
+        close = dist <= ZERO_MARGIN * max(1.0, float(size))
     if not np.any(close):
         return ""
     where = "unit circle" if discrete else "imaginary axis"
@@ -455,7 +464,7 @@ def zero_condition(
     if not len(zeros):
         return Condition("invariant zeros stable", True, "no invariant zeros")
     bad = zeros[~is_stable(zeros, discrete)]
-    note = boundary_note(zeros, discrete, size)
+    note = boundary_note(zeros, discrete, size, radius)
     listed = format_poles(zeros if not len(bad) else bad, braces=True, empty="none")
     if not len(bad):
         return Condition(
@@ -520,7 +529,11 @@ def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
 
 
 def detectability_conditions(
-    plant: Plant, dec: Decoupling, zeros: np.ndarray, size: float
+    plant: Plant,
+    dec: Decoupling,
+    zeros: np.ndarray,
+    size: float,
+    zero_cond: Condition | None = None,
 ) -> tuple[list[Condition], np.ndarray, int]:
     """Detectability and observability of the pair the designs use (rank condition holds).
 
@@ -544,7 +557,8 @@ def detectability_conditions(
         # in exact arithmetic the fixed modes are the invariant zeros; the zeros are computed
         # with every decision checked (uio_teach.linalg.checked_zeros), the staircase is not
         found = format_poles(fixed, braces=True, empty="none")
-        zero_cond = zero_condition(zeros, discrete, size)
+        if zero_cond is None:
+            zero_cond = zero_condition(zeros, discrete, size)
         listed_zeros = format_poles(zeros, braces=True, empty="none")
         why = (
             f"the fixed modes are the invariant zeros {listed_zeros}"
@@ -623,6 +637,7 @@ def conditioning_condition(bal: Plant) -> Condition:
     return Condition("well-conditioned decoupling", ok, reason, required=False)
 
 
+@one_blas_thread()
 def check_existence(plant: Plant) -> ExistenceReport:
     """Check the conditions under which an unknown input observer exists.
 
@@ -683,7 +698,7 @@ def check_existence(plant: Plant) -> ExistenceReport:
     movable = 0
     if rank_cond.holds:
         more, fixed, movable = detectability_conditions(
-            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size
+            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size, conds[-1]
         )
         conds.extend(more)
     else:

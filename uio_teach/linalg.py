@@ -33,7 +33,9 @@ invariant zeros, the fixed modes) is made by one rule:
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -56,6 +58,7 @@ __all__ = [
     "is_stable",
     "ObservabilitySplit",
     "sort_poles",
+    "one_blas_thread",
 ]
 
 
@@ -762,3 +765,37 @@ def checked_zeros(
     zeros = sort_poles(zc)
     near = [int(np.argmin(np.abs(zc - z))) for z in zeros]
     return ZeroSet(zeros, sort_poles(cand[doubtful]), rho[doubtful], tau, rc[near])
+
+
+_BLAS: Any = None
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Limit BLAS to one thread while the block (or decorated function) runs.
+
+    The designs' linear algebra works on matrices of at most a few hundred rows, in loops:
+    OpenBLAS's worker threads then cost more than they give, many times more when another
+    process keeps the other core busy. Uses threadpoolctl (built once; a no-op without it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import one_blas_thread
+    >>> with one_blas_thread():
+    ...     float(np.linalg.norm(np.eye(3)))
+    1.7320508075688772
+    """
+    global _BLAS
+    if _BLAS is None:
+        try:
+            from threadpoolctl import ThreadpoolController  # deferred: only when a design runs
+        except ImportError:  # pragma: no cover - threadpoolctl is optional
+            _BLAS = False
+        else:
+            _BLAS = ThreadpoolController()
+    if _BLAS is False:  # pragma: no cover
+        yield
+        return
+    with _BLAS.limit(limits=1, user_api="blas"):
+        yield

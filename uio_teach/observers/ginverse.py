@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_matrix, read_only
-from ..linalg import pinv, rank, sort_poles
+from ..linalg import one_blas_thread, pinv, rank, sort_poles
 from ..plant import Plant, check_plant
 from ..verify import check_decoupling, check_fixed_modes, check_identity, product_bound
 from .base import Observer, ObserverRealization
@@ -178,6 +178,7 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
     )
 
 
+@one_blas_thread()
 def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     """Design the generalized-matrix-inverse full-order observer (missile paper, eqs. (20)-(23)).
 

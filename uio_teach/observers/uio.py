@@ -8,6 +8,7 @@ import numpy as np
 
 from .._validation import read_only
 from ..existence import decoupling
+from ..linalg import one_blas_thread
 from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
 from ..verify import check_poles
@@ -67,6 +68,7 @@ class UIO(ProjectionObserver):
         return self._F
 
 
+@one_blas_thread()
 def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     """Design the unknown-input decoupling observer of Practical Assignment 9.
 
