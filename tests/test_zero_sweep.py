@@ -26,6 +26,7 @@ sweep and prints the table by family.
 from __future__ import annotations
 
 import argparse
+import json
 import warnings
 from collections import Counter, defaultdict
 from fractions import Fraction
@@ -248,7 +249,10 @@ def run_case(
     return out
 
 
-def sweep(cases: int, lmi_every: int = 10, verbose: bool = False) -> tuple[dict, list]:
+def sweep(
+    cases: int, lmi_every: int = 25, verbose: bool = False, part: tuple[int, int] = (0, 1)
+) -> tuple[dict, list]:
+    """Run ``cases`` plants (every ``part[1]``-th from ``part[0]``: one of several processes)."""
     table: dict = defaultdict(Counter)
     bad = []
     i = 0
@@ -257,6 +261,9 @@ def sweep(cases: int, lmi_every: int = 10, verbose: bool = False) -> tuple[dict,
             for coordinates in COORDINATES:
                 if i >= cases:
                     break
+                if i % part[1] != part[0]:
+                    i += 1
+                    continue
                 res = run_case(family, coordinates, i, lmi=(i % lmi_every == 0), verbose=verbose)
                 row = table[family]
                 row["cases"] += 1
@@ -322,8 +329,23 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=210)
     parser.add_argument("--verbose", action="store_true", help="print why designs were refused")
+    parser.add_argument("--part", type=int, nargs=2, default=(0, 1), metavar=("I", "OF"))
+    parser.add_argument("--merge", nargs="*", help="JSON tables of parts to add up and print")
     args = parser.parse_args()
-    table, bad = sweep(args.cases, verbose=args.verbose)
+    if args.merge:
+        table = defaultdict(Counter)
+        for path in args.merge:
+            with open(path, encoding="utf-8") as fh:
+                for family, row in json.load(fh).items():
+                    for key, value in row.items():
+                        if key == "max leak":
+                            table[family][key] = max(table[family][key], value)
+                        else:
+                            table[family][key] += value
+        _print(table)
+        raise SystemExit(0)
+    table, bad = sweep(args.cases, verbose=args.verbose, part=tuple(args.part))
+    print("JSON", json.dumps({k: dict(v) for k, v in table.items()}))
     _print(table)
     for b in bad:
         print("BAD", b)

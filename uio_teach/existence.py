@@ -327,7 +327,8 @@ def boundary_note(
         ``ZERO_MARGIN * max(1, size)``.
     radius : array_like, optional
         For each value, how far round-off of the data can move it
-        (:class:`uio_teach.linalg.ZeroSet`); the margin is then ``MARGIN`` times that.
+        (:class:`uio_teach.linalg.ZeroSet`): a value farther from the boundary than ``MARGIN``
+        times that (plus ``ZERO_MARGIN`` of its own size) gets no note.
 
     Returns
     -------
@@ -344,10 +345,12 @@ def boundary_note(
         return ""
     values = np.asarray(values, complex)
     dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
+    close = dist <= ZERO_MARGIN * max(1.0, float(size))
     if radius is not None and len(radius) == len(values):
-        close = dist <= MARGIN * np.asarray(radius, float)
-    else:
-        close = dist <= ZERO_MARGIN * max(1.0, float(size))
+        # a zero far from the boundary compared with how far round-off can move it is clear
+        close &= dist <= MARGIN * np.asarray(radius, float) + ZERO_MARGIN * np.maximum(
+            1.0, np.abs(values)
+        )
     if not np.any(close):
         return ""
     where = "unit circle" if discrete else "imaginary axis"

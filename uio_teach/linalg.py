@@ -623,13 +623,21 @@ def _scaled_system(A, B, C, D):
 
 
 def _rosenbrock_residual(A, B, C, D, size, z) -> float:
-    """Smallest singular value of ``[[z I - A, -B], [C, D]]`` relative to its size."""
+    """Smallest singular value of ``[[z I - A, -B], [C, D]]`` relative to its size.
+
+    For ``|z|`` beyond the system's size the state columns are divided by ``|z| / size`` (the
+    pencil in homogeneous form): without it every Rosenbrock matrix at a large ``z`` is nearly
+    singular (its smallest singular value falls like ``1 / |z|^2``), a zero or not.
+    """
     n = A.shape[0]
-    R = np.block([[z * np.eye(n) - A, -B], [C.astype(complex), D.astype(complex)]])
+    alpha = size / max(abs(z), size)
+    R = np.block(
+        [[(z * np.eye(n) - A) * alpha, -B], [(C * alpha).astype(complex), D.astype(complex)]]
+    )
     if not np.all(np.isfinite(R)):
         return 0.0
     s = np.linalg.svd(R, compute_uv=False)
-    return float(s[-1]) / max(abs(z), size)
+    return float(s[-1]) / size
 
 
 def _zero_condition(A, B, C, D, W, z) -> float:
@@ -738,9 +746,9 @@ def checked_zeros(
     probe = size * (rng.standard_normal(2) + 1j * rng.standard_normal(2))
     if min(_rosenbrock_residual(A, B, C, D, size, s) for s in probe) <= tau * ZERO_DOUBT:
         return ZeroSet(staircase, empty, np.zeros(0), tau)
-    # beyond |z| ~ size / sqrt(tau): any value's Rosenbrock matrix is singular to round-off
-    # (its smallest singular value falls like size^2 / |z|^2), so no test tells a zero from none
-    resolve = size / np.sqrt(tau * ZERO_DOUBT)
+    # beyond |z| ~ size / tau the homogeneous pencil's state columns are round-off: no test tells
+    # a zero from an infinite one
+    resolve = size / (tau * ZERO_DOUBT)
     limit = size / eps
 
     def square_down() -> tuple[np.ndarray, np.ndarray]:
