@@ -250,7 +250,7 @@ def run_case(
 
 
 def sweep(
-    cases: int, lmi_every: int = 25, verbose: bool = False, part: tuple[int, int] = (0, 1)
+    cases: int, lmi_every: int = 50, verbose: bool = False, part: tuple[int, int] = (0, 1)
 ) -> tuple[dict, list]:
     """Run ``cases`` plants (every ``part[1]``-th from ``part[0]``: one of several processes)."""
     table: dict = defaultdict(Counter)

@@ -648,7 +648,15 @@ def _zero_condition(A, B, C, D, W, z) -> float:
     ``kappa * ||delta||``.
     """
     n = A.shape[0]
-    R = np.block([[z * np.eye(n) - A, -B], [(W @ C).astype(complex), (W @ D).astype(complex)]])
+    # in homogeneous form, as in _rosenbrock_residual: the state columns scaled by alpha
+    size = max(1.0, float(np.linalg.norm(np.block([[A, B], [W @ C, W @ D]]), 2)))
+    alpha = size / max(abs(z), size)
+    R = np.block(
+        [
+            [(z * np.eye(n) - A) * alpha, -B],
+            [(W @ C * alpha).astype(complex), (W @ D).astype(complex)],
+        ]
+    )
     if not np.all(np.isfinite(R)):
         return np.inf
     U, _, Vh = np.linalg.svd(R)
