@@ -70,7 +70,7 @@ class GInverseObserver(Observer):
     @property
     def leak(self):
         """How much of the unknown input can reach the estimation error, judged on the returned
-        matrices (:func:`uio_teach.verify.decoupling_leak`); set by the design."""
+        matrices (``uio_teach.verify.decoupling_leak``); set by the design."""
         return self._leak
 
     @property

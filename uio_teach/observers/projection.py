@@ -61,7 +61,7 @@ class ProjectionObserver(Observer):
     @property
     def leak(self) -> DecouplingLeak | None:
         """How much of the unknown input can reach the estimation error, judged on the returned
-        matrices (:func:`uio_teach.verify.decoupling_leak`); set by the design."""
+        matrices (``uio_teach.verify.decoupling_leak``); set by the design."""
         return self._leak
 
     def realization(self) -> ObserverRealization:
