@@ -14,10 +14,11 @@ Judged:
   precision"; never a confident wrong verdict;
 * every returned design on its own matrices, in exact rational arithmetic: the residuals of the
   observer's defining identities (``theta A - F theta - K C``, ``theta E`` and
-  ``I - Dy C - Co theta``, with ``theta = I - Dy C`` for the UIO and the PMO) are formed with
-  :class:`fractions.Fraction` from the returned floating-point matrices, and the unknown input's
-  gain to the estimation error follows from them. A design returned without a warning leaks less
-  than ``LEAK_RTOL`` of the state's response, a warned one less than ``LEAK_REFUSE``.
+  ``I - Dy C - Co theta``, with ``theta = I - Dy C`` for the UIO and the PMO) are formed in
+  exact rational (dyadic integer) arithmetic from the returned floating-point matrices, and the
+  unknown input's gain to the estimation error follows from them. A design returned without a
+  warning leaks less than ``LEAK_RTOL`` of the state's response, a warned one less than
+  ``LEAK_REFUSE``.
 
 A quick sample runs in the suite; ``python tests/test_zero_sweep.py --cases 2000`` runs the
 sweep and prints the table by family.
@@ -29,11 +30,9 @@ import argparse
 import json
 import warnings
 from collections import Counter, defaultdict
-from fractions import Fraction
 
 import numpy as np
 import pytest
-import scipy.linalg as sla
 
 import uio_teach as ut
 from uio_teach.verify import LEAK_REFUSE, LEAK_RTOL, DecouplingWarning, PlacementAccuracyError
@@ -119,28 +118,63 @@ def build(family: str, coordinates: str, seed: int) -> tuple[ut.Plant, np.ndarra
 
 
 # exact judgement ------------------------------------------------------------------------------
-def _fr(M: np.ndarray) -> list[list[Fraction]]:
-    return [[Fraction(float(x)) for x in row] for row in np.atleast_2d(M)]
+class _Exact:
+    """A matrix of floats held exactly as Python integers times ``2**-shift``.
+
+    Every double is a dyadic rational, so sums and products of such matrices are exact in integer
+    arithmetic (the rational arithmetic of :class:`fractions.Fraction`, with the common
+    denominator kept as one power of 2).
+    """
+
+    def __init__(self, ints: np.ndarray, shift: int) -> None:
+        self.ints, self.shift = ints, shift
+
+    @classmethod
+    def of(cls, M: np.ndarray) -> _Exact:
+        M = np.atleast_2d(np.asarray(M, float))
+        ratios = [x.as_integer_ratio() for x in M.ravel().tolist()]
+        shift = max((d.bit_length() - 1 for _, d in ratios), default=0)
+        ints = np.array([n << (shift - (d.bit_length() - 1)) for n, d in ratios], dtype=object)
+        return cls(ints.reshape(M.shape), shift)
+
+    @classmethod
+    def eye(cls, n: int) -> _Exact:
+        return cls(np.array(np.eye(n, dtype=int), dtype=object), 0)
+
+    def _at(self, shift: int) -> np.ndarray:
+        return self.ints * (1 << (shift - self.shift))
+
+    def __matmul__(self, other: _Exact) -> _Exact:
+        return _Exact(np.dot(self.ints, other.ints), self.shift + other.shift)
+
+    def __sub__(self, other: _Exact) -> _Exact:
+        shift = max(self.shift, other.shift)
+        return _Exact(self._at(shift) - other._at(shift), shift)
+
+    def to_float(self) -> np.ndarray:
+        den = 1 << self.shift
+        # int / int is correctly rounded in Python, however large the integers
+        return np.array([int(x) / den for x in self.ints.ravel()], float).reshape(self.ints.shape)
 
 
-def _mul(X, Y):
-    Yt = list(zip(*Y, strict=True))
-    return [
-        [sum((a * b for a, b in zip(row, col, strict=True)), Fraction(0)) for col in Yt]
-        for row in X
-    ]
+def _fr(M: np.ndarray) -> _Exact:
+    return _Exact.of(M)
 
 
-def _sub(X, Y):
-    return [[a - b for a, b in zip(r, s, strict=True)] for r, s in zip(X, Y, strict=True)]
+def _mul(X: _Exact, Y: _Exact) -> _Exact:
+    return X @ Y
 
 
-def _eye(n):
-    return [[Fraction(int(i == j)) for j in range(n)] for i in range(n)]
+def _sub(X: _Exact, Y: _Exact) -> _Exact:
+    return X - Y
 
 
-def _float(X) -> np.ndarray:
-    return np.array([[float(a) for a in row] for row in X], dtype=float)
+def _eye(n: int) -> _Exact:
+    return _Exact.eye(n)
+
+
+def _float(X: _Exact) -> np.ndarray:
+    return X.to_float()
 
 
 def exact_leak(plant: ut.Plant, obs) -> float:
@@ -170,10 +204,8 @@ def exact_leak(plant: ut.Plant, obs) -> float:
     for w in np.unique(ws):
         s = 1j * w
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", sla.LinAlgWarning)
-                X = sla.solve(s * np.eye(n) - Af, Ef)
-                Y = sla.solve(s * np.eye(Ff.shape[0]) - Ff, R @ X + R1)
+            X = np.linalg.solve(s * np.eye(n) - Af, Ef)
+            Y = np.linalg.solve(s * np.eye(Ff.shape[0]) - Ff, R @ X + R1)
         except (np.linalg.LinAlgError, ValueError):
             continue
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(Y))):
@@ -213,6 +245,7 @@ def _poles(report: ut.ExistenceReport) -> np.ndarray:
     return poles
 
 
+@ut.linalg.one_blas_thread()
 def run_case(
     family: str, coordinates: str, seed: int, lmi: bool = False, verbose: bool = False
 ) -> dict:
@@ -281,6 +314,8 @@ def sweep(
                         bad.append((family, coordinates, i, name, leak))
                 if res["verdict"] == "WRONG":
                     bad.append((family, coordinates, i, "verdict", None))
+                if verbose:
+                    print("CASE", json.dumps([family, coordinates, i, res]), flush=True)
                 i += 1
     return table, bad
 
