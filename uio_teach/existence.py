@@ -703,6 +703,18 @@ def check_existence(plant: Plant) -> ExistenceReport:
         more, fixed, movable = detectability_conditions(
             plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size, conds[-1]
         )
+        det = more[0]
+        if conds[-1].undecided and not det.undecided:
+            # in exact arithmetic the fixed modes are the invariant zeros: detectability is no
+            # more certain than the zeros' stability
+            more[0] = Condition(
+                det.name,
+                None,
+                "cannot be decided at this precision: it is the stability of the invariant "
+                f"zeros, which round-off decides ({det.reason})",
+                margin=det.margin,
+                undecided=True,
+            )
         conds.extend(more)
     else:
         why = "not evaluated: the rank condition fails"
