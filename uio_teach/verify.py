@@ -438,7 +438,10 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
         points = 1j * np.unique(np.concatenate([[0.0], grid, res[res > 0]]))
     leak = bound = gain = 0.0
     eye = np.eye(n)
+    lam_f = lam[np.isfinite(lam)]
     for z in points:
+        if np.any(np.abs(lam_f - z) <= 1e-6 * max(1.0, abs(z))):
+            continue  # on a pole of the plant or the observer (an undamped mode): no gain there
         try:
             X = np.linalg.solve(z * eye - A, E)
             Y = Co @ np.linalg.inv(z * np.eye(F.shape[0]) - F)
