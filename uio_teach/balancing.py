@@ -367,7 +367,39 @@ def balanced_pair(
             if modes_agree(other.unobservable_modes * sigma, zeros):
                 split = other._replace(margin=min(other.margin, 1.0))  # flagged: marginal
                 break
+        else:
+            split = _split_from_modes(Ab, Cn, np.asarray(zeros, complex) / sigma) or split
     return BalancedPair(A=Ab, C=Cn, t=t, R=R, sigma=sigma, split=split)
+
+
+def _split_from_modes(A: np.ndarray, C: np.ndarray, modes: np.ndarray):
+    """The observability split whose unobservable modes are ``modes`` (distinct), or None.
+
+    The unobservable subspace is spanned by the vectors ``v`` with ``(A - z I) v = 0`` and
+    ``C v = 0`` for each mode ``z``: the smallest right singular vector of ``[z I - A; C]``
+    (real and imaginary parts for a complex pair). Used when the staircase's rank decisions miss
+    modes that the invariant zeros, computed with every decision checked, show.
+    """
+    n = A.shape[0]
+    if not len(modes):
+        return None
+    vecs = []
+    for z in modes:
+        if z.imag < 0:
+            continue  # its conjugate gives the same real plane
+        M = np.vstack([z * np.eye(n) - A, C.astype(complex)])
+        v = np.linalg.svd(M)[2][-1].conj()
+        vecs.extend([v.real, v.imag] if z.imag > 0 else [v.real])
+    V = np.array(vecs).T
+    U, sv, _ = np.linalg.svd(V, full_matrices=True)
+    k = len(modes)
+    if V.shape[1] != k or sv.size < k or sv[k - 1] <= 1e-8 * sv[0]:
+        return None  # repeated modes: their vectors do not span the subspace
+    Vu, Vo = U[:, :k], U[:, k:]
+    split = ObservabilitySplit(
+        Vo=Vo, Vu=Vu, Ao=Vo.T @ A @ Vo, Co=C @ Vo, Au=Vu.T @ A @ Vu, margin=1.0
+    )
+    return split if modes_agree(split.unobservable_modes, modes, rtol=1e-6) else None
 
 
 def modes_agree(modes: np.ndarray, zeros: np.ndarray, rtol: float = 1e-5) -> bool:

@@ -13,9 +13,10 @@ from .linalg import (
     DROP_MARGIN,
     MARGIN,
     ObservabilitySplit,
-    invariant_zeros,
+    checked_zeros,
     is_stable,
     left_null,
+    one_blas_thread,
     pinv,
     rank_decision,
     sort_poles,
@@ -62,6 +63,9 @@ class Condition:
     rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
     threshold, that ratio (threshold / dropped value); below ``uio_teach.linalg.MARGIN`` the
     verdict hangs on round-off and the reason says so. A rank-0 verdict carries it too."""
+    undecided: bool = False
+    """True when the verdict cannot be decided at this precision (``holds`` is then ``None``
+    and the reason says why)."""
 
     @property
     def marginal(self) -> bool:
@@ -73,6 +77,8 @@ class Condition:
         """The verdict in one character; ✓, ✗, – (not evaluated) or ○ (info, not met)."""
         if not self.required and self.holds is False:
             return "○"
+        if self.undecided:
+            return "?"
         return {True: "✓", False: "✗", None: "–"}[self.holds]
 
 
@@ -226,9 +232,23 @@ class ExistenceReport:
         return all(c.holds for c in self.conditions if c.required)
 
     @property
+    def decided(self) -> bool:
+        """False when a required condition cannot be decided at this precision."""
+        return not any(c.undecided for c in self.conditions if c.required)
+
+    @property
+    def verdict(self) -> str:
+        """The conclusion in words."""
+        if self.ok:
+            return "a UIO exists"
+        if not self.decided and not any(c.holds is False for c in self.conditions if c.required):
+            return "cannot be decided at this precision"
+        return "no UIO with stable error dynamics exists"
+
+    @property
     def failed(self) -> tuple[Condition, ...]:
-        """The required conditions that do not hold."""
-        return tuple(c for c in self.conditions if c.required and c.holds is False)
+        """The required conditions that do not hold or cannot be decided."""
+        return tuple(c for c in self.conditions if c.required and (c.holds is False or c.undecided))
 
     def __getitem__(self, name: str) -> Condition:
         for c in self.conditions:
@@ -248,8 +268,7 @@ class ExistenceReport:
             text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
             # wrap long reasons under their column so the table fits the book's column
             lines.append(fit_lines(text, indent=indent))
-        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
-        lines.append(f"  => {verdict}")
+        lines.append(f"  => {self.verdict}")
         return "\n".join(lines)
 
     __repr__ = __str__
@@ -260,7 +279,7 @@ class ExistenceReport:
             f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
             for c in self.conditions
         )
-        verdict = "a UIO exists" if self.ok else "no UIO with stable error dynamics exists"
+        verdict = self.verdict
         return (
             f"<div><b>Existence of an unknown input observer</b> for "
             f"{html.escape(repr(self.plant))}<table>"
@@ -283,12 +302,18 @@ RANK_RTOL = 100.0
 """The rank condition's thresholds are ``RANK_RTOL * eps`` (``RANK_RTOL * n * eps`` for the
 product ``C E``) times the size of the balanced data: round-off stays well below them."""
 
+AMPLIFICATION_LIMIT = 1e6
+"""Above this, the report says that any UIO of the plant amplifies round-off: ``H`` with
+``H C E = E`` has ``||H|| ||C|| >= ||E|| ||C|| / ||C E||``-sized entries (a small ``C E``)."""
+
 ZERO_MARGIN = 1e-6
 """A zero or fixed mode closer than this (relative to ``max(1, ||A||)`` in balanced units) to
 the stability boundary is reported as marginal: round-off of the data could move it across."""
 
 
-def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
+def boundary_note(
+    values: np.ndarray, discrete: bool, size: float, radius: np.ndarray | None = None
+) -> str:
     """A note for values within the numerical margin of the stability boundary.
 
     Parameters
@@ -300,6 +325,10 @@ def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
     size : float
         The size of the plant's balanced ``A``; the margin is
         ``ZERO_MARGIN * max(1, size)``.
+    radius : array_like, optional
+        For each value, how far round-off of the data can move it
+        (:class:`uio_teach.linalg.ZeroSet`): a value farther from the boundary than ``MARGIN``
+        times that (plus ``ZERO_MARGIN`` of its own size) gets no note.
 
     Returns
     -------
@@ -317,6 +346,11 @@ def boundary_note(values: np.ndarray, discrete: bool, size: float) -> str:
     values = np.asarray(values, complex)
     dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
     close = dist <= ZERO_MARGIN * max(1.0, float(size))
+    if radius is not None and len(radius) == len(values):
+        # a zero far from the boundary compared with how far round-off can move it is clear
+        close &= dist <= MARGIN * np.asarray(radius, float) + ZERO_MARGIN * np.maximum(
+            1.0, np.abs(values)
+        )
     if not np.any(close):
         return ""
     where = "unit circle" if discrete else "imaginary axis"
@@ -402,8 +436,21 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     return cond, rE
 
 
-def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
+def zero_condition(
+    zeros: np.ndarray,
+    discrete: bool,
+    size: float,
+    doubtful: np.ndarray | None = None,
+    residuals: np.ndarray | None = None,
+    radius: np.ndarray | None = None,
+) -> Condition:
     """The condition "invariant zeros stable" for the given zeros.
+
+    ``doubtful`` lists values that are zeros of plants within round-off of the data but not
+    certainly of this one (:class:`uio_teach.linalg.ZeroSet`), with ``residuals`` the
+    Rosenbrock matrix's smallest singular value there relative to the round-off threshold. When
+    such a value, or a zero within the numerical margin of the stability boundary, would change
+    the verdict, the condition is not decided (``holds=None``) and the reason says why.
 
     Examples
     --------
@@ -412,10 +459,15 @@ def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
     True
     """
     region = _region(discrete)
+    doubtful = np.zeros(0, complex) if doubtful is None else np.asarray(doubtful, complex)
+    zeros = np.asarray(zeros, complex)
+    undecided = _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius)
+    if undecided:
+        return Condition("invariant zeros stable", None, undecided, margin=1.0, undecided=True)
     if not len(zeros):
         return Condition("invariant zeros stable", True, "no invariant zeros")
     bad = zeros[~is_stable(zeros, discrete)]
-    note = boundary_note(zeros, discrete, size)
+    note = boundary_note(zeros, discrete, size, radius)
     listed = format_poles(zeros if not len(bad) else bad, braces=True, empty="none")
     if not len(bad):
         return Condition(
@@ -429,6 +481,46 @@ def zero_condition(zeros: np.ndarray, discrete: bool, size: float) -> Condition:
     )
 
 
+def _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius=None) -> str:
+    """Why the zero condition cannot be decided at this precision ('' when it can)."""
+    stable = is_stable(zeros, discrete)
+    dist = np.abs(np.abs(zeros) - 1.0) if discrete else np.abs(zeros.real)
+    if radius is not None and len(radius) == len(zeros):
+        # how far round-off of the data can move each zero (its condition number)
+        near = dist <= np.asarray(radius, float)
+    else:
+        near = dist <= ZERO_MARGIN * max(1.0, float(size))
+    if np.all(stable):
+        # the verdict "stable" would change with a doubtful unstable value or a zero on the edge
+        flip = doubtful[~is_stable(doubtful, discrete)] if doubtful.size else doubtful
+        edge = zeros[near]
+    else:
+        # "unstable" is certain when one unstable zero is certain and clear of the boundary
+        if np.any(~stable & ~near):
+            return ""
+        flip, edge = np.zeros(0, complex), zeros[~stable]
+    if not flip.size and not edge.size:
+        return ""
+    where = "unit circle" if discrete else "imaginary axis"
+    parts = []
+    if flip.size:
+        res = np.asarray(residuals if residuals is not None else [], float)
+        how = (
+            f" (singular to {float(np.min(res)):.2g} times the round-off threshold)"
+            if res.size
+            else ""
+        )
+        parts.append(
+            f"{format_poles(flip, braces=True)} outside {_region(discrete)} is an invariant zero "
+            f"of a plant within round-off of the data{how}, not certainly of this one"
+        )
+    if edge.size:
+        parts.append(
+            f"zero(s) {format_poles(edge, braces=True)} lie within round-off of the {where}"
+        )
+    return "cannot be decided at this precision: " + "; ".join(parts)
+
+
 def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
     """True when the fixed modes are the invariant zeros (same count, matched values)."""
     if len(fixed) != len(zeros):
@@ -440,7 +532,11 @@ def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
 
 
 def detectability_conditions(
-    plant: Plant, dec: Decoupling, zeros: np.ndarray, size: float
+    plant: Plant,
+    dec: Decoupling,
+    zeros: np.ndarray,
+    size: float,
+    zero_cond: Condition | None = None,
 ) -> tuple[list[Condition], np.ndarray, int]:
     """Detectability and observability of the pair the designs use (rank condition holds).
 
@@ -461,12 +557,26 @@ def detectability_conditions(
         margin, "a singular value of the observability staircase"
     )
     if not _agreeing_modes(fixed, zeros, dec.pair.sigma):
-        margin = min(margin, 1.0)
-        note += (
-            f" (within the numerical margin: the {len(fixed)} unobservable mode(s) and the "
-            f"{len(zeros)} invariant zero(s) should coincide but do not to round-off, so "
-            "this verdict hangs on round-off)"
+        # in exact arithmetic the fixed modes are the invariant zeros; the zeros are computed
+        # with every decision checked (uio_teach.linalg.checked_zeros), the staircase is not
+        found = format_poles(fixed, braces=True, empty="none")
+        if zero_cond is None:
+            zero_cond = zero_condition(zeros, discrete, size)
+        listed_zeros = format_poles(zeros, braces=True, empty="none")
+        why = (
+            f"the fixed modes are the invariant zeros {listed_zeros}"
+            f" (the observability staircase of {pair} finds {found}: its rank decisions do not "
+            "resolve them)"
         )
+        det = Condition(
+            f"detectable {pair}",
+            zero_cond.holds,
+            why,
+            margin=min(margin, 1.0),
+            undecided=zero_cond.undecided,
+        )
+        obs = Condition(f"observable {pair}", not len(zeros), why, required=False, margin=1.0)
+        return [det, obs], zeros, plant.n - len(zeros)
     listed = format_poles(fixed if not len(unstable) else unstable, braces=True, empty="none")
     if not len(unstable):
         reason = (
@@ -495,6 +605,42 @@ def detectability_conditions(
     return [det, obs], fixed, movable
 
 
+def conditioning_condition(bal: Plant) -> Condition:
+    """How much any UIO of the (balanced) plant amplifies round-off (information).
+
+    Every UIO has ``H`` with ``H C E = E`` and ``T = I - H C``; the smallest such ``H`` is
+    ``E (C E)^+``, so the decoupling multiplies the data's round-off by at least
+    ``||E|| ||C|| / sigma_min(C E)`` (in balanced units). Above ``AMPLIFICATION_LIMIT`` the UIO
+    exists but is ill-conditioned: its matrices hold their identities only to that many
+    rounding errors, and a design's check says how much the result leaks.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> ut.check_existence(ut.examples.pa9())["well-conditioned decoupling"].holds
+    True
+    """
+    E, C = bal.E, bal.C
+    G = np.hstack([C @ E, bal.D])
+    s = np.linalg.svd(G, compute_uv=False) if G.size else np.zeros(0)
+    rG = rank_decision(
+        G, scale=max(float(np.linalg.norm(C, 2) * np.linalg.norm(E, 2)), 1e-300)
+    ).rank
+    smin = float(s[rG - 1]) if rG else 0.0
+    top = float(np.linalg.norm(E, 2) * np.linalg.norm(C, 2)) if E.size and C.size else 0.0
+    amp = top / smin if smin > 0 else np.inf
+    ok = bool(amp <= AMPLIFICATION_LIMIT)
+    if ok:
+        reason = f"any UIO amplifies round-off by about {amp:.2g} at most"
+    else:
+        reason = (
+            f"a UIO exists only ill-conditioned: C E is {1 / amp:.2g} of ||C|| ||E||, so H "
+            f"(H C E = E) is large and any realization amplifies round-off by about {amp:.2g}"
+        )
+    return Condition("well-conditioned decoupling", ok, reason, required=False)
+
+
+@one_blas_thread()
 def check_existence(plant: Plant) -> ExistenceReport:
     """Check the conditions under which an unknown input observer exists.
 
@@ -546,20 +692,37 @@ def check_existence(plant: Plant) -> ExistenceReport:
     conds = [rank_cond]
     Bz = np.hstack([bal.E, np.zeros((plant.n, plant.nv))])
     Dz = np.hstack([np.zeros((plant.p, plant.q)), bal.D])
-    zeros = sort_poles(invariant_zeros(bal.A, Bz, bal.C, Dz) * sigma)
-    conds.append(zero_condition(zeros, discrete, size))
+    zs = checked_zeros(bal.A, Bz, bal.C, Dz)
+    zeros = sort_poles(zs.zeros * sigma)
+    conds.append(
+        zero_condition(zeros, discrete, size, zs.doubtful * sigma, zs.residuals, zs.radius * sigma)
+    )
     fixed = np.zeros(0, complex)
     movable = 0
     if rank_cond.holds:
         more, fixed, movable = detectability_conditions(
-            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size
+            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size, conds[-1]
         )
+        det = more[0]
+        if conds[-1].undecided and not det.undecided:
+            # in exact arithmetic the fixed modes are the invariant zeros: detectability is no
+            # more certain than the zeros' stability
+            more[0] = Condition(
+                det.name,
+                None,
+                "cannot be decided at this precision: it is the stability of the invariant "
+                f"zeros, which round-off decides ({det.reason})",
+                margin=det.margin,
+                undecided=True,
+            )
         conds.extend(more)
     else:
         why = "not evaluated: the rank condition fails"
         pair = _pair_name(plant)
         conds.append(Condition(f"detectable {pair}", None, why))
         conds.append(Condition(f"observable {pair}", None, why, required=False))
+    if rank_cond.holds and plant.q:
+        conds.append(conditioning_condition(bal))
     if plant.q:
         full = rE == plant.q
         reason = (

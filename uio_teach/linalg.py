@@ -33,7 +33,9 @@ invariant zeros, the fixed modes) is made by one rule:
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -49,9 +51,14 @@ __all__ = [
     "observability_matrix",
     "observability_decomposition",
     "invariant_zeros",
+    "checked_zeros",
+    "ZeroSet",
+    "ZERO_RTOL",
+    "ZERO_DOUBT",
     "is_stable",
     "ObservabilitySplit",
     "sort_poles",
+    "one_blas_thread",
 ]
 
 
@@ -548,3 +555,263 @@ def _reduce(A, B, C, D, scale):
         B = B1
         C = np.vstack([A21, Ct[:, :k]])
         D = np.vstack([B2, Dplus])
+
+
+ZERO_RTOL = 10.0
+"""A candidate ``z`` is an invariant zero when the smallest singular value of the scaled
+Rosenbrock matrix at ``z`` is at most ``ZERO_RTOL * (n + p) * eps`` of its size (the backward
+error of a double-precision computation); between that and ``ZERO_DOUBT`` times more it is a zero
+of a plant within round-off of the data, but not certainly of this one."""
+
+ZERO_DOUBT = 1e3
+"""How far above the zero threshold a candidate still counts as doubtful (see ``ZERO_RTOL``)."""
+
+
+class ZeroSet(NamedTuple):
+    """Invariant zeros with the evidence for each (:func:`checked_zeros`).
+
+    Attributes
+    ----------
+    zeros : numpy.ndarray of complex
+        The zeros: values at which the scaled Rosenbrock matrix is singular to round-off, found by
+        a random square-down of the outputs and confirmed on the full (non-square) matrix and by
+        the orthogonal staircase or a second square-down.
+    doubtful : numpy.ndarray of complex
+        Values at which the Rosenbrock matrix is singular to within ``ZERO_DOUBT`` times the
+        round-off threshold, or that one method finds and the other does not: zeros of plants
+        within round-off of the data, on which no verdict should rest.
+    residuals : numpy.ndarray of float
+        For each doubtful value, the smallest singular value of the scaled Rosenbrock matrix
+        divided by its threshold.
+    threshold : float
+        The relative singular value below which a value is a zero.
+    radius : numpy.ndarray of float
+        For each zero, how far round-off of the data (``threshold`` relative to the scaled
+        system) can move it, from its condition number ``||u|| ||v|| / |u_x^H v_x|`` (``u``,
+        ``v`` the left and right singular vectors of the Rosenbrock matrix at the zero).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import checked_zeros
+    >>> zs = checked_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]])
+    >>> zs.zeros, zs.doubtful.size
+    (array([-1.5+0.j]), 0)
+    """
+
+    zeros: np.ndarray
+    doubtful: np.ndarray
+    residuals: np.ndarray
+    threshold: float
+    radius: np.ndarray = np.zeros(0)
+
+
+def _scaled_system(A, B, C, D):
+    """Balance ``A`` (diagonal similarity) and scale ``B``, ``C`` to its size; zeros unchanged."""
+    n = A.shape[0]
+    if n:
+        _, (bal, _) = sla.matrix_balance(A, permute=False, separate=True)
+        A = A / bal[:, None] * bal[None, :]
+        B = B / bal[:, None]
+        C = C * bal[None, :]
+    alpha = max(float(np.linalg.norm(A, 2)), 1.0) if n else 1.0
+    nb = float(np.linalg.norm(B, 2)) if B.size else 0.0
+    nc = float(np.linalg.norm(C, 2)) if C.size else 0.0
+    beta = alpha / nb if nb > 0 else 1.0
+    gamma = alpha / nc if nc > 0 else 1.0
+    return A, B * beta, C * gamma, D * (beta * gamma)
+
+
+def _rosenbrock_residual(A, B, C, D, size, z) -> float:
+    """Smallest singular value of ``[[z I - A, -B], [C, D]]`` relative to its size.
+
+    For ``|z|`` beyond the system's size the state columns are divided by ``|z| / size`` (the
+    pencil in homogeneous form): without it every Rosenbrock matrix at a large ``z`` is nearly
+    singular (its smallest singular value falls like ``1 / |z|^2``), a zero or not.
+    """
+    n = A.shape[0]
+    alpha = size / max(abs(z), size)
+    R = np.block(
+        [[(z * np.eye(n) - A) * alpha, -B], [(C * alpha).astype(complex), D.astype(complex)]]
+    )
+    if not np.all(np.isfinite(R)):
+        return 0.0
+    s = np.linalg.svd(R, compute_uv=False)
+    return float(s[-1]) / size
+
+
+def _zero_condition(A, B, C, D, W, z) -> float:
+    """Condition number ``||u|| ||v|| / |u_x^H v_x|`` of ``z`` as a zero of the square-down ``W``.
+
+    ``u``, ``v``: left and right singular vectors of the smallest singular value of the square
+    Rosenbrock matrix; a perturbation ``delta`` of the pencil moves ``z`` by about
+    ``kappa * ||delta||``.
+    """
+    n = A.shape[0]
+    # in homogeneous form, as in _rosenbrock_residual: the state columns scaled by alpha
+    size = max(1.0, float(np.linalg.norm(np.block([[A, B], [W @ C, W @ D]]), 2)))
+    alpha = size / max(abs(z), size)
+    R = np.block(
+        [
+            [(z * np.eye(n) - A) * alpha, -B],
+            [(W @ C * alpha).astype(complex), (W @ D).astype(complex)],
+        ]
+    )
+    if not np.all(np.isfinite(R)):
+        return np.inf
+    U, _, Vh = np.linalg.svd(R)
+    k = abs(np.vdot(U[:n, -1], Vh[-1, :n].conj()))
+    return 1.0 / k if k > 0 else np.inf
+
+
+def _square_down_zeros(A, B, C, D, W, limit) -> np.ndarray:
+    """Finite generalized eigenvalues of the Rosenbrock pencil of ``(A, B, W C, W D)``."""
+    n, m = B.shape
+    M = np.block([[A, B], [W @ C, W @ D]])
+    N = np.zeros_like(M)
+    N[:n, :n] = np.eye(n)
+    with np.errstate(all="ignore"):
+        w = sla.eigvals(M, N)
+    return w[np.isfinite(w) & (np.abs(w) < limit)]
+
+
+def _match(values: np.ndarray, pool: np.ndarray, rtol: float, floor: float) -> np.ndarray:
+    """For each value, whether a distinct element of ``pool`` lies within ``rtol`` of it."""
+    pool = list(pool)
+    found = np.zeros(len(values), bool)
+    for i, z in enumerate(values):
+        if not pool:
+            break
+        d = [abs(z - x) / max(abs(z), floor) for x in pool]
+        j = int(np.argmin(d))
+        if d[j] <= rtol:
+            found[i] = True
+            pool.pop(j)
+    return found
+
+
+def checked_zeros(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray | None = None
+) -> ZeroSet:
+    """Invariant zeros of ``(A, B, C, D)`` with every decision checked, fast zeros included.
+
+    Two independent methods on a scaled system (``A`` balanced, ``||B|| = ||C|| = ||A||``, input
+    columns compressed to full rank): the orthogonal staircase of :func:`invariant_zeros`, and
+    the generalized eigenvalues of the square Rosenbrock pencils of random square-downs
+    ``(A, B, W C, W D)`` (every zero of the system is a zero of each square-down). Each candidate
+    ``z`` is then judged on the full Rosenbrock matrix: it is a zero when that matrix is
+    singular at ``z`` to round-off (its smallest singular value at most ``ZERO_RTOL (n + p) eps``
+    of its size) and a second square-down finds it too; a candidate within ``ZERO_DOUBT`` of that
+    threshold, or found by one method and refuted by the other, is listed as doubtful.
+
+    A zero a million times faster than the poles (a small ``C B`` next to ``B``) is found: the
+    pencil of a square-down is regular and well scaled, and the Rosenbrock matrix's singular
+    value is judged relative to ``|z|``.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        The system (``D`` zero when omitted).
+
+    Returns
+    -------
+    ZeroSet
+
+    Examples
+    --------
+    A zero at +1000 of a plant whose poles are near -1 (``C B`` small next to ``B``):
+
+    >>> import numpy as np
+    >>> from uio_teach.linalg import checked_zeros
+    >>> A = np.array([[-1.0, 0.0], [1.0, -2.0]]); B = np.array([[1.0], [-1.002]])
+    >>> zs = checked_zeros(A, B, [[1.0, 1.0]])
+    >>> zs.zeros.real.round(6), zs.doubtful.size
+    (array([999.]), 0)
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    n = A.shape[0]
+    B = np.asarray(B, float).reshape(n, -1)
+    C = np.asarray(C, float).reshape(-1, n)
+    p = C.shape[0]
+    D = np.zeros((p, B.shape[1])) if D is None else np.asarray(D, float).reshape(p, B.shape[1])
+    eps = np.finfo(float).eps
+    empty = np.zeros(0, complex)
+    staircase = invariant_zeros(A, B, C, D)
+    A, B, C, D = _scaled_system(A, B, C, D)
+    # independent input columns only (a repeated unknown input adds no zero)
+    BD = np.vstack([B, D])
+    if BD.size:
+        _, s, Vt = np.linalg.svd(BD, full_matrices=False)
+        r = int(np.sum(s > max(BD.shape) * eps * 100 * s[0])) if s.size and s[0] > 0 else 0
+        B, D = (BD @ Vt[:r].T)[:n], (BD @ Vt[:r].T)[n:]
+    m = B.shape[1]
+    size = max(1.0, float(np.linalg.norm(np.block([[A, B], [C, D]]), 2)))
+    tau = ZERO_RTOL * (n + p) * eps
+    if n == 0 or m == 0 or p < m:
+        return ZeroSet(staircase, empty, np.zeros(0), tau)
+    rng = np.random.default_rng(0)
+    # normal rank: a Rosenbrock matrix singular at random points has no isolated zeros
+    probe = size * (rng.standard_normal(2) + 1j * rng.standard_normal(2))
+    if min(_rosenbrock_residual(A, B, C, D, size, s) for s in probe) <= tau * ZERO_DOUBT:
+        return ZeroSet(staircase, empty, np.zeros(0), tau)
+    # beyond |z| ~ size / tau the homogeneous pencil's state columns are round-off: no test tells
+    # a zero from an infinite one
+    resolve = size / (tau * ZERO_DOUBT)
+    limit = size / eps
+
+    def square_down() -> tuple[np.ndarray, np.ndarray]:
+        W = np.linalg.qr(rng.standard_normal((p, m)))[0].T if p > m else np.eye(p)
+        return _square_down_zeros(A, B, C, D, W, limit), W
+
+    (first, W1), second = square_down(), (square_down()[0] if p > m else None)
+    # the staircase's zeros join the candidates when the square-down did not find them
+    extra = staircase[~_match(staircase, first, 1e-6, size * 1e-8)]
+    cand = np.concatenate([first, extra])
+    rho = np.array([_rosenbrock_residual(A, B, C, D, size, z) for z in cand]) / tau
+    # a zero of the system is a zero of every square-down
+    again = (
+        _match(cand, second, 1e-6, size * 1e-8) if second is not None else np.ones(len(cand), bool)
+    )
+    fast = np.abs(cand) > resolve
+    confirmed = (rho <= 1.0) & again & ~fast
+    doubtful = ~confirmed & (((rho <= ZERO_DOUBT) & ~fast) | (fast & again & (p > m)))
+    zc = cand[confirmed]
+    kappa = np.array([_zero_condition(A, B, C, D, W1, z) for z in zc])
+    rc = 10 * tau * np.maximum(np.abs(zc), size) * kappa
+    zeros = sort_poles(zc)
+    near = [int(np.argmin(np.abs(zc - z))) for z in zeros]
+    return ZeroSet(zeros, sort_poles(cand[doubtful]), rho[doubtful], tau, rc[near])
+
+
+_BLAS: Any = None
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Limit BLAS to one thread while the block (or decorated function) runs.
+
+    The designs' linear algebra works on matrices of at most a few hundred rows, in loops:
+    OpenBLAS's worker threads then cost more than they give, many times more when another
+    process keeps the other core busy. Uses threadpoolctl (built once; a no-op without it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.linalg import one_blas_thread
+    >>> with one_blas_thread():
+    ...     float(np.linalg.norm(np.eye(3)))
+    1.7320508075688772
+    """
+    global _BLAS
+    if _BLAS is None:
+        try:
+            from threadpoolctl import ThreadpoolController  # deferred: only when a design runs
+        except ImportError:  # pragma: no cover - threadpoolctl is optional
+            _BLAS = False
+        else:
+            _BLAS = ThreadpoolController()
+    if _BLAS is False:  # pragma: no cover
+        yield
+        return
+    with _BLAS.limit(limits=1, user_api="blas"):
+        yield

@@ -25,6 +25,7 @@ it obtained with what it promised:
 from __future__ import annotations
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -43,6 +44,13 @@ __all__ = [
     "relative_residual",
     "product_bound",
     "check_fixed_modes",
+    "LEAK_RTOL",
+    "LEAK_REFUSE",
+    "DecouplingLeak",
+    "DecouplingWarning",
+    "DecouplingError",
+    "decoupling_leak",
+    "check_decoupling",
 ]
 
 POLE_RTOL = 1e-6
@@ -326,3 +334,194 @@ def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
             f"{_fmt(nearest)}): the error would depend on the unknown input, so the observer "
             "is refused"
         )
+
+
+LEAK_RTOL = 1e-6
+"""A design is returned without a word when the unknown input's gain to the estimation error is
+certainly below ``LEAK_RTOL`` times its gain to the state (round-off of the check included)."""
+
+LEAK_REFUSE = 1e-3
+"""A design whose computed leak exceeds this fraction of the state's response is refused."""
+
+
+class DecouplingWarning(UserWarning):
+    """The design decouples only to a stated fraction: it amplifies round-off (a small ``C E``)."""
+
+
+class DecouplingError(PlacementAccuracyError):
+    """The returned matrices do not decouple the estimation error from the unknown input."""
+
+
+class DecouplingLeak(NamedTuple):
+    """How much of the unknown input reaches the estimation error (:func:`decoupling_leak`).
+
+    Attributes
+    ----------
+    leak : float
+        Largest gain of ``G_de`` over the largest gain of ``G_dx`` at the test points, from the
+        residuals of the stored matrices formed in extended precision.
+    bound : float
+        ``leak`` plus what the rounding of the residuals' computation can add: what the stored
+        matrices can leak at most.
+    amplification : float
+        ``bound / eps``: how many double-precision rounding errors of the data the realization
+        turns into a leak.
+    """
+
+    leak: float
+    bound: float
+    amplification: float
+
+
+def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> DecouplingLeak:
+    """The unknown input's path to an observer's estimation error, from first principles.
+
+    The observer ``w' = F w + K y + ...``, ``xhat = Co w + Dy y`` estimates ``theta x`` with
+    ``theta = I - M C`` (``M = Dy`` for the UIO and the PMO): with ``eps = theta x - w``,
+    ``eps' = F eps + R x + theta E d`` where ``R = theta A - F theta - K C``, and the estimation
+    error is ``R0 x + Co eps`` with ``R0 = I - Dy C - Co theta``. All three residuals are zero
+    for an observer that decouples. They are formed from the stored matrices in extended
+    precision (``numpy.longdouble``), so that the rounding of forming them sits well below the
+    double-precision rounding they measure, and their effect is evaluated at frequencies
+    ``s = j w`` spread over the plant's and the observer's and at each resonance (``z = e^jw``
+    in discrete time): ``G_de(s) = R0 G_dx(s) + Co (sI - F)^-1 (R G_dx(s) + theta E)`` against
+    ``G_dx(s) = (sI - A)^-1 E``, largest gain against largest gain.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import uio_teach as ut
+    >>> from uio_teach.verify import decoupling_leak
+    >>> obs = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3])
+    >>> pl = obs.plant
+    >>> res = decoupling_leak(pl.A, pl.E, pl.C, obs.F, obs.K, np.eye(3), obs.H)
+    >>> bool(res.bound < 1e-12)
+    True
+    """
+    A, E, C, F, K, Co, Dy = (np.asarray(X, float) for X in (A, E, C, F, K, Co, Dy))
+    M = Dy if M is None else np.asarray(M, float)
+    n, q = E.shape
+    if q == 0 or n == 0:
+        return DecouplingLeak(0.0, 0.0, 0.0)
+    if not all(np.all(np.isfinite(X)) for X in (A, E, C, F, K, Co, Dy, M)):
+        return DecouplingLeak(np.inf, np.inf, np.inf)
+    ext = np.longdouble
+    # the rounding of the residuals' own computation: sqrt(n) times the working precision times
+    # the size of their terms (rounding errors of a sum add up like a random walk)
+    gamma = 4 * np.sqrt(n + 2) * float(np.finfo(ext).eps)
+    with np.errstate(all="ignore"):
+        Ax, Ex, Cx, Fx, Kx, Cox, Dyx, Mx = (X.astype(ext) for X in (A, E, C, F, K, Co, Dy, M))
+        eye = np.eye(n, dtype=ext)
+        theta = eye - Mx @ Cx
+        R = (theta @ Ax - Fx @ theta - Kx @ Cx).astype(float)
+        R1 = (theta @ Ex).astype(float)
+        R0 = (eye - Dyx @ Cx - Cox @ theta).astype(float)
+        aT = np.eye(n) + np.abs(M) @ np.abs(C)
+        aA, aF, aK, aC, aE = (np.abs(X) for X in (A, F, K, C, E))
+        # how far each residual can be from its computed value
+        Rb = gamma * float(np.linalg.norm(aT @ aA + aF @ aT + aK @ aC, 2))
+        R1b = gamma * float(np.linalg.norm(aT @ aE, 2))
+        R0b = gamma * float(np.linalg.norm(np.eye(n) + np.abs(Dy) @ aC + np.abs(Co) @ aT, 2))
+        if not (np.isfinite(Rb) and np.isfinite(R1b) and np.isfinite(R0b)):
+            return DecouplingLeak(np.inf, np.inf, np.inf)
+        lam = np.concatenate([np.linalg.eigvals(A), np.linalg.eigvals(F)])
+    if discrete:
+        ang = np.abs(np.angle(lam[np.isfinite(lam)]))
+        points = np.exp(1j * np.unique(np.concatenate([np.linspace(0.0, np.pi, 13), ang])))
+    else:
+        mags = np.abs(lam[np.isfinite(lam)])
+        mags = mags[mags > 0]
+        lo, hi = (float(mags.min()), float(mags.max())) if mags.size else (1.0, 1.0)
+        # a grid over the plant's and the observer's frequencies, and each resonance
+        grid = np.geomspace(lo, hi, 12) if hi > lo else np.array([lo])
+        res = np.abs(lam.imag[np.isfinite(lam)])
+        points = 1j * np.unique(np.concatenate([[0.0], grid, res[res > 0]]))
+    leak = bound = gain = 0.0
+    eye = np.eye(n)
+    lam_f = lam[np.isfinite(lam)]
+    for z in points:
+        if np.any(np.abs(lam_f - z) <= 1e-6 * max(1.0, abs(z))):
+            continue  # on a pole of the plant or the observer (an undamped mode): no gain there
+        try:
+            X = np.linalg.solve(z * eye - A, E)
+            Y = Co @ np.linalg.inv(z * np.eye(F.shape[0]) - F)
+        except np.linalg.LinAlgError:
+            continue
+        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(Y))):
+            continue
+        nx = float(np.linalg.norm(X, 2))
+        gain = max(gain, nx)
+        here = float(np.linalg.norm(R0 @ X + Y @ (R @ X + R1), 2))
+        leak = max(leak, here)
+        bound = max(bound, here + R0b * nx + float(np.linalg.norm(Y, 2)) * (Rb * nx + R1b))
+    if gain == 0:
+        return DecouplingLeak(0.0, 0.0, 0.0)
+    return DecouplingLeak(leak / gain, bound / gain, bound / gain / _EPS)
+
+
+def check_decoupling(
+    A,
+    E,
+    C,
+    F,
+    K,
+    Co,
+    Dy,
+    M=None,
+    *,
+    discrete: bool = False,
+    what: str = "the observer",
+    cause: str = "",
+    stacklevel: int = 3,
+) -> DecouplingLeak:
+    """Refuse a design that leaks; warn when it decouples only to more than ``LEAK_RTOL``.
+
+    Parameters
+    ----------
+    A, E, C : array_like
+        The plant.
+    F, K, Co, Dy, M : array_like
+        The observer (see :func:`decoupling_leak`).
+    what : str
+        How the design is called in messages.
+    cause : str
+        What makes the realization amplify round-off (e.g. the size of ``H``), for the messages.
+
+    Raises
+    ------
+    DecouplingError
+        The stored matrices leak more than ``LEAK_REFUSE`` of the state's response.
+
+    Warns
+    -----
+    DecouplingWarning
+        The leak is certainly below ``LEAK_REFUSE`` but not below ``LEAK_RTOL``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.verify import check_decoupling
+    >>> A = np.diag([-1.0, -2.0]); E = np.array([[1.0], [0.0]]); C = np.array([[1.0, 0.0]])
+    >>> Dy = np.array([[1.0], [0.0]])  # xhat = (y, w): the first state is measured
+    >>> bool(check_decoupling(A, E, C, A, np.zeros((2, 1)), np.eye(2), Dy).bound < 1e-12)
+    True
+    """
+    res = decoupling_leak(A, E, C, F, K, Co, Dy, M, discrete)
+    if res.bound <= LEAK_RTOL:
+        return res
+    why = f"the realization amplifies round-off by {res.amplification:.2g}" + (
+        f" ({cause})" if cause else ""
+    )
+    if not res.leak <= LEAK_REFUSE:
+        raise DecouplingError(
+            f"{what} does not decouple: the unknown input reaches the estimation error with "
+            f"{res.leak:.2g} of its gain on the state (judged on the returned matrices); "
+            f"{why}. The design is refused"
+        )
+    warnings.warn(
+        f"{what} decouples only approximately: the unknown input may reach the estimation error "
+        f"with up to {res.bound:.2g} of its gain on the state; {why}",
+        DecouplingWarning,
+        stacklevel=stacklevel,
+    )
+    return res

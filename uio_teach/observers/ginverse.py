@@ -7,9 +7,9 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_matrix, read_only
-from ..linalg import pinv, rank, sort_poles
+from ..linalg import one_blas_thread, pinv, rank, sort_poles
 from ..plant import Plant, check_plant
-from ..verify import check_fixed_modes, check_identity, product_bound
+from ..verify import check_decoupling, check_fixed_modes, check_identity, product_bound
 from .base import Observer, ObserverRealization
 from .projection import require_existence
 
@@ -46,7 +46,10 @@ class GInverseObserver(Observer):
         n, p = plant.n, plant.p
         A, C, E = plant.A, plant.C, plant.E
         Cg = pinv(C)
-        Pc = np.eye(n) - Cg @ C
+        # the orthogonal projection onto ker C from an orthonormal basis of it: exactly 0 for an
+        # invertible C (I - C^+ C would be round-off of size eps cond(C))
+        Vn = _null_basis(C)
+        Pc = Vn @ Vn.T
         CE = C @ E
         CEg = pinv(CE)
         W = np.eye(p) - CE @ CEg
@@ -62,6 +65,13 @@ class GInverseObserver(Observer):
         # orthonormal basis of range(Pc): the error lives there
         U, s, _ = np.linalg.svd(Pc)
         self._basis = U[:, : n - rank(C)]
+        self._leak = None
+
+    @property
+    def leak(self):
+        """How much of the unknown input can reach the estimation error, judged on the returned
+        matrices (``uio_teach.verify.decoupling_leak``); set by the design."""
+        return self._leak
 
     @property
     def Cg(self) -> np.ndarray:
@@ -133,6 +143,13 @@ class GInverseObserver(Observer):
         )
 
 
+def _null_basis(C: np.ndarray) -> np.ndarray:
+    """Orthonormal basis (columns) of ker C, its dimension decided by ``rank``."""
+    n = C.shape[1]
+    _, _, Vt = np.linalg.svd(C, full_matrices=True)
+    return Vt[rank(C) :].T.copy() if n else np.zeros((0, 0))
+
+
 def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> None:
     """Verify a g-inverse observer on the data as given (identity and fixed modes)."""
     pl = obs.plant
@@ -147,8 +164,24 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
     poles = obs.poles()
     if fixed is not None and len(fixed) <= len(poles):
         check_fixed_modes(poles, fixed, what="the g-inverse observer")
+    # from first principles: the observer state tracks (I - K C) x, xhat = Pc w + Dy y
+    real = obs.realization()
+    obs._leak = check_decoupling(
+        pl.A,
+        pl.E,
+        pl.C,
+        real.A,
+        real.B_y,
+        real.C,
+        real.D_y,
+        K,
+        discrete=pl.is_discrete,
+        what="the g-inverse observer",
+        stacklevel=4,
+    )
 
 
+@one_blas_thread()
 def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     """Design the generalized-matrix-inverse full-order observer (missile paper, eqs. (20)-(23)).
 

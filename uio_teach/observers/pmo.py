@@ -8,6 +8,7 @@ import numpy as np
 
 from .._validation import as_matrix, read_only
 from ..existence import decoupling
+from ..linalg import one_blas_thread
 from ..lmi import lmi_gain
 from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
@@ -90,6 +91,7 @@ class PMO(ProjectionObserver):
         return read_only(self._K1 + self._K2)
 
 
+@one_blas_thread()
 def design_pmo(
     plant: Plant,
     poles: Any = None,
@@ -193,7 +195,7 @@ def design_pmo(
     else:
         L = decoupled_gain("L", plant, L)
     obs = PMO(plant, dec.M, L, Mv, certificate)
-    verify_projection(obs, "the PMO", dec.pair.fixed_modes)
+    verify_projection(obs, "the PMO", report.fixed_modes)
     if requested is not None:
         check_poles(obs.F, requested, what="the PMO", stacklevel=3)
     obs.warn_if_unstable()

@@ -18,7 +18,13 @@ from .._validation import as_matrix, read_only
 from ..existence import ExistenceReport, UIOExistenceError, check_existence
 from ..linalg import pinv
 from ..plant import Plant
-from ..verify import check_fixed_modes, check_identity, product_bound
+from ..verify import (
+    DecouplingLeak,
+    check_decoupling,
+    check_fixed_modes,
+    check_identity,
+    product_bound,
+)
 from .base import Observer, ObserverRealization
 
 __all__ = [
@@ -46,10 +52,17 @@ class ProjectionObserver(Observer):
         self._K1 = read_only(K1)
         self._F = read_only(self._T @ plant.A - K1 @ plant.C)
         self._K2 = read_only(self._F @ H)
+        self._leak: DecouplingLeak | None = None
 
     @property
     def error_matrix(self) -> np.ndarray:
         return self._F
+
+    @property
+    def leak(self) -> DecouplingLeak | None:
+        """How much of the unknown input can reach the estimation error, judged on the returned
+        matrices (``uio_teach.verify.decoupling_leak``); set by the design."""
+        return self._leak
 
     def realization(self) -> ObserverRealization:
         pl = self.plant
@@ -84,6 +97,32 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
     # an error matrix without them does not decouple, whatever the identities say
     if fixed is not None:
         check_fixed_modes(obs.poles(), fixed, what=what)
+    # from first principles, on the matrices returned: the unknown input's path to the error
+    H, K = obs._H, obs._K1 + obs._K2
+    nH, nC, nK = (float(np.linalg.norm(X, 2)) for X in (H, pl.C, obs._K1))
+    nA = float(np.linalg.norm(pl.A, 2))
+    if nH * nC > 1e6:
+        cause = f"||H|| ||C|| = {nH * nC:.2g}: a C E small next to E makes H large"
+    elif nK * nC > 1e6 * max(nA, 1e-300):
+        cause = (
+            f"||K1|| ||C|| = {nK * nC:.2g} against ||A|| = {nA:.2g}: the placement needs a "
+            "large gain (many states per output, poles close together or far from the plant's)"
+        )
+    else:
+        cause = ""
+    obs._leak = check_decoupling(
+        pl.A,
+        pl.E,
+        pl.C,
+        obs._F,
+        K,
+        np.eye(pl.n),
+        H,
+        discrete=pl.is_discrete,
+        what=what,
+        cause=cause,
+        stacklevel=4,
+    )
 
 
 def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:

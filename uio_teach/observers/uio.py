@@ -8,6 +8,7 @@ import numpy as np
 
 from .._validation import read_only
 from ..existence import decoupling
+from ..linalg import one_blas_thread
 from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
 from ..verify import check_poles
@@ -67,6 +68,7 @@ class UIO(ProjectionObserver):
         return self._F
 
 
+@one_blas_thread()
 def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     """Design the unknown-input decoupling observer of Practical Assignment 9.
 
@@ -132,7 +134,7 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     else:
         K1 = decoupled_gain("K1", plant, K1)
     obs = UIO(plant, dec.M, K1)
-    verify_projection(obs, "the UIO", dec.pair.fixed_modes)
+    verify_projection(obs, "the UIO", report.fixed_modes)
     if requested is not None:
         check_poles(obs.F, requested, what="the UIO", stacklevel=3)
     obs.warn_if_unstable()

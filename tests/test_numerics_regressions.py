@@ -1,0 +1,138 @@
+"""Regression cases: fast invariant zeros, a small CE, an invertible C of any size.
+
+Each plant is built so that the right answer is known exactly (see ``test_zero_sweep``); the
+exact judge of a design's leak is the same rational-arithmetic one.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from test_zero_sweep import _orthogonal, exact_leak
+
+import uio_teach as ut
+from uio_teach.verify import LEAK_REFUSE, DecouplingError, DecouplingWarning
+
+
+def fast_zero_plant(z: float, seed: int, n: int = 5, p: int = 2) -> ut.Plant:
+    """``n`` states, one unknown input, the invariant zero ``z``, poles near -1, orthogonal."""
+    import scipy.signal as ssig
+
+    rng = np.random.default_rng(seed)
+    A = np.zeros((n, n))
+    A[0, 0] = z
+    A[0, 1:] = rng.standard_normal(n - 1)
+    A[1:, 1:] = rng.standard_normal((n - 1, n - 1))
+    A[1, 0] = rng.standard_normal()
+    E = np.zeros((n, 1))
+    E[1, 0] = 1.0
+    C = np.zeros((p, n))
+    C[:, 1:] = rng.standard_normal((p, n - 1))
+    G = ssig.place_poles(A, E, -(0.5 + rng.random(n))).gain_matrix
+    A[1] -= G[0]  # only the unknown input's row: the zero stays at z exactly
+    Q = _orthogonal(n, rng)
+    return ut.Plant(Q.T @ A @ Q, C @ Q, E=Q.T @ E)
+
+
+@pytest.mark.parametrize("z", [1e3, 1e4, 1e5, 1e6])
+@pytest.mark.parametrize("seed", range(3))
+def test_a_fast_unstable_zero_is_never_called_a_uio(z, seed):
+    report = ut.check_existence(fast_zero_plant(z, seed))
+    assert not report.ok
+    if report.decided:
+        # the zero is found, to many digits, and decides the verdict
+        zeros = report.invariant_zeros
+        assert np.min(np.abs(zeros - z)) <= 1e-6 * z
+        assert report["invariant zeros stable"].holds is False
+    else:
+        assert "cannot be decided at this precision" in str(report)
+
+
+@pytest.mark.parametrize("z", [-1e3, -1e5])
+def test_a_fast_stable_zero_is_a_fixed_mode_of_the_design(z):
+    plant = fast_zero_plant(z, seed=1)
+    report = ut.check_existence(plant)
+    assert report.ok
+    assert np.min(np.abs(report.invariant_zeros - z)) <= 1e-6 * abs(z)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DecouplingWarning)
+        obs = ut.design_uio(plant, poles=-np.arange(1.0, report.movable + 1))
+    assert np.min(np.abs(obs.poles() - z)) <= 1e-6 * abs(z)
+    assert exact_leak(plant, obs) <= LEAK_REFUSE
+
+
+def test_units_do_not_flip_the_verdict_of_a_fast_zero():
+    plant = fast_zero_plant(1e3, seed=0)
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        t = 10.0 ** rng.uniform(-1, 1, plant.n)
+        wy = 10.0 ** rng.uniform(-1, 1, plant.p)
+        other = ut.Plant(
+            plant.A / t[:, None] * t[None, :],
+            wy[:, None] * plant.C * t[None, :],
+            E=plant.E / t[:, None],
+        )
+        assert not ut.check_existence(other).ok
+
+
+def small_ce_plant(ce: float = 1e-8) -> ut.Plant:
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((4, 4))
+    C = rng.standard_normal((2, 4))
+    E = np.linalg.svd(C)[2][-1][:, None] + ce * C[:1].T
+    return ut.Plant(A, C, E=E)
+
+
+def test_a_small_ce_is_reported_as_ill_conditioned():
+    report = ut.check_existence(small_ce_plant())
+    cond = report["well-conditioned decoupling"]
+    assert cond.holds is False and "amplifies round-off by about" in cond.reason
+    assert ut.check_existence(ut.examples.pa9())["well-conditioned decoupling"].holds
+
+
+@pytest.mark.parametrize(
+    "design",
+    [
+        lambda pl: ut.design_uio(pl, poles=[-1, -2, -3, -4]),
+        lambda pl: ut.design_pmo(pl, poles=[-1, -2, -3, -4]),
+        lambda pl: ut.design_ginverse(pl),
+    ],
+    ids=["uio", "pmo", "ginverse"],
+)
+def test_a_small_ce_design_is_refused_or_warned_never_silently_leaking(design):
+    plant = small_ce_plant()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            obs = design(plant)
+        except DecouplingError as exc:
+            assert "does not decouple" in str(exc) and "amplifies round-off" in str(exc)
+            return
+    warned = [w for w in caught if issubclass(w.category, DecouplingWarning)]
+    leak = exact_leak(plant, obs)
+    assert leak <= (LEAK_REFUSE if warned else 1e-6)
+
+
+def test_ginverse_is_exact_for_an_invertible_c_of_any_size():
+    rng = np.random.default_rng(0)
+    Q = _orthogonal(3, rng) * 1e3
+    plant = ut.Plant(np.diag([-1.0, -2.0, -3.0]), Q, E=[[1.0], [0.0], [0.0]])
+    obs = ut.design_ginverse(plant)
+    real = obs.realization()
+    # xhat = C^-1 y: nothing left to estimate, a leak at the round-off of C^-1 alone
+    np.testing.assert_allclose(real.D_y @ plant.C, np.eye(3), atol=1e-12)
+    assert not np.any(obs.projection)
+    eps = np.finfo(float).eps
+    assert obs.leak.bound <= 10 * eps and exact_leak(plant, obs) <= 10 * eps
+
+
+@pytest.mark.parametrize("ce", [1e-1, 1e-2, 1e-3])
+def test_the_exact_judge_and_the_designs_own_check_agree(ce):
+    plant = small_ce_plant(ce)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DecouplingWarning)
+        obs = ut.design_uio(plant, poles=[-1, -2, -3, -4])
+    exact = exact_leak(plant, obs)
+    assert exact <= obs.leak.bound * 1.01 + 1e-300
