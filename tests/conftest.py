@@ -92,9 +92,10 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
 
 def is_probe(words: list[str]) -> bool:
     """A library's one-off look at the machine, cached for the process: ``tool --version``
-    (jupytext asks pandoc), the sandbox's ``bwrap ... /bin/true``. Whichever test happens to come
-    first would start it, so it needs no marker."""
-    if len(words) == 2 and words[1] == "--version":
+    (jupytext asks pandoc), ``bwrap --help`` (which options this bubblewrap has), the sandbox's
+    ``bwrap ... /bin/true``. Whichever test happens to come first would start it, so it needs
+    no marker."""
+    if len(words) == 2 and words[1] in ("--version", "--help"):
         return True
     return bool(words) and Path(words[0]).name == "bwrap" and words[-1] == "/bin/true"
 

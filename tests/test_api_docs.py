@@ -90,15 +90,22 @@ SLOW_DOCTESTS = {
 }
 
 
+# Modules whose docstring examples start a process: the sandbox's probe runs Python (and the
+# package's notebook runner) inside bubblewrap.
+PROCESS_DOCTESTS = {"uio_teach.instructor.sandbox": ("subprocess", "kernel")}
+
+
 def _modules():
     names = ["uio_teach"]
     for info in pkgutil.walk_packages(ut.__path__, prefix="uio_teach."):
         if not info.name.endswith("__main__"):
             names.append(info.name)
-    return [
-        pytest.param(name, marks=[pytest.mark.slow] if name in SLOW_DOCTESTS else [])
-        for name in names
-    ]
+    params = []
+    for name in names:
+        marks = [pytest.mark.slow] if name in SLOW_DOCTESTS else []
+        marks += [getattr(pytest.mark, m) for m in PROCESS_DOCTESTS.get(name, ())]
+        params.append(pytest.param(name, marks=marks))
+    return params
 
 
 @pytest.mark.doctest
