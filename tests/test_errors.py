@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
+import inspect
+import pkgutil
+
 import pytest
 
 import uio_teach as ut
@@ -34,6 +38,34 @@ ERRORS = {
 def test_every_error_has_the_common_base_and_its_builtin_kind(error):
     assert issubclass(error, ut.UIOTeachError)
     assert issubclass(error, ERRORS[error])
+
+
+def _defined_in_the_package() -> list[type[BaseException]]:
+    """Every exception and warning class a module of the package defines."""
+    found = []
+    for info in pkgutil.walk_packages(ut.__path__, prefix="uio_teach."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for value in vars(module).values():
+            if (
+                inspect.isclass(value)
+                and issubclass(value, BaseException)
+                and value.__module__ == module.__name__
+            ):
+                found.append(value)
+    return found
+
+
+def test_every_error_and_warning_of_every_module_has_the_common_base():
+    """Found by walking the package, so a new class cannot be left out of the list above."""
+    stray = [
+        f"{c.__module__}.{c.__name__}"
+        for c in _defined_in_the_package()
+        if c not in (ut.UIOTeachError, ut.UIOTeachWarning)
+        and not issubclass(c, ut.UIOTeachWarning if issubclass(c, Warning) else ut.UIOTeachError)
+    ]
+    assert not stray, f"outside UIOTeachError / UIOTeachWarning: {stray}"
 
 
 def test_warnings_have_the_common_base():

@@ -9,6 +9,7 @@ import numpy as np
 
 from ._display import LINE_WIDTH, fit_lines, format_poles
 from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
+from .errors import UIOTeachError
 from .linalg import (
     DROP_MARGIN,
     MARGIN,
@@ -288,7 +289,7 @@ class ExistenceReport:
         )
 
 
-class UIOExistenceError(ValueError):
+class UIOExistenceError(UIOTeachError, ValueError):
     """No unknown input observer exists; ``.report`` says which condition failed."""
 
     def __init__(self, report: ExistenceReport, what: str = "an unknown input observer") -> None:

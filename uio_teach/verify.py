@@ -32,6 +32,7 @@ import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from ._display import format_complex
+from .errors import UIOTeachError, UIOTeachWarning
 
 __all__ = [
     "POLE_RTOL",
@@ -64,11 +65,11 @@ def _fmt(values) -> str:
     return "{" + ", ".join(format_complex(v, 7) for v in values) + "}" if len(values) else "none"
 
 
-class PlacementAccuracyWarning(UserWarning):
+class PlacementAccuracyWarning(UIOTeachWarning):
     """The obtained poles differ from the requested ones by more than round-off allows."""
 
 
-class PlacementAccuracyError(ValueError):
+class PlacementAccuracyError(UIOTeachError, ValueError):
     """A computed design fails its own check: wrong poles, non-finite gain or broken identity."""
 
 
@@ -344,7 +345,7 @@ LEAK_REFUSE = 1e-3
 """A design whose computed leak exceeds this fraction of the state's response is refused."""
 
 
-class DecouplingWarning(UserWarning):
+class DecouplingWarning(UIOTeachWarning):
     """The design decouples only to a stated fraction: it amplifies round-off (a small ``C E``)."""
 
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from .._display import fit_lines, format_complex, matrices_html, matrices_text
+from ..errors import UIOTeachWarning
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
 
@@ -17,7 +18,7 @@ if TYPE_CHECKING:  # python-control is imported where a conversion needs it
 __all__ = ["Observer", "ObserverRealization", "UnstableObserverWarning"]
 
 
-class UnstableObserverWarning(UserWarning):
+class UnstableObserverWarning(UIOTeachWarning):
     """The designed observer's error dynamics are not asymptotically stable."""
 
 
