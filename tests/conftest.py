@@ -33,10 +33,12 @@ from __future__ import annotations
 
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import NamedTuple
 
 import matplotlib
 import pytest
@@ -199,21 +201,41 @@ def jupyter_book() -> str:
     return str(local) if local.exists() else "jupyter-book"
 
 
-@pytest.fixture(scope="session")
-def built_book() -> Path:
-    """Build the book once per test run, exactly as ``make book`` does; the HTML folder.
+class BookBuild(NamedTuple):
+    """The one build of the book in a test run: its command, exit status and the log's tail."""
 
-    Shared by every test that reads the built pages (tests marked ``book``).
+    command: list[str]
+    returncode: int
+    log: str
+
+
+@pytest.fixture(scope="session")
+def book_build() -> BookBuild:
+    """Build the book once per test run, as ``make book`` does, every chapter executed afresh.
+
+    The execution cache is emptied and every page re-read (``--all``) first, so each chapter runs
+    against the package as it is now, not as it was when the cache was filled: this build is
+    what proves the chapters run (``test_chapters.py``), not a second execution of each.
     """
-    command = [jupyter_book(), "build", ".", "-W", "-n", "--keep-going"]
+    shutil.rmtree(ROOT / "_build" / ".jupyter_cache", ignore_errors=True)
+    shutil.rmtree(HTML / "reports", ignore_errors=True)
+    command = [jupyter_book(), "build", ".", "--all", "-W", "-n", "--keep-going"]
     proc = subprocess.run(
         command, cwd=ROOT, capture_output=True, text=True, timeout=BOOK_BUILD_LIMIT
     )
-    if proc.returncode != 0:
-        log = (proc.stdout + proc.stderr)[-8000:]
+    return BookBuild(command, proc.returncode, (proc.stdout + proc.stderr)[-8000:])
+
+
+@pytest.fixture(scope="session")
+def built_book(book_build: BookBuild) -> Path:
+    """The HTML folder of the one build; fails the test when the build failed.
+
+    Shared by every test that reads the built pages (tests marked ``book``).
+    """
+    if book_build.returncode != 0:
         pytest.fail(
-            f"`{' '.join(command)}` exited with {proc.returncode}; tracebacks of failed chapters"
-            f" are in {HTML / 'reports'}.\n{log}",
+            f"`{' '.join(book_build.command)}` exited with {book_build.returncode}; tracebacks "
+            f"of failed chapters are in {HTML / 'reports'}.\n{book_build.log}",
             pytrace=False,
         )
     return HTML
