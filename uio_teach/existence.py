@@ -594,8 +594,9 @@ def detectability_conditions(
             margin=margin,
         )
     if len(fixed):
+        all_fixed = format_poles(fixed, braces=True, empty="none")
         reason = (
-            f"{movable} of {plant.n} poles can be placed; {listed} are fixed "
+            f"{movable} of {plant.n} poles can be placed; {all_fixed} are fixed "
             "(they are the invariant zeros)"
         )
     else:
