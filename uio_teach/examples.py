@@ -347,7 +347,7 @@ def quadruple_tank(
     T1, T2, T3, T4 = tank_time_constants(setting)
     kc = float(pub.kc)
     custom = (g1, g2) != tuple(float(x) for x in pub.gamma)
-    name = f"quadruple tank ({setting}" + (f", gamma {g1:g}, {g2:g})" if custom else ")")
+    name = f"quadruple tank ({setting}" + (f" levels, gamma {g1:g}, {g2:g})" if custom else ")")
     return Plant(
         [
             [-1 / T1, 0, A3 / (A1 * T3), 0],
