@@ -563,7 +563,221 @@ def _real_modes(T: np.ndarray) -> list[tuple[int, int, Any]] | None:
     return blocks[::-1]
 
 
+# Block length of the scan: a block's own response is one product with a block Toeplitz matrix
+# of L x L blocks (cost ~ L per sample), the block starts one recursion L times shorter.
+_BLOCK = 16
+# The scan forms Phi^k for k up to the span of the run. Beyond this size a power could turn an
+# unexcited unstable mode (0 * huge) into noise or NaN: the modal recursion takes over.
+_GROWTH = 1e100
+# Entries of a power of Phi below this are set to zero: they add nothing a double can hold to
+# the states, and subnormal numbers would make the products many times slower.
+_NEGLIGIBLE = 1e-290
+
+
+class _Growth(Exception):
+    """A power of ``Phi`` too large for the block scan."""
+
+
+class _Plan:
+    """The one-step matrices of a system on a uniform grid, and the scan's matrices per level.
+
+    Level ``d`` runs ``x[k+1] = P_d x[k] + G_d u[k]`` with ``P_0 = D^-1 Phi D`` (balanced,
+    ``D`` diagonal of powers of 2), ``G_0 = D^-1 Gam`` and, above it, ``P_d = P_(d-1)^L``,
+    ``G_d = I``. A level of block length ``L`` keeps ``P_d^L`` and the matrix ``KW`` that
+    maps one block's inputs (input channel by channel at level 0, time step by time step
+    above) and its starting state to the ``L`` states that follow.
+    """
+
+    def __init__(self, Phi: np.ndarray, G0: np.ndarray, G1: np.ndarray | None) -> None:
+        _, (scale, _) = sla.matrix_balance(Phi, permute=False, separate=True)
+        if G1 is None:
+            Gam, G1 = G0, np.zeros_like(G0)
+        else:
+            Gam = G0 + Phi @ G1
+        self.Phi, self.G0, self.G1, self.scale = Phi, G0, G1, scale
+        self.P = Phi * (scale[None, :] / scale[:, None])
+        self.G = Gam / scale[:, None]
+        self.levels: dict[tuple[int, int], tuple[int, np.ndarray, np.ndarray]] = {}
+
+    def level(self, depth: int, L: int) -> tuple[np.ndarray, ...]:
+        """``(P_d^L, KW, ...)`` of level ``depth`` for blocks of ``L`` steps."""
+        key = (depth, L)
+        if key not in self.levels:
+            if depth == 0:
+                self.levels[key] = _first_level(self.P, self.G, L)
+            else:
+                self.levels[key] = _block_matrices(self.level(depth - 1, _BLOCK)[0], L)
+        return self.levels[key]
+
+
+def _powers(P: np.ndarray, L: int) -> np.ndarray:
+    """``P^0 ... P^L`` stacked; :class:`_Growth` if one exceeds ``_GROWTH`` or is not finite."""
+    nx = P.shape[0]
+    pw = np.empty((L + 1, nx, nx))
+    pw[0] = np.eye(nx)
+    for i in range(L):
+        np.matmul(P, pw[i], out=pw[i + 1])
+    if not np.abs(pw).max() <= _GROWTH:
+        raise _Growth
+    pw[np.abs(pw) < _NEGLIGIBLE] = 0.0
+    return pw
+
+
+def _first_level(P: np.ndarray, G: np.ndarray, L: int) -> tuple[np.ndarray, ...]:
+    """``(P^L, KW, Kend)`` for blocks of ``L`` steps of ``x[k+1] = P x[k] + G s[k]``.
+
+    A block's row ``[s_block, x[bL]]`` (inputs channel by channel, then the block's
+    start) times ``KW`` gives ``[x[bL + i], s[bL + i]]`` for ``i = 0 ... L-1``: the
+    states with the inputs beside them (copied exactly, by ones), ready for the outputs.
+    ``KW = [K; W]``: ``K`` block Toeplitz with blocks ``(P^(i-1-j) G)^T`` for ``j < i``,
+    ``W = [I, P^T, ... (P^(L-1))^T]``. ``s_block @ Kend`` is the block's end state
+    ``x[bL + L]`` from rest.
+    """
+    nx, ns = G.shape
+    pw = _powers(P, L)
+    PG = np.concatenate([np.zeros((1, nx, ns)), pw[:L] @ G])  # P^(m-1) G, zero for m = 0
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # i - j: input step j, state step i
+    # KW[channel, j, i, state + input]
+    KW = np.zeros((ns, L, L, nx + ns))
+    KW[..., :nx] = PG.transpose(2, 0, 1)[:, np.maximum(lag, 0)]  # [channel, j, i, state]
+    KW[:, lag < 0, :nx] = 0.0
+    j = np.arange(L)
+    KW[:, j, j, nx:] = np.eye(ns)[:, None, :]
+    W = np.zeros((nx, L, nx + ns))
+    W[:, :, :nx] = pw[:L].transpose(2, 0, 1)
+    KW = np.vstack([KW.reshape(ns * L, L * (nx + ns)), W.reshape(nx, L * (nx + ns))])
+    Kend = PG[L:0:-1].transpose(2, 0, 1).reshape(ns * L, nx)  # rows (channel, j): P^(L-1-j) G
+    return pw[L], KW, Kend
+
+
+def _block_matrices(P: np.ndarray, L: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(P^L, KW)`` for blocks of ``L`` steps of ``x[k+1] = P x[k] + u[k]``.
+
+    A block's row ``[u[bL], ... u[bL + L-1], x[bL]]`` times ``KW`` gives its states
+    ``x[bL + 1 ... bL + L]`` in a row: ``KW = [K; W]``, ``K`` block upper triangular
+    Toeplitz with blocks ``(P^(i-j))^T`` and ``W = [P^T, (P^2)^T, ... (P^L)^T]``.
+    """
+    nx = P.shape[0]
+    pw = _powers(P, L)
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # i - j: input step j, state step i
+    K = pw[:L].transpose(0, 2, 1)[np.maximum(lag, 0)]  # [j, i, input, state]
+    K[lag < 0] = 0.0
+    K = K.transpose(0, 2, 1, 3).reshape(L * nx, L * nx)
+    W = pw[1:].transpose(2, 0, 1).reshape(nx, L * nx)
+    return pw[L], np.vstack([K, W])
+
+
+def _scan_steps(plan: _Plan, depth: int, U: np.ndarray, x0: np.ndarray) -> np.ndarray:
+    """States ``x[0 ... M]`` of ``x[k+1] = P_d x[k] + u[k]`` for the rows ``u[k]`` of ``U``.
+
+    In blocks of ``L`` steps; the block starts ``x[bL]`` obey ``x[(b+1)L] = P_d^L x[bL] +
+    e_b`` (``e_b`` the block's end state from rest), level ``depth + 1``; then all
+    states are one product.
+    """
+    M, nx = U.shape
+    L = min(_BLOCK, M)
+    nb, r = divmod(M, L)
+    PL, KW = plan.level(depth, L)
+    A = np.empty((nb + (r > 0), (L + 1) * nx))
+    A[:nb, : L * nx] = U[: nb * L].reshape(nb, L * nx)
+    if r:
+        A[nb, : r * nx] = U[nb * L :].ravel()
+        A[nb, r * nx : L * nx] = 0.0
+    _starts(plan, depth, A, A[:-1, : L * nx] @ KW[: L * nx, -nx:], x0)
+    X = np.empty((A.shape[0] * L + 1, nx))
+    X[0] = x0
+    np.matmul(A, KW, out=X[1:].reshape(A.shape[0], L * nx))
+    return X[: M + 1]
+
+
+def _starts(plan: _Plan, depth: int, A: np.ndarray, ends: np.ndarray, x0: np.ndarray) -> None:
+    """The block starts into the last columns of ``A``, from the blocks' ends from rest."""
+    nx = x0.size
+    if A.shape[0] == 1:
+        A[0, -nx:] = x0
+    else:
+        A[:, -nx:] = _scan_steps(plan, depth + 1, ends, x0)
+
+
+def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray) -> np.ndarray:
+    """The balanced states ``D^-1 xi[k]`` with the inputs beside them: rows ``[xi', s]``.
+
+    Shape (N, nz + ns), time along the first axis. A parallel scan in blocks of ``L``
+    steps: inside a block the response from rest, ``x[bL + i] - P^i x[bL] = sum_j
+    P^(i-1-j) G s[bL + j]``, is one product of all blocks' inputs with a block Toeplitz
+    matrix; the block starts obey a recursion ``L`` times shorter, solved the same way
+    (:func:`_scan_steps`). Every term is a power of ``P`` applied to a state or an input,
+    as in the one-step recursion, with fewer roundings.
+    """
+    ns, N = S.shape
+    nx = plan.P.shape[0]
+    L = min(_BLOCK, N)
+    nb, r = divmod(N, L)
+    PL, KW, Kend = plan.level(0, L)
+    A = np.empty((nb + (r > 0), ns * L + nx))
+    blocks = A[:, : ns * L].reshape(A.shape[0], ns, L).transpose(1, 0, 2)  # [channel, block, step]
+    blocks[:, :nb] = S[:, : nb * L].reshape(ns, nb, L)
+    if r:
+        blocks[:, nb, :r] = S[:, nb * L :]
+        blocks[:, nb, r:] = 0.0
+    x0 = xi0 / plan.scale
+    _starts(plan, 0, A, A[:-1, : ns * L] @ Kend, x0)
+    XS = np.empty((A.shape[0] * L, nx + ns))
+    np.matmul(A, KW, out=XS.reshape(A.shape[0], L * (nx + ns)))
+    return XS[:N]
+
+
+_PLANS: dict[tuple, _Plan] = {}
+_PLANS_KEPT = 8  # systems whose one-step matrices are kept (the most recently used)
+
+
+def _plan(key: tuple | None, make: Callable[[], tuple]) -> _Plan:
+    """The plan of a system and step, built once: recalled while the same observer is rerun."""
+    plan = _PLANS.pop(key, None) if key is not None else None
+    if plan is None:
+        plan = _Plan(*make())
+    if key is not None:
+        _PLANS[key] = plan  # most recent last
+        while len(_PLANS) > _PLANS_KEPT:
+            del _PLANS[next(iter(_PLANS))]
+    return plan
+
+
 def _recursion(
+    plan: _Plan, S: np.ndarray, z0: np.ndarray, output: np.ndarray | None = None
+) -> np.ndarray:
+    """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
+
+    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
+
+    ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
+    ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
+    diagonal ``D`` of powers of 2, exact), so that states of very different
+    size keep their own relative accuracy. The recursion is then run by the
+    block scan :func:`_scan` (matrix products only, no eigenvectors: defective and
+    non-normal ``Phi`` need no special care), and ``z = D xi' + G1 s`` is mapped
+    to the outputs in one more product. When a power of ``Phi`` over the span grows
+    too large for the scan (a fast unstable pole), :func:`_recursion_modes` runs it
+    mode by mode instead.
+    """
+    nz = plan.P.shape[0]
+    G1, scale = plan.G1, plan.scale
+    try:
+        XS = _scan(plan, S, z0 - G1 @ S[:, 0])
+    except _Growth:
+        return _recursion_modes(plan.Phi, plan.G0, plan.G1, S, z0, output)
+    # z = D xi' + G1 s, and on to the outputs if asked: one product with [xi', s]
+    if output is None:
+        W = np.hstack([np.diag(scale), G1])
+    else:
+        W = np.hstack([output[:, :nz] * scale[None, :], output[:, :nz] @ G1 + output[:, nz:]])
+    out = W @ XS.T
+    # the first column exactly, not through the change of coordinates
+    out[:, 0] = z0 if output is None else output @ np.concatenate([z0, S[:, 0]])
+    return out
+
+
+def _recursion_modes(
     Phi: np.ndarray,
     G0: np.ndarray,
     G1: np.ndarray | None,
@@ -571,9 +785,7 @@ def _recursion(
     z0: np.ndarray,
     output: np.ndarray | None = None,
 ) -> np.ndarray:
-    """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
-
-    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
+    """:func:`_recursion` mode by mode: for powers of ``Phi`` too large for the block scan.
 
     ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
     ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
@@ -788,19 +1000,25 @@ def linear_response(
     z0 = np.asarray(initial_state, float)
     with _one_blas_thread(), np.errstate(all="ignore"):
         if discrete:
-            return _recursion(A, B, None, S, z0, output)
+            key = ("discrete", A.shape, B.shape, A.tobytes(), B.tobytes())
+            return _recursion(_plan(key, lambda: (A, B, None)), S, z0, output)
         h = _uniform_step(t)
         if h is None:
             return _map(output, _stepwise(A, B, t, S, z0), S)
-        Phi, G0, G1 = foh_matrices(A, B, h)
-        if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
-            poles = np.linalg.eigvals(A)
-            raise SimulationOverflowError(
-                "the response leaves the floating-point range within one time step",
-                poles[poles.real > 0],
-                float(t[min(1, t.size - 1)]),
-            )
-        return _recursion(Phi, G0, G1, S, z0, output)
+
+        def one_step() -> tuple[np.ndarray, ...]:
+            Phi, G0, G1 = foh_matrices(A, B, h)
+            if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
+                poles = np.linalg.eigvals(A)
+                raise SimulationOverflowError(
+                    "the response leaves the floating-point range within one time step",
+                    poles[poles.real > 0],
+                    float(t[min(1, t.size - 1)]),
+                )
+            return Phi, G0, G1
+
+        key = (h, A.shape, B.shape, A.tobytes(), B.tobytes())
+        return _recursion(_plan(key, one_step), S, z0, output)
 
 
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
