@@ -388,7 +388,7 @@ def _noise(noise: Any, seed: Any, p: int, N: int) -> np.ndarray:
     return sd[:, None] * rng.standard_normal((p, N))
 
 
-_CONTROLLER: Any = None
+_BLAS_LIBRARIES: list | None = None
 
 
 @contextmanager
@@ -397,22 +397,26 @@ def _one_blas_thread() -> Iterator[None]:
 
     The products here are small or thin (8 x 10 x N); on a 2-core machine
     OpenBLAS's worker threads make them several times slower, not faster.
-    The controller is built once (that is the slow part of threadpoolctl).
+    The BLAS libraries are looked up once (the slow part of threadpoolctl);
+    then each run only reads and sets their thread counts.
     """
-    global _CONTROLLER
-    if _CONTROLLER is None:
+    global _BLAS_LIBRARIES
+    if _BLAS_LIBRARIES is None:
         try:
             # deferred on purpose: optional, and only needed once a simulation runs
             from threadpoolctl import ThreadpoolController
         except ImportError:  # pragma: no cover - threadpoolctl is optional
-            _CONTROLLER = False
+            _BLAS_LIBRARIES = []
         else:
-            _CONTROLLER = ThreadpoolController()
-    if _CONTROLLER is False:  # pragma: no cover
+            _BLAS_LIBRARIES = ThreadpoolController().select(user_api="blas").lib_controllers
+    before = [lib.get_num_threads() for lib in _BLAS_LIBRARIES]
+    try:
+        for lib in _BLAS_LIBRARIES:
+            lib.set_num_threads(1)
         yield
-        return
-    with _CONTROLLER.limit(limits=1, user_api="blas"):
-        yield
+    finally:
+        for lib, threads in zip(_BLAS_LIBRARIES, before, strict=True):
+            lib.set_num_threads(threads)
 
 
 # the joint system and its solution --------------------------------------------------------
@@ -446,13 +450,17 @@ def joint_system(plant: Plant, observer: Observer) -> tuple[np.ndarray, np.ndarr
     A_o, B_u, B_y, _, _ = observer.realization()
     n, nw = plant.n, A_o.shape[0]
     q, r, p = plant.q, plant.nv, plant.p
-    Az = np.block([[plant.A, np.zeros((n, nw))], [B_y @ plant.C, A_o]])
-    Bz = np.block(
-        [
-            [plant.B, plant.E, np.zeros((n, r)), np.zeros((n, p))],
-            [B_u, np.zeros((nw, q)), B_y @ plant.D, B_y],
-        ]
-    )
+    m = plant.m
+    Az = np.zeros((n + nw, n + nw))
+    Az[:n, :n] = plant.A
+    Az[n:, :n] = B_y @ plant.C
+    Az[n:, n:] = A_o
+    Bz = np.zeros((n + nw, m + q + r + p))
+    Bz[:n, :m] = plant.B
+    Bz[:n, m : m + q] = plant.E
+    Bz[n:, :m] = B_u
+    Bz[n:, m + q : m + q + r] = B_y @ plant.D
+    Bz[n:, m + q + r :] = B_y
     return Az, Bz
 
 
@@ -699,15 +707,16 @@ def _starts(plan: _Plan, depth: int, A: np.ndarray, ends: np.ndarray, x0: np.nda
         A[:, -nx:] = _scan_steps(plan, depth + 1, ends, x0)
 
 
-def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray) -> np.ndarray:
-    """The balanced states ``D^-1 xi[k]`` with the inputs beside them: rows ``[xi', s]``.
+def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """The signals ``W @ [xi'[k]; s[k]]`` (``xi' = D^-1 xi`` balanced), shape (N, rows).
 
-    Shape (N, nz + ns), time along the first axis. A parallel scan in blocks of ``L``
-    steps: inside a block the response from rest, ``x[bL + i] - P^i x[bL] = sum_j
-    P^(i-1-j) G s[bL + j]``, is one product of all blocks' inputs with a block Toeplitz
-    matrix; the block starts obey a recursion ``L`` times shorter, solved the same way
-    (:func:`_scan_steps`). Every term is a power of ``P`` applied to a state or an input,
-    as in the one-step recursion, with fewer roundings.
+    Time runs along the first axis. A parallel scan in blocks of ``L`` steps: inside a
+    block the response from rest, ``x[bL + i] - P^i x[bL] = sum_j P^(i-1-j) G s[bL + j]``,
+    is one product of all blocks' inputs with a block Toeplitz matrix; the block starts
+    obey a recursion ``L`` times shorter, solved the same way (:func:`_scan_steps`). Every
+    term is a power of ``P`` applied to a state or an input, as in the one-step recursion,
+    with fewer roundings. The map ``W`` to the signals is folded into the last product, so
+    that the states themselves are never stored.
     """
     ns, N = S.shape
     nx = plan.P.shape[0]
@@ -722,9 +731,11 @@ def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray) -> np.ndarray:
         blocks[:, nb, r:] = 0.0
     x0 = xi0 / plan.scale
     _starts(plan, 0, A, A[:-1, : ns * L] @ Kend, x0)
-    XS = np.empty((A.shape[0] * L, nx + ns))
-    np.matmul(A, KW, out=XS.reshape(A.shape[0], L * (nx + ns)))
-    return XS[:N]
+    rows = W.shape[0]
+    KWout = (KW.reshape(-1, nx + ns) @ W.T).reshape(KW.shape[0], L * rows)
+    Y = np.empty((A.shape[0] * L, rows))
+    np.matmul(A, KWout, out=Y.reshape(A.shape[0], L * rows))
+    return Y[:N]
 
 
 _PLANS: dict[tuple, _Plan] = {}
@@ -762,16 +773,15 @@ def _recursion(
     """
     nz = plan.P.shape[0]
     G1, scale = plan.G1, plan.scale
-    try:
-        XS = _scan(plan, S, z0 - G1 @ S[:, 0])
-    except _Growth:
-        return _recursion_modes(plan.Phi, plan.G0, plan.G1, S, z0, output)
-    # z = D xi' + G1 s, and on to the outputs if asked: one product with [xi', s]
+    # z = D xi' + G1 s, and on to the outputs if asked: W @ [xi'; s]
     if output is None:
         W = np.hstack([np.diag(scale), G1])
     else:
         W = np.hstack([output[:, :nz] * scale[None, :], output[:, :nz] @ G1 + output[:, nz:]])
-    out = W @ XS.T
+    try:
+        out = _scan(plan, S, z0 - G1 @ S[:, 0], W).T
+    except _Growth:
+        return _recursion_modes(plan.Phi, plan.G0, plan.G1, S, z0, output)
     # the first column exactly, not through the change of coordinates
     out[:, 0] = z0 if output is None else output @ np.concatenate([z0, S[:, 0]])
     return out
@@ -1211,15 +1221,27 @@ def simulate(
     if plant.is_discrete:
         _check_discrete_grid(plant, t)
 
-    # all inputs in one array s = [u; d; v; noise]; the recorded inputs are views of it
+    # the given inputs in one array; the recorded inputs are views of it, and those not given
+    # are zero (read-only views of a single zero: no memory)
     m, q, r, p = plant.m, plant.q, plant.nv, plant.p
-    S = np.empty((m + q + r + p, N))
-    S[:m] = input_samples("u", u, m, t)
-    S[m : m + q] = input_samples("d", d, q, t)
-    S[m + q : m + q + r] = input_samples("v", v, r, t)
-    S[m + q + r :] = _noise(noise, seed, p, N)
+    channels = [("u", u, m), ("d", d, q), ("v", v, r), ("noise", noise, p)]
+    given = [value is not None for _, value, _ in channels]
+    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
+    S = np.empty((keep.size, N))
+    recorded = {}
+    row = 0
+    for (name, value, size), is_given in zip(channels, given, strict=True):
+        if not is_given:
+            recorded[name] = np.broadcast_to(np.zeros(()), (size, N))
+            continue
+        if name == "noise":
+            S[row : row + size] = _noise(noise, seed, p, N)
+        else:
+            S[row : row + size] = input_samples(name, value, size, t)
+        recorded[name] = S[row : row + size]
+        row += size
     S.setflags(write=False)
-    inputs = SimulationInputs(u=S[:m], d=S[m : m + q], v=S[m + q : m + q + r], noise=S[m + q + r :])
+    inputs = SimulationInputs(**recorded)
 
     real = observer.realization()
     nw = real.A.shape[0]
@@ -1233,20 +1255,19 @@ def simulate(
     # the signals read off [z; s] = [x; w; u; d; v; noise], one row block each:
     # x, w, y = C x + D v + noise and xhat = C_o w + D_y y
     n = plant.n
-    ny = np.zeros((p, n + nw + S.shape[0]))
+    ns = m + q + r + p
+    ny = np.zeros((p, n + nw + ns))
     ny[:, :n] = plant.C
     ny[:, n + nw + m + q : n + nw + m + q + r] = plant.D
     ny[:, n + nw + m + q + r :] = np.eye(p)
     nxhat = real.D_y @ ny
     nxhat[:, n : n + nw] += real.C
-    output = np.vstack([np.eye(n + nw, n + nw + S.shape[0]), ny, nxhat])
+    output = np.vstack([np.eye(n + nw, n + nw + ns), ny, nxhat])
     # inputs that were not given are zero and add nothing: the engine sees the others alone
-    given = [u is not None, d is not None, v is not None, noise is not None]
-    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
     output = np.hstack([output[:, : n + nw], output[:, n + nw + keep]])
     try:
         signals = linear_response(
-            Az, Bz[:, keep], t, S[keep], z0, discrete=plant.is_discrete, output=output
+            Az, Bz[:, keep], t, S, z0, discrete=plant.is_discrete, output=output
         )
     except SimulationOverflowError:
         raise _overflow(Az, plant, t, 1) from None
