@@ -571,8 +571,11 @@ def _real_modes(T: np.ndarray) -> list[tuple[int, int, Any]] | None:
     return blocks[::-1]
 
 
-# Block length of the scan: a block's own response is one product with a block Toeplitz matrix
-# of L x L blocks (cost ~ L per sample), the block starts one recursion L times shorter.
+# Block lengths of the scan: a block's own response is one product with a block Toeplitz matrix
+# of L x L blocks (cost ~ L per sample), the block starts one recursion L times shorter. The
+# first level, over all samples, reads the inputs and writes the signals: short blocks keep
+# its product small; the levels above run on few block starts, where longer blocks save steps.
+_FIRST_BLOCK = 8
 _BLOCK = 16
 # The scan forms Phi^k for k up to the span of the run. Beyond this size a power could turn an
 # unexcited unstable mode (0 * huge) into noise or NaN: the modal recursion takes over.
@@ -614,7 +617,8 @@ class _Plan:
             if depth == 0:
                 self.levels[key] = _first_level(self.P, self.G, L)
             else:
-                self.levels[key] = _block_matrices(self.level(depth - 1, _BLOCK)[0], L)
+                below = _FIRST_BLOCK if depth == 1 else _BLOCK
+                self.levels[key] = _block_matrices(self.level(depth - 1, below)[0], L)
         return self.levels[key]
 
 
@@ -720,7 +724,7 @@ def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray, W: np.ndarray) -> np.ndar
     """
     ns, N = S.shape
     nx = plan.P.shape[0]
-    L = min(_BLOCK, N)
+    L = min(_FIRST_BLOCK, N)
     nb, r = divmod(N, L)
     PL, KW, Kend = plan.level(0, L)
     A = np.empty((nb + (r > 0), ns * L + nx))
