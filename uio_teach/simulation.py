@@ -24,23 +24,31 @@ involved: the only approximation is the straight line drawn between input
 samples, so smooth inputs converge like ``h**2`` and piecewise-linear inputs
 are simulated exactly (to rounding).
 
-**Fast recursion.** The recursion ``z[k+1] = Phi z[k] + f[k]`` is run in the
-real Schur coordinates of the balanced ``Phi`` (``Phi = D Z T Z^T D^-1``, ``D``
-a diagonal scaling by powers of 2, ``Z`` orthogonal, ``T`` block upper
-triangular). The blocks are solved last first: a block's forcing for every
-step, the inputs and the coupling to the blocks below, is one matrix product;
-a real eigenvalue is then a scalar first-order recursion and a complex pair one
-complex scalar recursion, which :func:`scipy.signal.lfilter` runs in compiled
-code. There is no Python loop over the samples. A complex pair too close to
-defective to be split into its modes is run instead in the triangular complex
-Schur form (every coordinate a scalar recursion coupled to those below). While
-it runs, BLAS is limited to one thread (with threadpoolctl, when installed):
-the products are small or thin, and on a 2-core machine OpenBLAS's worker
-threads made the whole simulation about three to ten times slower.
+**Fast recursion.** The recursion ``z[k+1] = Phi z[k] + f[k]`` is run as a
+block scan of matrix products, with no Python loop over the samples. In a
+block of ``L`` steps every state is a power of ``Phi`` applied to the block's
+first state plus powers of ``Phi`` applied to the block's inputs: for all blocks
+at once, one product of the inputs with a block Toeplitz matrix. The blocks'
+first states obey the same recursion with ``Phi^L``, ``L`` times shorter, solved
+the same way. The measurements and estimates are folded into the last product,
+so the states are read off directly. ``Phi`` is balanced first (a diagonal
+scaling by powers of 2, exact), so that states of very different size keep
+their accuracy; no eigenvectors are formed, so defective and non-normal
+matrices need no special care. The one-step matrices are kept for the few
+systems simulated last, so rerunning an observer on the same grid skips the
+matrix exponential. A run whose powers of ``Phi`` leave the range of doubles
+(a fast unstable pole over a long span) is run instead mode by mode in
+balanced real Schur coordinates (:func:`scipy.signal.lfilter` for each real
+pole and each complex pair), where a mode that nothing excites stays exactly
+zero. While it runs, BLAS is limited to one thread (with threadpoolctl, when
+installed): the products are small or thin, and on a 2-core machine
+OpenBLAS's worker threads made the whole simulation about three to ten times
+slower.
 """
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, NamedTuple
@@ -744,14 +752,16 @@ def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray, W: np.ndarray) -> np.ndar
 
 _PLANS: dict[tuple, _Plan] = {}
 _PLANS_KEPT = 8  # systems whose one-step matrices are kept (the most recently used)
+_PLANS_LOCK = threading.Lock()
 
 
-def _plan(key: tuple | None, make: Callable[[], tuple]) -> _Plan:
+def _plan(key: tuple, make: Callable[[], tuple]) -> _Plan:
     """The plan of a system and step, built once: recalled while the same observer is rerun."""
-    plan = _PLANS.pop(key, None) if key is not None else None
+    with _PLANS_LOCK:
+        plan = _PLANS.pop(key, None)
     if plan is None:
         plan = _Plan(*make())
-    if key is not None:
+    with _PLANS_LOCK:
         _PLANS[key] = plan  # most recent last
         while len(_PLANS) > _PLANS_KEPT:
             del _PLANS[next(iter(_PLANS))]
@@ -967,8 +977,8 @@ def linear_response(
     :func:`~uio_teach.observer_residual` both run on it): in
     continuous time the inputs are taken as linear between samples and the
     system is solved exactly over each step (first-order hold, one matrix
-    exponential per step size), with the fast Schur recursion on a uniform
-    grid; in discrete time the recursion itself. BLAS is limited to one
+    exponential per step size), with the block scan on a uniform grid
+    (see the module documentation); in discrete time the recursion itself. BLAS is limited to one
     thread while it runs.
 
     Parameters
@@ -984,8 +994,7 @@ def linear_response(
     output : numpy.ndarray, shape (k, nz + ns), optional
         Return ``output @ [z; s]`` (signals read off the states and the
         inputs, such as measurements and estimates) instead of ``z``: it is
-        folded into the last change of coordinates, one product instead of
-        two passes over the states.
+        folded into the scan's last product, so the states are never stored.
 
     Returns
     -------
@@ -1104,7 +1113,7 @@ def simulate(
     ...`` when discrete) drives the observer ``w' = A_o w + B_u u + B_y y``,
     ``xhat = C_o w + D_y y``. In continuous time the inputs are linear between
     the time points (first-order hold) and the joint system is solved exactly
-    for them, by one matrix exponential and a compiled recursion (see the
+    for them, by one matrix exponential and a block scan of matrix products (see the
     module documentation); in discrete time the recursion is the plant's own.
 
     Parameters
