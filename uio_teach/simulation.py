@@ -635,8 +635,12 @@ def _powers(P: np.ndarray, L: int) -> np.ndarray:
     nx = P.shape[0]
     pw = np.empty((L + 1, nx, nx))
     pw[0] = np.eye(nx)
-    for i in range(L):
-        np.matmul(P, pw[i], out=pw[i + 1])
+    pw[1] = P
+    known = 1  # P^1 ... P^known are in place: the next ones are those times P^known
+    while known < L:
+        more = min(known, L - known)
+        np.matmul(pw[1 : more + 1], pw[known], out=pw[known + 1 : known + more + 1])
+        known += more
     if not np.abs(pw).max() <= _GROWTH:
         raise _Growth
     pw[np.abs(pw) < _NEGLIGIBLE] = 0.0
