@@ -183,7 +183,8 @@ class UIOResponse:
         self.outputs = outputs
         self.estimates = estimates
         self.error = states - estimates
-        self.residual = outputs - plant.C @ estimates
+        residual = plant.C @ estimates
+        self.residual = np.subtract(outputs, residual, out=residual)
         self.inputs = inputs
         self.observer_states = observer_states
         self.plant = plant
@@ -259,7 +260,8 @@ def _uniform_step(t: np.ndarray) -> float | None:
     """The step of a uniform grid (``None`` if the spacing varies beyond rounding)."""
     h = (t[-1] - t[0]) / (t.size - 1)
     tol = 1e-9 * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
-    if np.max(np.abs(np.diff(t) - h)) <= tol:
+    steps = np.diff(t)
+    if max(steps.max() - h, h - steps.min()) <= tol:
         return float(h)
     return None
 
@@ -455,7 +457,12 @@ def joint_system(plant: Plant, observer: Observer) -> tuple[np.ndarray, np.ndarr
     >>> Az.shape, Bz.shape
     ((6, 6), (6, 5))
     """
-    A_o, B_u, B_y, _, _ = observer.realization()
+    return _joint(plant, observer.realization())
+
+
+def _joint(plant: Plant, realization: Any) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`joint_system` from the observer's realization, already at hand."""
+    A_o, B_u, B_y, _, _ = realization
     n, nw = plant.n, A_o.shape[0]
     q, r, p = plant.q, plant.nv, plant.p
     m = plant.m
@@ -1268,7 +1275,7 @@ def simulate(
     w0 = _vector("observer_state", observer_state, nw, f"one value per observer state, n_w = {nw}")
     z0 = np.concatenate([x0, w0])
 
-    Az, Bz = joint_system(plant, observer)
+    Az, Bz = _joint(plant, real)
     # the signals read off [z; s] = [x; w; u; d; v; noise], one row block each:
     # x, w, y = C x + D v + noise and xhat = C_o w + D_y y
     n = plant.n
