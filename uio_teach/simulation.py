@@ -1010,8 +1010,9 @@ def linear_response(
     Returns
     -------
     numpy.ndarray, shape (nz, N) or (k, N)
-        May contain non-finite values when the response overflows; callers
-        check the range.
+        Time along the second axis; stored time-major (the transpose of a
+        C-ordered array) when the block scan computed it. May contain
+        non-finite values when the response overflows; callers check the range.
 
     Raises
     ------
