@@ -1036,7 +1036,7 @@ def linear_response(
     with _one_blas_thread(), np.errstate(all="ignore"):
         if discrete:
             key = ("discrete", A.shape, B.shape, A.tobytes(), B.tobytes())
-            return _recursion(_plan(key, lambda: (A, B, None)), S, z0, output)
+            return _recursion(_plan(key, lambda: (A.copy(), B.copy(), None)), S, z0, output)
         h = _uniform_step(t)
         if h is None:
             return _map(output, _stepwise(A, B, t, S, z0), S)
