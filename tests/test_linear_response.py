@@ -128,3 +128,18 @@ def test_the_first_state_is_the_initial_state_exactly():
     z0 = np.array([0.1, 1e-17])
     z = linear_response(A, np.zeros((2, 0)), t, np.zeros((0, t.size)), z0)
     assert z[:, 0].tolist() == z0.tolist()
+
+
+@pytest.mark.parametrize("discrete", [False, True], ids=["continuous", "discrete"])
+def test_a_system_changed_in_place_is_not_taken_for_the_one_before(discrete):
+    """The one-step matrices are kept per system and step: a matrix edited in place, or another
+    step, is a new system."""
+    A = np.array([[-1.0, 2.0], [0.0, -3.0]]) if not discrete else np.array([[0.9, 0.1], [0, 0.5]])
+    B = np.array([[0.0], [1.0]])
+    z0 = np.array([1.0, -1.0])
+    for t in (np.linspace(0.0, 2.0, 201), np.linspace(0.0, 2.0, 401), np.linspace(0.0, 2.0, 401)):
+        S = np.vstack([np.cos(t)])
+        z = linear_response(A, B, t, S, z0, discrete=discrete)
+        ref, Phi = _loop(A, B, t, S, z0, discrete)
+        assert np.abs(z - ref).max() <= _tolerance(ref, Phi)
+        A[0, 1] *= -0.5  # edited in place after each run
