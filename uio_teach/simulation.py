@@ -24,23 +24,31 @@ involved: the only approximation is the straight line drawn between input
 samples, so smooth inputs converge like ``h**2`` and piecewise-linear inputs
 are simulated exactly (to rounding).
 
-**Fast recursion.** The recursion ``z[k+1] = Phi z[k] + f[k]`` is run in the
-real Schur coordinates of the balanced ``Phi`` (``Phi = D Z T Z^T D^-1``, ``D``
-a diagonal scaling by powers of 2, ``Z`` orthogonal, ``T`` block upper
-triangular). The blocks are solved last first: a block's forcing for every
-step, the inputs and the coupling to the blocks below, is one matrix product;
-a real eigenvalue is then a scalar first-order recursion and a complex pair one
-complex scalar recursion, which :func:`scipy.signal.lfilter` runs in compiled
-code. There is no Python loop over the samples. A complex pair too close to
-defective to be split into its modes is run instead in the triangular complex
-Schur form (every coordinate a scalar recursion coupled to those below). While
-it runs, BLAS is limited to one thread (with threadpoolctl, when installed):
-the products are small or thin, and on a 2-core machine OpenBLAS's worker
-threads made the whole simulation about three to ten times slower.
+**Fast recursion.** The recursion ``z[k+1] = Phi z[k] + f[k]`` is run as a
+block scan of matrix products, with no Python loop over the samples. In a
+block of ``L`` steps every state is a power of ``Phi`` applied to the block's
+first state plus powers of ``Phi`` applied to the block's inputs: for all blocks
+at once, one product of the inputs with a block Toeplitz matrix. The blocks'
+first states obey the same recursion with ``Phi^L``, ``L`` times shorter, solved
+the same way. The measurements and estimates are folded into the last product,
+so the states are read off directly. ``Phi`` is balanced first (a diagonal
+scaling by powers of 2, exact), so that states of very different size keep
+their accuracy; no eigenvectors are formed, so defective and non-normal
+matrices need no special care. The one-step matrices are kept for the few
+systems simulated last, so rerunning an observer on the same grid skips the
+matrix exponential. A run whose powers of ``Phi`` leave the range of doubles
+(a fast unstable pole over a long span) is run instead mode by mode in
+balanced real Schur coordinates (:func:`scipy.signal.lfilter` for each real
+pole and each complex pair), where a mode that nothing excites stays exactly
+zero. While it runs, BLAS is limited to one thread (with threadpoolctl, when
+installed): the products are small or thin, and on a 2-core machine
+OpenBLAS's worker threads made the whole simulation about three to ten times
+slower.
 """
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, NamedTuple
@@ -175,7 +183,8 @@ class UIOResponse:
         self.outputs = outputs
         self.estimates = estimates
         self.error = states - estimates
-        self.residual = outputs - plant.C @ estimates
+        residual = plant.C @ estimates
+        self.residual = np.subtract(outputs, residual, out=residual)
         self.inputs = inputs
         self.observer_states = observer_states
         self.plant = plant
@@ -251,7 +260,8 @@ def _uniform_step(t: np.ndarray) -> float | None:
     """The step of a uniform grid (``None`` if the spacing varies beyond rounding)."""
     h = (t[-1] - t[0]) / (t.size - 1)
     tol = 1e-9 * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
-    if np.max(np.abs(np.diff(t) - h)) <= tol:
+    steps = np.diff(t)
+    if max(steps.max() - h, h - steps.min()) <= tol:
         return float(h)
     return None
 
@@ -350,7 +360,7 @@ def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.nda
                 f"{name} must have shape {accepted} (one row per channel, one column per time "
                 f"point), got {arr.shape}"
             )
-    if not np.all(np.isfinite(arr)):
+    if not (np.isfinite(arr.min()) and np.isfinite(arr.max())):  # a NaN or an infinity
         i, j = (int(a) for a in np.argwhere(~np.isfinite(arr))[0])
         raise ValueError(
             f"{name} has a non-finite value {arr[i, j]} in channel {i} at time point {j} "
@@ -388,7 +398,7 @@ def _noise(noise: Any, seed: Any, p: int, N: int) -> np.ndarray:
     return sd[:, None] * rng.standard_normal((p, N))
 
 
-_CONTROLLER: Any = None
+_BLAS_LIBRARIES: list | None = None
 
 
 @contextmanager
@@ -397,22 +407,26 @@ def _one_blas_thread() -> Iterator[None]:
 
     The products here are small or thin (8 x 10 x N); on a 2-core machine
     OpenBLAS's worker threads make them several times slower, not faster.
-    The controller is built once (that is the slow part of threadpoolctl).
+    The BLAS libraries are looked up once (the slow part of threadpoolctl);
+    then each run only reads and sets their thread counts.
     """
-    global _CONTROLLER
-    if _CONTROLLER is None:
+    global _BLAS_LIBRARIES
+    if _BLAS_LIBRARIES is None:
         try:
             # deferred on purpose: optional, and only needed once a simulation runs
             from threadpoolctl import ThreadpoolController
         except ImportError:  # pragma: no cover - threadpoolctl is optional
-            _CONTROLLER = False
+            _BLAS_LIBRARIES = []
         else:
-            _CONTROLLER = ThreadpoolController()
-    if _CONTROLLER is False:  # pragma: no cover
+            _BLAS_LIBRARIES = ThreadpoolController().select(user_api="blas").lib_controllers
+    before = [lib.get_num_threads() for lib in _BLAS_LIBRARIES]
+    try:
+        for lib in _BLAS_LIBRARIES:
+            lib.set_num_threads(1)
         yield
-        return
-    with _CONTROLLER.limit(limits=1, user_api="blas"):
-        yield
+    finally:
+        for lib, threads in zip(_BLAS_LIBRARIES, before, strict=True):
+            lib.set_num_threads(threads)
 
 
 # the joint system and its solution --------------------------------------------------------
@@ -443,16 +457,25 @@ def joint_system(plant: Plant, observer: Observer) -> tuple[np.ndarray, np.ndarr
     >>> Az.shape, Bz.shape
     ((6, 6), (6, 5))
     """
-    A_o, B_u, B_y, _, _ = observer.realization()
+    return _joint(plant, observer.realization())
+
+
+def _joint(plant: Plant, realization: Any) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`joint_system` from the observer's realization, already at hand."""
+    A_o, B_u, B_y, _, _ = realization
     n, nw = plant.n, A_o.shape[0]
     q, r, p = plant.q, plant.nv, plant.p
-    Az = np.block([[plant.A, np.zeros((n, nw))], [B_y @ plant.C, A_o]])
-    Bz = np.block(
-        [
-            [plant.B, plant.E, np.zeros((n, r)), np.zeros((n, p))],
-            [B_u, np.zeros((nw, q)), B_y @ plant.D, B_y],
-        ]
-    )
+    m = plant.m
+    Az = np.zeros((n + nw, n + nw))
+    Az[:n, :n] = plant.A
+    Az[n:, :n] = B_y @ plant.C
+    Az[n:, n:] = A_o
+    Bz = np.zeros((n + nw, m + q + r + p))
+    Bz[:n, :m] = plant.B
+    Bz[:n, m : m + q] = plant.E
+    Bz[n:, :m] = B_u
+    Bz[n:, m + q : m + q + r] = B_y @ plant.D
+    Bz[n:, m + q + r :] = B_y
     return Az, Bz
 
 
@@ -563,7 +586,233 @@ def _real_modes(T: np.ndarray) -> list[tuple[int, int, Any]] | None:
     return blocks[::-1]
 
 
+# Block lengths of the scan: a block's own response is one product with a block Toeplitz matrix
+# of L x L blocks (cost ~ L per sample), the block starts one recursion L times shorter. The
+# first level, over all samples, reads the inputs and writes the signals: short blocks keep
+# its product small; the levels above run on few block starts, where longer blocks save steps.
+_FIRST_BLOCK = 8
+_BLOCK = 16
+# The scan forms Phi^k for k up to the span of the run. Beyond this size a power could turn an
+# unexcited unstable mode (0 * huge) into noise or NaN: the modal recursion takes over.
+_GROWTH = 1e100
+# Entries of a power of Phi below this are set to zero: they add nothing a double can hold to
+# the states, and subnormal numbers would make the products many times slower.
+_NEGLIGIBLE = 1e-290
+
+
+class _Growth(Exception):
+    """A power of ``Phi`` too large for the block scan."""
+
+
+class _Plan:
+    """The one-step matrices of a system on a uniform grid, and the scan's matrices per level.
+
+    Level ``d`` runs ``x[k+1] = P_d x[k] + G_d u[k]`` with ``P_0 = D^-1 Phi D`` (balanced,
+    ``D`` diagonal of powers of 2), ``G_0 = D^-1 Gam`` and, above it, ``P_d = P_(d-1)^L``,
+    ``G_d = I``. A level of block length ``L`` keeps ``P_d^L`` and the matrix ``KW`` that
+    maps one block's inputs (input channel by channel at level 0, time step by time step
+    above) and its starting state to the ``L`` states that follow.
+    """
+
+    def __init__(self, Phi: np.ndarray, G0: np.ndarray, G1: np.ndarray | None) -> None:
+        _, (scale, _) = sla.matrix_balance(Phi, permute=False, separate=True)
+        if G1 is None:
+            Gam, G1 = G0, np.zeros_like(G0)
+        else:
+            Gam = G0 + Phi @ G1
+        self.Phi, self.G0, self.G1, self.scale = Phi, G0, G1, scale
+        self.P = Phi * (scale[None, :] / scale[:, None])
+        self.G = Gam / scale[:, None]
+        self.levels: dict[tuple[int, int], tuple[int, np.ndarray, np.ndarray]] = {}
+
+    def level(self, depth: int, L: int) -> tuple[np.ndarray, ...]:
+        """``(P_d^L, KW, ...)`` of level ``depth`` for blocks of ``L`` steps."""
+        key = (depth, L)
+        if key not in self.levels:
+            if depth == 0:
+                self.levels[key] = _first_level(self.P, self.G, L)
+            else:
+                below = _FIRST_BLOCK if depth == 1 else _BLOCK
+                self.levels[key] = _block_matrices(self.level(depth - 1, below)[0], L)
+        return self.levels[key]
+
+
+def _powers(P: np.ndarray, L: int) -> np.ndarray:
+    """``P^0 ... P^L`` stacked; :class:`_Growth` if one exceeds ``_GROWTH`` or is not finite."""
+    nx = P.shape[0]
+    pw = np.empty((L + 1, nx, nx))
+    pw[0] = np.eye(nx)
+    pw[1] = P
+    known = 1  # P^1 ... P^known are in place: the next ones are those times P^known
+    while known < L:
+        more = min(known, L - known)
+        np.matmul(pw[1 : more + 1], pw[known], out=pw[known + 1 : known + more + 1])
+        known += more
+    if not np.abs(pw).max() <= _GROWTH:
+        raise _Growth
+    pw[np.abs(pw) < _NEGLIGIBLE] = 0.0
+    return pw
+
+
+def _first_level(P: np.ndarray, G: np.ndarray, L: int) -> tuple[np.ndarray, ...]:
+    """``(P^L, KW, Kend)`` for blocks of ``L`` steps of ``x[k+1] = P x[k] + G s[k]``.
+
+    A block's row ``[s_block, x[bL]]`` (inputs channel by channel, then the block's
+    start) times ``KW`` gives ``[x[bL + i], s[bL + i]]`` for ``i = 0 ... L-1``: the
+    states with the inputs beside them (copied exactly, by ones), ready for the outputs.
+    ``KW = [K; W]``: ``K`` block Toeplitz with blocks ``(P^(i-1-j) G)^T`` for ``j < i``,
+    ``W = [I, P^T, ... (P^(L-1))^T]``. ``s_block @ Kend`` is the block's end state
+    ``x[bL + L]`` from rest.
+    """
+    nx, ns = G.shape
+    pw = _powers(P, L)
+    PG = np.concatenate([np.zeros((1, nx, ns)), pw[:L] @ G])  # P^(m-1) G, zero for m = 0
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # i - j: input step j, state step i
+    # KW[channel, j, i, state + input]
+    KW = np.zeros((ns, L, L, nx + ns))
+    KW[..., :nx] = PG.transpose(2, 0, 1)[:, np.maximum(lag, 0)]  # [channel, j, i, state]
+    KW[:, lag < 0, :nx] = 0.0
+    j = np.arange(L)
+    KW[:, j, j, nx:] = np.eye(ns)[:, None, :]
+    W = np.zeros((nx, L, nx + ns))
+    W[:, :, :nx] = pw[:L].transpose(2, 0, 1)
+    KW = np.vstack([KW.reshape(ns * L, L * (nx + ns)), W.reshape(nx, L * (nx + ns))])
+    Kend = PG[L:0:-1].transpose(2, 0, 1).reshape(ns * L, nx)  # rows (channel, j): P^(L-1-j) G
+    return pw[L], KW, Kend
+
+
+def _block_matrices(P: np.ndarray, L: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(P^L, KW)`` for blocks of ``L`` steps of ``x[k+1] = P x[k] + u[k]``.
+
+    A block's row ``[u[bL], ... u[bL + L-1], x[bL]]`` times ``KW`` gives its states
+    ``x[bL + 1 ... bL + L]`` in a row: ``KW = [K; W]``, ``K`` block upper triangular
+    Toeplitz with blocks ``(P^(i-j))^T`` and ``W = [P^T, (P^2)^T, ... (P^L)^T]``.
+    """
+    nx = P.shape[0]
+    pw = _powers(P, L)
+    lag = np.arange(L)[None, :] - np.arange(L)[:, None]  # i - j: input step j, state step i
+    K = pw[:L].transpose(0, 2, 1)[np.maximum(lag, 0)]  # [j, i, input, state]
+    K[lag < 0] = 0.0
+    K = K.transpose(0, 2, 1, 3).reshape(L * nx, L * nx)
+    W = pw[1:].transpose(2, 0, 1).reshape(nx, L * nx)
+    return pw[L], np.vstack([K, W])
+
+
+def _scan_steps(plan: _Plan, depth: int, U: np.ndarray, x0: np.ndarray) -> np.ndarray:
+    """States ``x[0 ... M]`` of ``x[k+1] = P_d x[k] + u[k]`` for the rows ``u[k]`` of ``U``.
+
+    In blocks of ``L`` steps; the block starts ``x[bL]`` obey ``x[(b+1)L] = P_d^L x[bL] +
+    e_b`` (``e_b`` the block's end state from rest), level ``depth + 1``; then all
+    states are one product.
+    """
+    M, nx = U.shape
+    L = min(_BLOCK, M)
+    nb, r = divmod(M, L)
+    PL, KW = plan.level(depth, L)
+    A = np.empty((nb + (r > 0), (L + 1) * nx))
+    A[:nb, : L * nx] = U[: nb * L].reshape(nb, L * nx)
+    if r:
+        A[nb, : r * nx] = U[nb * L :].ravel()
+        A[nb, r * nx : L * nx] = 0.0
+    _starts(plan, depth, A, A[:-1, : L * nx] @ KW[: L * nx, -nx:], x0)
+    X = np.empty((A.shape[0] * L + 1, nx))
+    X[0] = x0
+    np.matmul(A, KW, out=X[1:].reshape(A.shape[0], L * nx))
+    return X[: M + 1]
+
+
+def _starts(plan: _Plan, depth: int, A: np.ndarray, ends: np.ndarray, x0: np.ndarray) -> None:
+    """The block starts into the last columns of ``A``, from the blocks' ends from rest."""
+    nx = x0.size
+    if A.shape[0] == 1:
+        A[0, -nx:] = x0
+    else:
+        A[:, -nx:] = _scan_steps(plan, depth + 1, ends, x0)
+
+
+def _scan(plan: _Plan, S: np.ndarray, xi0: np.ndarray, W: np.ndarray) -> np.ndarray:
+    """The signals ``W @ [xi'[k]; s[k]]`` (``xi' = D^-1 xi`` balanced), shape (N, rows).
+
+    Time runs along the first axis. A parallel scan in blocks of ``L`` steps: inside a
+    block the response from rest, ``x[bL + i] - P^i x[bL] = sum_j P^(i-1-j) G s[bL + j]``,
+    is one product of all blocks' inputs with a block Toeplitz matrix; the block starts
+    obey a recursion ``L`` times shorter, solved the same way (:func:`_scan_steps`). Every
+    term is a power of ``P`` applied to a state or an input, as in the one-step recursion,
+    with fewer roundings. The map ``W`` to the signals is folded into the last product, so
+    that the states themselves are never stored.
+    """
+    ns, N = S.shape
+    nx = plan.P.shape[0]
+    L = min(_FIRST_BLOCK, N)
+    nb, r = divmod(N, L)
+    PL, KW, Kend = plan.level(0, L)
+    A = np.empty((nb + (r > 0), ns * L + nx))
+    blocks = A[:, : ns * L].reshape(A.shape[0], ns, L).transpose(1, 0, 2)  # [channel, block, step]
+    blocks[:, :nb] = S[:, : nb * L].reshape(ns, nb, L)
+    if r:
+        blocks[:, nb, :r] = S[:, nb * L :]
+        blocks[:, nb, r:] = 0.0
+    x0 = xi0 / plan.scale
+    _starts(plan, 0, A, A[:-1, : ns * L] @ Kend, x0)
+    rows = W.shape[0]
+    KWout = (KW.reshape(-1, nx + ns) @ W.T).reshape(KW.shape[0], L * rows)
+    Y = np.empty((A.shape[0] * L, rows))
+    np.matmul(A, KWout, out=Y.reshape(A.shape[0], L * rows))
+    return Y[:N]
+
+
+_PLANS: dict[tuple, _Plan] = {}
+_PLANS_KEPT = 8  # systems whose one-step matrices are kept (the most recently used)
+_PLANS_LOCK = threading.Lock()
+
+
+def _plan(key: tuple, make: Callable[[], tuple]) -> _Plan:
+    """The plan of a system and step, built once: recalled while the same observer is rerun."""
+    with _PLANS_LOCK:
+        plan = _PLANS.pop(key, None)
+    if plan is None:
+        plan = _Plan(*make())
+    with _PLANS_LOCK:
+        _PLANS[key] = plan  # most recent last
+        while len(_PLANS) > _PLANS_KEPT:
+            del _PLANS[next(iter(_PLANS))]
+    return plan
+
+
 def _recursion(
+    plan: _Plan, S: np.ndarray, z0: np.ndarray, output: np.ndarray | None = None
+) -> np.ndarray:
+    """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
+
+    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
+
+    ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
+    ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
+    diagonal ``D`` of powers of 2, exact), so that states of very different
+    size keep their own relative accuracy. The recursion is then run by the
+    block scan :func:`_scan` (matrix products only, no eigenvectors: defective and
+    non-normal ``Phi`` need no special care), and ``z = D xi' + G1 s`` is mapped
+    to the outputs in one more product. When a power of ``Phi`` over the span grows
+    too large for the scan (a fast unstable pole), :func:`_recursion_modes` runs it
+    mode by mode instead.
+    """
+    nz = plan.P.shape[0]
+    G1, scale = plan.G1, plan.scale
+    # z = D xi' + G1 s, and on to the outputs if asked: W @ [xi'; s]
+    if output is None:
+        W = np.hstack([np.diag(scale), G1])
+    else:
+        W = np.hstack([output[:, :nz] * scale[None, :], output[:, :nz] @ G1 + output[:, nz:]])
+    try:
+        out = _scan(plan, S, z0 - G1 @ S[:, 0], W).T
+    except _Growth:
+        return _recursion_modes(plan.Phi, plan.G0, plan.G1, S, z0, output)
+    # the first column exactly, not through the change of coordinates
+    out[:, 0] = z0 if output is None else output @ np.concatenate([z0, S[:, 0]])
+    return out
+
+
+def _recursion_modes(
     Phi: np.ndarray,
     G0: np.ndarray,
     G1: np.ndarray | None,
@@ -571,9 +820,7 @@ def _recursion(
     z0: np.ndarray,
     output: np.ndarray | None = None,
 ) -> np.ndarray:
-    """All states of ``z[k+1] = Phi z[k] + G0 s[k] + G1 s[k+1]``, ``z[0] = z0``.
-
-    With ``output``, ``output @ [z; s]`` instead (see :func:`linear_response`).
+    """:func:`_recursion` mode by mode: for powers of ``Phi`` too large for the block scan.
 
     ``xi[k] = z[k] - G1 s[k]`` obeys ``xi[k+1] = Phi xi[k] + Gam s[k]`` with
     ``Gam = G0 + Phi G1``. ``Phi`` is first balanced (``D^-1 Phi D`` with a
@@ -741,8 +988,8 @@ def linear_response(
     :func:`~uio_teach.observer_residual` both run on it): in
     continuous time the inputs are taken as linear between samples and the
     system is solved exactly over each step (first-order hold, one matrix
-    exponential per step size), with the fast Schur recursion on a uniform
-    grid; in discrete time the recursion itself. BLAS is limited to one
+    exponential per step size), with the block scan on a uniform grid
+    (see the module documentation); in discrete time the recursion itself. BLAS is limited to one
     thread while it runs.
 
     Parameters
@@ -758,14 +1005,14 @@ def linear_response(
     output : numpy.ndarray, shape (k, nz + ns), optional
         Return ``output @ [z; s]`` (signals read off the states and the
         inputs, such as measurements and estimates) instead of ``z``: it is
-        folded into the last change of coordinates, one product instead of
-        two passes over the states.
+        folded into the scan's last product, so the states are never stored.
 
     Returns
     -------
     numpy.ndarray, shape (nz, N) or (k, N)
-        May contain non-finite values when the response overflows; callers
-        check the range.
+        Time along the second axis; stored time-major (the transpose of a
+        C-ordered array) when the block scan computed it. May contain
+        non-finite values when the response overflows; callers check the range.
 
     Raises
     ------
@@ -788,19 +1035,25 @@ def linear_response(
     z0 = np.asarray(initial_state, float)
     with _one_blas_thread(), np.errstate(all="ignore"):
         if discrete:
-            return _recursion(A, B, None, S, z0, output)
+            key = ("discrete", A.shape, B.shape, A.tobytes(), B.tobytes())
+            return _recursion(_plan(key, lambda: (A.copy(), B.copy(), None)), S, z0, output)
         h = _uniform_step(t)
         if h is None:
             return _map(output, _stepwise(A, B, t, S, z0), S)
-        Phi, G0, G1 = foh_matrices(A, B, h)
-        if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
-            poles = np.linalg.eigvals(A)
-            raise SimulationOverflowError(
-                "the response leaves the floating-point range within one time step",
-                poles[poles.real > 0],
-                float(t[min(1, t.size - 1)]),
-            )
-        return _recursion(Phi, G0, G1, S, z0, output)
+
+        def one_step() -> tuple[np.ndarray, ...]:
+            Phi, G0, G1 = foh_matrices(A, B, h)
+            if not (np.all(np.isfinite(Phi)) and np.all(np.isfinite(G0 + G1))):
+                poles = np.linalg.eigvals(A)
+                raise SimulationOverflowError(
+                    "the response leaves the floating-point range within one time step",
+                    poles[poles.real > 0],
+                    float(t[min(1, t.size - 1)]),
+                )
+            return Phi, G0, G1
+
+        key = (h, A.shape, B.shape, A.tobytes(), B.tobytes())
+        return _recursion(_plan(key, one_step), S, z0, output)
 
 
 _BIG = 1e300  # beyond this a response is about to leave the float range (1.8e308)
@@ -872,7 +1125,7 @@ def simulate(
     ...`` when discrete) drives the observer ``w' = A_o w + B_u u + B_y y``,
     ``xhat = C_o w + D_y y``. In continuous time the inputs are linear between
     the time points (first-order hold) and the joint system is solved exactly
-    for them, by one matrix exponential and a compiled recursion (see the
+    for them, by one matrix exponential and a block scan of matrix products (see the
     module documentation); in discrete time the recursion is the plant's own.
 
     Parameters
@@ -993,15 +1246,27 @@ def simulate(
     if plant.is_discrete:
         _check_discrete_grid(plant, t)
 
-    # all inputs in one array s = [u; d; v; noise]; the recorded inputs are views of it
+    # the given inputs in one array; the recorded inputs are views of it, and those not given
+    # are zero (read-only views of a single zero: no memory)
     m, q, r, p = plant.m, plant.q, plant.nv, plant.p
-    S = np.empty((m + q + r + p, N))
-    S[:m] = input_samples("u", u, m, t)
-    S[m : m + q] = input_samples("d", d, q, t)
-    S[m + q : m + q + r] = input_samples("v", v, r, t)
-    S[m + q + r :] = _noise(noise, seed, p, N)
+    channels = [("u", u, m), ("d", d, q), ("v", v, r), ("noise", noise, p)]
+    given = [value is not None for _, value, _ in channels]
+    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
+    S = np.empty((keep.size, N))
+    recorded = {}
+    row = 0
+    for (name, value, size), is_given in zip(channels, given, strict=True):
+        if not is_given:
+            recorded[name] = np.broadcast_to(np.zeros(()), (size, N))
+            continue
+        if name == "noise":
+            S[row : row + size] = _noise(noise, seed, p, N)
+        else:
+            S[row : row + size] = input_samples(name, value, size, t)
+        recorded[name] = S[row : row + size]
+        row += size
     S.setflags(write=False)
-    inputs = SimulationInputs(u=S[:m], d=S[m : m + q], v=S[m + q : m + q + r], noise=S[m + q + r :])
+    inputs = SimulationInputs(**recorded)
 
     real = observer.realization()
     nw = real.A.shape[0]
@@ -1011,24 +1276,23 @@ def simulate(
     w0 = _vector("observer_state", observer_state, nw, f"one value per observer state, n_w = {nw}")
     z0 = np.concatenate([x0, w0])
 
-    Az, Bz = joint_system(plant, observer)
+    Az, Bz = _joint(plant, real)
     # the signals read off [z; s] = [x; w; u; d; v; noise], one row block each:
     # x, w, y = C x + D v + noise and xhat = C_o w + D_y y
     n = plant.n
-    ny = np.zeros((p, n + nw + S.shape[0]))
+    ns = m + q + r + p
+    ny = np.zeros((p, n + nw + ns))
     ny[:, :n] = plant.C
     ny[:, n + nw + m + q : n + nw + m + q + r] = plant.D
     ny[:, n + nw + m + q + r :] = np.eye(p)
     nxhat = real.D_y @ ny
     nxhat[:, n : n + nw] += real.C
-    output = np.vstack([np.eye(n + nw, n + nw + S.shape[0]), ny, nxhat])
+    output = np.vstack([np.eye(n + nw, n + nw + ns), ny, nxhat])
     # inputs that were not given are zero and add nothing: the engine sees the others alone
-    given = [u is not None, d is not None, v is not None, noise is not None]
-    keep = np.flatnonzero(np.repeat(given, [m, q, r, p]))
     output = np.hstack([output[:, : n + nw], output[:, n + nw + keep]])
     try:
         signals = linear_response(
-            Az, Bz[:, keep], t, S[keep], z0, discrete=plant.is_discrete, output=output
+            Az, Bz[:, keep], t, S, z0, discrete=plant.is_discrete, output=output
         )
     except SimulationOverflowError:
         raise _overflow(Az, plant, t, 1) from None
