@@ -485,17 +485,7 @@ def invariant_zeros(
     # Scale first (see the module's tolerance policy): a diagonal similarity balances A,
     # then input and output scalings bring ||B|| and ||C|| to ||A||. The zeros do not change,
     # and no block is judged against another block's size.
-    if n:
-        _, (bal, _) = sla.matrix_balance(A, permute=False, separate=True)
-        A = A / bal[:, None] * bal[None, :]
-        B = B / bal[:, None]
-        C = C * bal[None, :]
-    alpha = max(float(np.linalg.norm(A, 2)), 1.0) if n else 1.0
-    nb = float(np.linalg.norm(B, 2)) if B.size else 0.0
-    nc = float(np.linalg.norm(C, 2)) if C.size else 0.0
-    beta = alpha / nb if nb > 0 else 1.0
-    gamma = alpha / nc if nc > 0 else 1.0
-    B, C, D = B * beta, C * gamma, D * (beta * gamma)
+    A, B, C, D = _scaled_system(A, B, C, D)
     scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
     A1, B1, C1, D1 = _reduce(A, B, C, D, scale)
     A2, B2, C2, D2 = _reduce(A1.T, C1.T, B1.T, D1.T, scale)
