@@ -109,7 +109,7 @@ def read_widgets(text: str) -> list[list[str]]:
                 f"p95 {ratio} of a rebuild",
             ]
         )
-        if "LMI" not in label:
+        if "," not in label:  # one memory figure per explorer, on its main row
             memory.append((label, cells[8]))
     if not rows:
         raise ReportError("no table with an 'explorer' column")
