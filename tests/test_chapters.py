@@ -202,11 +202,13 @@ def test_no_hard_coded_chapter_or_equation_numbers() -> None:
 
 
 @pytest.mark.subprocess  # jupytext asks pandoc for its version
-def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path) -> None:
+def test_chapter_converts_to_a_notebook_without_outputs(tmp_path: Path, monkeypatch) -> None:
     import importlib.util
 
     import nbformat
 
+    # the book's extensions import each other from their folder, as Sphinx loads them
+    monkeypatch.syspath_prepend(str(BOOK.parent / "_ext"))
     spec = importlib.util.spec_from_file_location(
         "chapter_notebooks", BOOK.parent / "_ext" / "chapter_notebooks.py"
     )
