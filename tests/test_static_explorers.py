@@ -175,6 +175,9 @@ _LAYOUT_JS = """(k) => {
           natural: img.naturalWidth, naturalHeight: img.naturalHeight,
           picture: {client: picture.clientWidth, scroll: picture.scrollWidth},
           captions: rect(root.querySelector('.uio-captions')), height: rect(root).height,
+          text: (() => { const t = document.createRange();
+                         t.selectNodeContents(root.querySelector('.uio-caption'));
+                         return t.getBoundingClientRect().height; })(),
           controls, current: img.currentSrc,
           state: {src: img.currentSrc, alt: img.alt,
                   value: root.querySelector('input[type=range]').value,
@@ -263,10 +266,16 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
     for a, b in itertools.pairwise(seen[1:]):
         for key in ("src", "alt", "caption"):
             assert a["state"][key] != b["state"][key], (where, key, a["state"]["value"])
-    # the explorer keeps its height while the slider and the menu move: the page never jumps
-    heights = {round(m["height"], 1) for m in seen}
+    # the page opens with no empty space under the caption (its box holds its text and the
+    # paragraph's margins); from the first move on, the explorer keeps its height while the
+    # slider and the menu move (the box holds the longest caption): the page never jumps
+    first = seen[0]
+    assert first["captions"]["height"] - first["text"] <= 10, (where, first["text"])
+    heights = {round(m["height"], 1) for m in seen[1:]}
     assert len(heights) == 1, (where, heights)
-    assert len({round(m["captions"]["height"], 1) for m in seen}) == 1, where
+    assert len({round(m["captions"]["height"], 1) for m in seen[1:]}) == 1, where
+    assert all(m["captions"]["height"] >= m["text"] for m in seen), where
+    assert first["height"] <= seen[1]["height"] + 0.5, where
     return seen
 
 
@@ -298,7 +307,10 @@ def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
     first = measured["seen"][0]
     print(
         f"{name} at 390 px: explorer {first['box']['width']:.0f} px, picture "
-        f"{first['img']['width']:.0f} x {first['img']['height']:.0f} px"
+        f"{first['img']['width']:.0f} x {first['img']['height']:.0f} px; under the caption "
+        f"{first['captions']['height'] - first['text']:.0f} px at first, the box "
+        f"{first['captions']['height']:.0f} px, {measured['seen'][1]['captions']['height']:.0f} px "
+        "after the first move"
     )
 
 

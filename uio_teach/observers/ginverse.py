@@ -23,8 +23,8 @@ class GInverseObserver(Observer):
 
         K  = Pc E (CE)^g + Kv (I - CE (CE)^g)
         Av = Pc A Pc - Pc E (CE)^g C A Pc,   Cv = (I - CE (CE)^g) C A Pc
-        q' = (Av - Kv Cv) q + G y + (Pc - K C) B u
-        xhat = Pc q + (Cg + Pc K) y
+        z' = (Av - Kv Cv) z + G y + (Pc - K C) B u
+        xhat = Pc z + (Cg + Pc K) y
 
     Built by :func:`design_ginverse`.
 
