@@ -159,7 +159,8 @@ class ExplorerFigure:
     ``o`` invariant zeros, which are the fixed poles; unit circle in discrete
     time) and the applied unknown signals. Each panel has its own vertical
     scale, so a good estimate is not flattened by a bad one. Messages are
-    written under the panels, never over the curves.
+    written under the panels, never over the curves; a legend sits in a band
+    at the top of its panel that the curves do not enter.
 
     :meth:`update` only changes the data of existing lines and texts
     (``set_data``, ``set_text``) and rescales the axes; :meth:`draw` renders
@@ -203,6 +204,8 @@ class ExplorerFigure:
         ``"signals"``.
     lines : dict
         The lines of each curve by the name of the curve, one per channel.
+    bands : dict
+        By panel name, the fraction of the panel's height kept for its legend.
 
     Examples
     --------
