@@ -32,8 +32,8 @@ import pytest
 import test_book
 from test_book import PAGES, ROOT, SCREENSHOTS, _open_local
 
-# the book, its local server and the browser of test_book (one build per test run)
-built_book = test_book.built_book
+# the book (conftest's built_book), its local server and the browser of test_book (one build
+# per test run)
 book_server = test_book.book_server
 browser = test_book.browser
 

@@ -282,7 +282,7 @@ class ExplorerFigure:
         --------
         >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
         >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
-        6.5
+        7.0
         """
         texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
         return float(min(t.get_fontsize() for t in texts))
