@@ -464,6 +464,8 @@ class ExplorerFigure:
         style = {"drawstyle": "steps-post"} if sc.discrete else {}
         sig = self.axes["signals"]
         sig.set_ylabel("unknown inputs", fontsize=8 * k)
+        if self.narrow:  # beside the pole map: the label on the free right edge, not over the map
+            sig.yaxis.set_label_position("right")
         self.lines["d"] = [
             sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sc.input_symbol, i), **style)[0]
             for i in range(plant.q)
