@@ -51,7 +51,7 @@ def expected_values(lab: str) -> np.ndarray:
     elif lab == "case_study":
         mats = [case_study.M, case_study.A1, case_study.L, case_study.L_SOLVED, case_study.L_MOVED]
     else:
-        mats = [missile.M, missile.A1, missile.L, missile.F, missile.Cg, missile.Pc, missile.K]
+        mats = [missile.M, missile.A1, missile.L, missile.F, missile.Cg, missile.Pc, missile.Kg]
         mats += [np.array(list(missile.CATCH.values())), missile.RMS]
     values = np.concatenate([np.ravel(m) for m in mats])
     return values[np.abs(values) > 1e-6]

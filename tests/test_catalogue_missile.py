@@ -35,7 +35,7 @@ L = PMO.L
 F = A1 - L @ C
 Cg = np.linalg.pinv(C)
 Pc = EYE - Cg @ C
-K = Pc @ E @ CEg
+Kg = Pc @ E @ CEg
 NAMES = ["x1", "x2", "x3", "x4", "v1", "v2"]
 
 
@@ -132,19 +132,19 @@ CATALOGUE = {
     ),
     "L = 0": (lambda: pmo(gain=np.zeros((n, p)), f=A1), "but the exercise asks for"),
     # the g-inverse observer ------------------------------------------------------------------
-    "Cg left out": (lambda: checks.missile_ginverse(None, Pc, K), "Cg is missing"),
-    "Pc left out": (lambda: checks.missile_ginverse(Cg, None, K), "Pc is missing"),
-    "K left out": (lambda: checks.missile_ginverse(Cg, Pc, None), "K is missing"),
+    "Cg left out": (lambda: checks.missile_ginverse(None, Pc, Kg), "Cg is missing"),
+    "Pc left out": (lambda: checks.missile_ginverse(Cg, None, Kg), "Pc is missing"),
+    "Kg left out": (lambda: checks.missile_ginverse(Cg, Pc, None), "Kg is missing"),
     "Pc = Cg C": (
-        lambda: checks.missile_ginverse(Cg, Cg @ C, K),
+        lambda: checks.missile_ginverse(Cg, Cg @ C, Kg),
         "Pc is Cg C, the projection onto the measured coordinates",
     ),
-    "K = the PMO's M": (lambda: checks.missile_ginverse(Cg, Pc, M), "Your K is E (CE)^g"),
+    "Kg = the PMO's M": (lambda: checks.missile_ginverse(Cg, Pc, M), "Your Kg is E (CE)^g"),
     "a generalized inverse that is not Moore-Penrose": (
-        lambda: checks.missile_ginverse(Cg + Pc @ np.ones((n, p)), Pc, K),
+        lambda: checks.missile_ginverse(Cg + Pc @ np.ones((n, p)), Pc, Kg),
         "not the Moore-Penrose one",
     ),
-    "Cg = 0": (lambda: checks.missile_ginverse(np.zeros((n, p)), Pc, K), "not an inverse of C"),
+    "Cg = 0": (lambda: checks.missile_ginverse(np.zeros((n, p)), Pc, Kg), "not an inverse of C"),
     # the reconstruction ------------------------------------------------------------------------
     "vhat left out": (lambda: checks.missile_reconstruction(None, RUN), "vhat must be the result"),
     "the run left out": (lambda: checks.missile_reconstruction(VHAT, None), "got None"),
@@ -329,7 +329,7 @@ RIGHT_BUT_DIFFERENT = {
         observer=PMO_OTHER,
         poles=[-200, -220],
     ),
-    "K with a Kv term (here CE is invertible, so it does nothing)": lambda: checks.missile_ginverse(
+    "Kg with a Kv term (CE is invertible here: it does nothing)": lambda: checks.missile_ginverse(
         Cg, Pc, Pc @ E @ CEg + np.ones((n, p)) @ (np.eye(p) - CE @ CEg)
     ),
     "rms as a list": lambda: checks.missile_noise(list(RMS), NOISY, sigma=SIGMA, seed=SEED),
@@ -357,7 +357,7 @@ def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
 def test_the_right_answer_passes_every_check():
     results = [
         pmo(),
-        checks.missile_ginverse(Cg, Pc, K),
+        checks.missile_ginverse(Cg, Pc, Kg),
         reconstruction(),
         catch_check(),
         checks.missile_noise(RMS, NOISY, sigma=SIGMA, seed=SEED, plant=PLANT, observer=PMO),

@@ -257,9 +257,9 @@ def test_missile_ginverse_structural_identities():
     g = ut.design_ginverse(plant, Kv=np.arange(8.0).reshape(4, 2))
     A, C, E = plant.A, plant.C, plant.E
     Pc = np.eye(4) - np.linalg.pinv(C) @ C
-    # eq. (20): (I - Cg C) E - K C E = 0
-    gain = np.linalg.cond(C) * np.linalg.cond(C @ E)  # Pc from pinv(C), K from a solve with CE
-    assert_zero(Pc @ E - g.K @ C @ E, np.eye(4) + np.abs(g.K) @ np.abs(C), E, terms=4, gain=gain)
+    # eq. (20): (I - Cg C) E - Kg C E = 0
+    gain = np.linalg.cond(C) * np.linalg.cond(C @ E)  # Pc from pinv(C), Kg from a solve with CE
+    assert_zero(Pc @ E - g.Kg @ C @ E, np.eye(4) + np.abs(g.Kg) @ np.abs(C), E, terms=4, gain=gain)
     # Pc is the orthogonal projection: symmetric and idempotent
     np.testing.assert_allclose(Pc, Pc.T)
     np.testing.assert_allclose(Pc @ Pc, Pc)
@@ -269,11 +269,11 @@ def test_missile_ginverse_structural_identities():
         g.Cv, np.eye(2) + np.abs(C @ E) @ np.abs(np.linalg.pinv(C @ E)), C, A, terms=4, gain=gain
     )
     g0 = ut.design_ginverse(plant)
-    assert_rounding_close(g.K, g0.K, terms=4, gain=gain)  # Kv does not enter K
+    assert_rounding_close(g.Kg, g0.Kg, terms=4, gain=gain)  # Kv does not enter Kg
     assert_rounding_close(  # G does not depend on Kv either (Cv = 0): products with A, ~3e4
         g.realization().B_y,
         g0.realization().B_y,
-        size=size_of(A) * size_of(g.K),
+        size=size_of(A) * size_of(g.Kg),
         terms=16,
         gain=gain,
     )

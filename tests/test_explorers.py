@@ -726,3 +726,33 @@ def test_zero_residual_is_drawn_flat_and_said():
     lo, hi = ef.axes["uio.residual"].get_ylim()
     assert hi - lo >= frame.limits["residual"] / 10  # the outputs' scale, not 1e-11
     assert not compute_frame(sc).residual_zero
+
+
+@pytest.mark.parametrize("name", [*sorted(SCENARIOS), "quadruple_tank"])
+@pytest.mark.parametrize("narrow", [False, True])
+def test_no_legend_covers_a_curve(name, narrow):
+    # every picture of the static book (first, middle and last slider value, both
+    # disturbance types): a band at the top of each panel keeps its legend clear of curves
+    from uio_teach.explorers.scenarios import scenario_of
+    from uio_teach.explorers.static import (
+        NARROW_DPI,
+        NARROW_FONTSCALE,
+        WIDE_FONTSCALE,
+        frame_settings,
+    )
+    from uio_teach.plotting import covered_curves
+
+    sc = SCENARIOS[name]() if name in SCENARIOS else scenario_of(name)
+    values = sc.static_values
+    scale = NARROW_FONTSCALE if narrow else WIDE_FONTSCALE
+    for value in (values[0], values[len(values) // 2], values[-1]):
+        plant = sc
+        if sc.static_plant_control is not None and sc.rebuild is not None:
+            plant = sc.rebuild(**{sc.static_plant_control.name: value})
+        fig = ExplorerFigure(
+            plant, dpi=NARROW_DPI, sticky=False, fontscale=scale, narrow=narrow, lmi=False
+        )
+        assert fig.bands, "the panels' legends have bands"
+        for kind in ("random steps", "sinusoid"):
+            fig.update(compute_frame(plant, frame_settings(sc, sc.defaults, value, kind)))
+            assert covered_curves(fig.fig) == [], (value, kind)

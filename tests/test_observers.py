@@ -233,7 +233,7 @@ def _families():
     return [
         (ut.design_uio(pa9, poles=[-1, -2, -3]), ("H", "T", "K1", "K2", "K", "F")),
         (ut.design_pmo(case, method="lmi"), ("M", "A1", "L", "F", "G", "Mv", "lmi_certificate")),
-        (ut.design_ginverse(missile), ("Cg", "K", "Av", "Cv", "Kv", "G", "projection")),
+        (ut.design_ginverse(missile), ("Cg", "Kg", "Av", "Cv", "Kv", "G", "projection")),
         (ut.design_luenberger(pa9, poles=[-1, -2, -3]), ("L", "F")),
     ]
 

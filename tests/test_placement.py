@@ -137,7 +137,7 @@ def test_every_design_meets_its_decoupling_identities():
     assert_zero(pmo.L @ case.D, pmo.L, case.D, terms=3, gain=np.linalg.cond(case.D))
     assert_zero(pmo.M @ case.D, pmo.M, case.D, terms=3, gain=np.linalg.cond(case.D))
     g = ut.design_ginverse(ut.examples.missile_autopilot())
-    P, K, pl = g.projection, g.K, g.plant
+    P, K, pl = g.projection, g.Kg, g.plant
     gain = np.linalg.cond(pl.C) * np.linalg.cond(pl.C @ pl.E)  # P from pinv(C), K from CE
     assert_zero(
         (P - P @ K @ pl.C) @ pl.E,

@@ -148,3 +148,30 @@ def test_bank_figure_draws_every_member_over_its_threshold_with_legible_text():
     texts += list(fig.legends[0].get_texts())
     sizes_px = [text.get_fontsize() * 100 / 72 * scale for text in texts if text.get_text()]
     assert min(sizes_px) >= 9, min(sizes_px)
+
+
+def test_no_legend_of_a_course_figure_covers_a_curve():
+    import matplotlib
+
+    from uio_teach.instructor import figures
+
+    config = figures.FigureConfig()
+    runs = figures._Runs(config)
+    drawn = [name for name, spec in figures.FIGURES.items() if not spec.table]
+    assert drawn
+    for name in drawn:
+        with matplotlib.style.context(config["style"]):
+            fig = figures.FIGURES[name].draw(runs)
+        assert any(ax.get_legend() for ax in fig.axes) or fig.legends or name.endswith("zeros")
+        assert plotting.covered_curves(fig) == [], name
+
+
+def test_the_legend_check_sees_a_legend_over_a_curve():
+    fig = plotting.new_figure()
+    ax = fig.subplots()
+    ax.plot([0, 1], [1, 1], label="top", drawstyle="steps-post")
+    ax.plot([0, 1], [0, 0], label="bottom")
+    ax.legend(loc="upper right")
+    assert plotting.covered_curves(fig) == [("top", "top")]
+    plotting.legend_beside(ax)
+    assert plotting.covered_curves(fig) == []

@@ -175,6 +175,17 @@ _LAYOUT_JS = """(k) => {
           natural: img.naturalWidth, naturalHeight: img.naturalHeight,
           picture: {client: picture.clientWidth, scroll: picture.scrollWidth},
           captions: rect(root.querySelector('.uio-captions')), height: rect(root).height,
+          // the caption's own height: its lines (runs of text less than half a line apart count
+          // as one) times the line height, and its margins
+          text: (() => {
+            const p = root.querySelector('.uio-caption'), t = document.createRange();
+            t.selectNodeContents(p);
+            const cs = getComputedStyle(p), size = parseFloat(cs.fontSize);
+            const lh = cs.lineHeight === 'normal' ? 1.2 * size : parseFloat(cs.lineHeight);
+            const tops = [...t.getClientRects()].map((r) => r.top).sort((a, b) => a - b);
+            let lines = 0, last = -Infinity;
+            for (const top of tops) { if (top - last > lh / 2) { lines += 1; last = top; } }
+            return lines * lh + parseFloat(cs.marginTop) + parseFloat(cs.marginBottom); })(),
           controls, current: img.currentSrc,
           state: {src: img.currentSrc, alt: img.alt,
                   value: root.querySelector('input[type=range]').value,
@@ -263,10 +274,15 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
     for a, b in itertools.pairwise(seen[1:]):
         for key in ("src", "alt", "caption"):
             assert a["state"][key] != b["state"][key], (where, key, a["state"]["value"])
-    # the explorer keeps its height while the slider and the menu move: the page never jumps
-    heights = {round(m["height"], 1) for m in seen}
+    # the page opens with no empty space under the caption (its box holds its text and the
+    # paragraph's margins); from the first move on, the explorer keeps its height while the
+    # slider and the menu move (the box holds the longest caption): the page never jumps
+    first = seen[0]
+    assert abs(first["captions"]["height"] - first["text"]) <= 3, (where, first["text"])
+    heights = {round(m["height"], 1) for m in seen[1:]}
     assert len(heights) == 1, (where, heights)
-    assert len({round(m["captions"]["height"], 1) for m in seen}) == 1, where
+    assert len({round(m["captions"]["height"], 1) for m in seen[1:]}) == 1, where
+    assert first["height"] <= seen[1]["height"] + 0.5, where
     return seen
 
 
@@ -298,7 +314,10 @@ def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
     first = measured["seen"][0]
     print(
         f"{name} at 390 px: explorer {first['box']['width']:.0f} px, picture "
-        f"{first['img']['width']:.0f} x {first['img']['height']:.0f} px"
+        f"{first['img']['width']:.0f} x {first['img']['height']:.0f} px; under the caption "
+        f"{first['captions']['height'] - first['text']:.0f} px at first, the box "
+        f"{first['captions']['height']:.0f} px, {measured['seen'][1]['captions']['height']:.0f} px "
+        "after the first move"
     )
 
 

@@ -29,12 +29,9 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
-import test_book
 from test_book import PAGES, ROOT, SCREENSHOTS, _open_local
 
-# the local server and the browser of test_book (the book itself: conftest, one build per run)
-book_server = test_book.book_server
-browser = test_book.browser
+# the book (conftest's built_book), its local server and the browser (conftest: one each per run)
 
 pytestmark = [pytest.mark.book]
 

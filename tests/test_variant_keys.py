@@ -53,8 +53,8 @@ def missile_solution(params):
     pmo = ut.design_pmo(plant, poles=[complex(p) for p in params["pmo_poles"]], Mv=Mv)
     Cg = np.linalg.pinv(C)
     Pc = np.eye(plant.n) - Cg @ C
-    K = Pc @ E @ np.linalg.inv(C @ E)
-    return {"M": pmo.M, "L": pmo.L, "F": pmo.F, "Cg": Cg, "Pc": Pc, "K": K}
+    Kg = Pc @ E @ np.linalg.inv(C @ E)
+    return {"M": pmo.M, "L": pmo.L, "F": pmo.F, "Cg": Cg, "Pc": Pc, "Kg": Kg}
 
 
 def verdicts(lab, answer, params):
@@ -82,7 +82,7 @@ def verdicts(lab, answer, params):
             answer["M"], answer["L"], answer["F"], poles=params["pmo_poles"], plant=plant
         ).passed,
         "missile.ginverse": checks.missile_ginverse(
-            answer["Cg"], answer["Pc"], answer["K"], plant
+            answer["Cg"], answer["Pc"], answer["Kg"], plant
         ).passed,
     }
 

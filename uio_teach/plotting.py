@@ -10,6 +10,7 @@ Drawing code only; the numbers come from :func:`uio_teach.simulate` and
   one line per channel into an axes; :func:`finish_panel` labels and grids it;
 * the bank of UIOs: :func:`plot_bank_alarms` (each member's windowed residual over its
   threshold, one panel per run, one legend for all panels);
+* checks: :func:`covered_curves` (the curves a legend covers, for tests of every figure);
 * names: :func:`symbol` (``$e_{1}$``, ``$\\hat{x}_{2}$``), :func:`axis_label` (the error
   ``e = x - xhat``, the residual ``r = y - C xhat``, an input and its estimate) and
   :func:`time_label`; :func:`new_figure` makes a figure without pyplot.
@@ -60,6 +61,8 @@ __all__ = [
     "time_label",
     "with_unit",
     "residual_colors",
+    "covered_curves",
+    "legend_beside",
     "UNIT",
 ]
 
@@ -289,7 +292,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ylabel : str
         The label of its vertical axis.
     legend : bool, optional
-        Show the legend (upper right, 10 points).
+        Show the legend (beside the panel, :func:`legend_beside`).
 
     Examples
     --------
@@ -303,7 +306,36 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
     ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
     if legend:
-        ax.legend(loc="upper right", fontsize=FONT_SIZE)
+        legend_beside(ax)
+
+
+def legend_beside(ax: Axes, **kwargs: Any) -> Any:
+    """The panel's legend beside it, right of its upper corner: never over a curve.
+
+    A constrained-layout figure (:func:`new_figure`) narrows the panels to make room.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    **kwargs
+        Passed to ``ax.legend`` (handles, labels, ``ncol``, ...).
+
+    Returns
+    -------
+    matplotlib.legend.Legend
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import covered_curves, legend_beside, new_figure
+    >>> ax = new_figure().subplots()
+    >>> _ = ax.plot([0, 1], [1, 1], label="flat at the top")
+    >>> _ = legend_beside(ax)
+    >>> covered_curves(ax.figure)
+    []
+    """
+    options = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "borderaxespad": 0.0}
+    return ax.legend(**{**options, "fontsize": FONT_SIZE, **kwargs})
 
 
 def plot_channels(
@@ -736,3 +768,82 @@ def plot_bank_alarms(
         frameon=False,
     )
     return fig
+
+
+def covered_curves(fig: Figure) -> list[tuple[str, str]]:
+    """The curves a legend covers: (legend's first label, curve's label) for each.
+
+    Every visible legend of the figure (in an axes or on the figure) is measured on the drawn
+    figure, in display coordinates; a curve is covered when one of its drawn points lies inside
+    a legend's frame: its vertices and points along each segment a pixel apart (steps as
+    drawn), within the part of the frame inside the curve's axes and its clip box.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure (drawn first, on an Agg canvas if it has none that renders).
+
+    Returns
+    -------
+    list of tuple of str
+        Empty when no legend covers a curve.
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import covered_curves, new_figure
+    >>> fig = new_figure()
+    >>> ax = fig.subplots()
+    >>> _ = ax.plot([0, 1], [0, 1], label="rising")
+    >>> _ = ax.legend(loc="upper left")
+    >>> covered_curves(fig)
+    []
+    >>> _ = ax.legend(loc="center")
+    >>> covered_curves(fig)
+    [('rising', 'rising')]
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.cbook import STEP_LOOKUP_MAP
+    from matplotlib.transforms import Bbox
+
+    if not hasattr(fig.canvas, "get_renderer"):  # a figure without pyplot: an Agg canvas
+        FigureCanvasAgg(fig)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    legends = [lg for lg in [*legends, *fig.legends] if lg.get_visible()]
+    found = []
+    for legend in legends:
+        box = legend.get_frame().get_window_extent(renderer)
+        name = legend.get_texts()[0].get_text() if legend.get_texts() else ""
+        for ax in fig.axes:
+            if not ax.get_visible():
+                continue
+            for line in ax.get_lines():
+                area = Bbox.intersection(box, ax.get_window_extent(renderer))
+                clip = line.get_clip_box()
+                if area is not None and clip is not None and line.get_clip_on():
+                    area = Bbox.intersection(area, clip)
+                if not line.get_visible() or area is None or area.width <= 0 or area.height <= 0:
+                    continue
+                x, y = (np.asarray(v, dtype=float).ravel() for v in line.get_data())
+                if x.size == 0:
+                    continue
+                style = line.get_drawstyle()
+                if style != "default" and style in STEP_LOOKUP_MAP:
+                    x, y = STEP_LOOKUP_MAP[style](x, y)
+                xy = line.get_transform().transform(np.column_stack([x, y]))
+                ok = np.isfinite(xy).all(axis=1)
+                points = [xy[ok]]
+                both = ok[:-1] & ok[1:]
+                a, b = xy[:-1][both], xy[1:][both]
+                steps = np.clip(np.ceil(np.hypot(*(b - a).T)), 1, 2000).astype(int)
+                for m in np.unique(steps):
+                    s = np.linspace(0.0, 1.0, m + 1)[:, None, None]
+                    sel = steps == m
+                    points.append((a[sel] + s * (b[sel] - a[sel])).reshape(-1, 2))
+                p = np.concatenate(points)
+                across = (p[:, 0] > area.x0) & (p[:, 0] < area.x1)
+                inside = across & (p[:, 1] > area.y0) & (p[:, 1] < area.y1)
+                if inside.any():
+                    found.append((name, line.get_label()))
+    return found

@@ -1,14 +1,14 @@
 """Simulate a plant together with an observer, exactly for the sampled inputs.
 
-The plant and the observer form one linear system with state ``z = [x; w]``
-and inputs ``s = [u; d; v; noise]``::
+The plant and the observer form one linear system with state ``[x; z]`` (``z`` the
+observer's own state) and inputs ``s = [u; d; v; noise]``::
 
     x' = A x + B u + E d                       (plant)
     y  = C x + D v + noise                     (measurement)
-    w' = A_o w + B_u u + B_y y                 (observer)
-    xhat = C_o w + D_y y
+    z' = A_o z + B_u u + B_y y                 (observer)
+    xhat = C_o z + D_y y
 
-(``x[k+1] = ...``, ``w[k+1] = ...`` for a discrete plant). :func:`~uio_teach.simulate`
+(``x[k+1] = ...``, ``z[k+1] = ...`` for a discrete plant). :func:`~uio_teach.simulate`
 builds this joint system once and solves it on the time grid.
 
 **Continuous time.** Between two samples the inputs are taken as linear (a
@@ -145,8 +145,8 @@ class UIOResponse:
     inputs : SimulationInputs
         The samples of ``u``, ``d``, ``v`` and ``noise`` that were applied.
     observer_states : numpy.ndarray
-        Shape (n_w, N): the observer's internal state ``w`` (``z`` of the UIO, ``q`` of the
-        PMO and g-inverse observer, ``xhat`` of the Luenberger observer).
+        Shape (n_z, N): the observer's own state ``z`` (in every observer; the Luenberger
+        observer's is ``xhat``).
     plant : Plant
         The simulated plant.
     observer : Observer

@@ -257,8 +257,8 @@ def _missile() -> tuple[GradedCheck, ...]:
         GradedCheck(
             "missile.ginverse",
             "The generalized-inverse observer",
-            ("Cg", "Pc", "K"),
-            lambda a, p, plant: missile_ginverse(a["Cg"], a["Pc"], a["K"], plant=plant),
+            ("Cg", "Pc", "Kg"),
+            lambda a, p, plant: missile_ginverse(a["Cg"], a["Pc"], a["Kg"], plant=plant),
         ),
         GradedCheck(
             "missile.reconstruction",

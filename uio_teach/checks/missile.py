@@ -2,8 +2,8 @@
 
 * :func:`missile_pmo` -- ``M``, ``L``, ``F``: ``(I - MC)E = 0``,
   ``F = (I - MC)A - LC``, the asked poles next to the two fixed ones;
-* :func:`missile_ginverse` -- ``Cg``, ``Pc``, ``K``: the Moore-Penrose inverse,
-  ``Pc = I - Cg C``, condition (20) ``Pc E - K C E = 0``;
+* :func:`missile_ginverse` -- ``Cg``, ``Pc``, ``Kg``: the Moore-Penrose inverse,
+  ``Pc = I - Cg C``, condition (20) ``Pc E - Kg C E = 0``;
 * :func:`missile_reconstruction` -- ``v̂`` of a noise-free run follows ``v``;
 * :func:`missile_catch_times` -- the catch times of Table II, recomputed;
 * :func:`missile_noise` -- the RMS error of ``v̂`` with measurement noise,
@@ -18,8 +18,8 @@ Examples
 >>> C = plant.C
 >>> Cg = np.linalg.pinv(C)
 >>> Pc = np.eye(4) - Cg @ C
->>> K = Pc @ plant.E @ np.linalg.pinv(C @ plant.E)
->>> checks.missile_ginverse(Cg, Pc, K).passed
+>>> Kg = Pc @ plant.E @ np.linalg.pinv(C @ plant.E)
+>>> checks.missile_ginverse(Cg, Pc, Kg).passed
 True
 """
 
@@ -167,9 +167,9 @@ def missile_pmo(
 
 @never_raises("Missile: the generalized-inverse observer", "missile.ginverse")
 def missile_ginverse(
-    Cg: Any, Pc: Any, K: Any, plant: Any = None, *, tol: float = 1e-9
+    Cg: Any, Pc: Any, Kg: Any, plant: Any = None, *, tol: float = 1e-9
 ) -> CheckResult:
-    """Check ``Cg = C^g``, ``Pc = I - Cg C`` and condition (20), ``Pc E - K C E = 0``.
+    """Check ``Cg = C^g``, ``Pc = I - Cg C`` and condition (20), ``Pc E - Kg C E = 0``.
 
     Parameters
     ----------
@@ -177,8 +177,8 @@ def missile_ginverse(
         Your Moore-Penrose inverse of ``C``.
     Pc : array_like, shape (n, n)
         Your projection onto the null space of ``C``.
-    K : array_like, shape (n, p)
-        Your gain ``K = Pc E (CE)^g + Kv (I - CE (CE)^g)``.
+    Kg : array_like, shape (n, p)
+        Your gain ``Kg = Pc E (CE)^g + Kv (I - CE (CE)^g)``.
     plant : Plant, optional
         :func:`uio_teach.examples.missile_autopilot` by default.
     tol : float, optional
@@ -203,8 +203,8 @@ def missile_ginverse(
     C, E = plant.C, plant.E
     Cg = read_matrix(result, "Cg", Cg, n, p, f"n x p = {n} x {p}")
     Pc = read_matrix(result, "Pc", Pc, n, n, f"n x n = {n} x {n}")
-    K = read_matrix(result, "K", K, n, p, f"n x p = {n} x {p}")
-    if Cg is None or Pc is None or K is None:
+    Kg = read_matrix(result, "Kg", Kg, n, p, f"n x p = {n} x {p}")
+    if Cg is None or Pc is None or Kg is None:
         return result
     ref = np.linalg.pinv(C)
     if close(Cg, ref, tol):
@@ -230,20 +230,20 @@ def missile_ginverse(
         )
     else:
         result.add(False, "Pc is not I - Cg C with your Cg: recompute it from your Cg.")
-    R = Pc @ E - K @ C @ E
+    R = Pc @ E - Kg @ C @ E
     big = float(np.max(np.abs(R)))
     if big <= 1e-6 * max(1.0, float(np.max(np.abs(E)))):
-        result.add(True, f"Pc E - K C E = 0{up_to(big, 'largest entry')}: condition (20) holds.")
+        result.add(True, f"Pc E - Kg C E = 0{up_to(big, 'largest entry')}: condition (20) holds.")
     else:
         CEg = np.linalg.pinv(C @ E)
         hint = (
-            " Your K is E (CE)^g, the PMO's M: the g-inverse observer projects E with Pc first."
-            if close(K, E @ CEg, 1e-9)
-            else " K must satisfy K C E = Pc E (eq. (20))."
+            " Your Kg is E (CE)^g, the PMO's M: the g-inverse observer projects E with Pc first."
+            if close(Kg, E @ CEg, 1e-9)
+            else " Kg must satisfy Kg C E = Pc E (eq. (20))."
         )
         result.add(
             False,
-            f"condition (20) fails: Pc E - K C E = {format_matrix_line(R)} (largest entry "
+            f"condition (20) fails: Pc E - Kg C E = {format_matrix_line(R)} (largest entry "
             f"{big:.3g}), so v reaches the error.{hint}",
         )
     return result
@@ -578,7 +578,7 @@ def missile_noise(
     observer: Any = None,
     initial_state: Any = None,
 ) -> CheckResult:
-    """Check the RMS error of ``v̂`` with noise, and compare it with ``sigma gamma_i / (sqrt(2) h)``.
+    """Check the RMS error of ``v̂`` with noise, and compare it with ``sigma beta_i / (sqrt(2) h)``.
 
     Parameters
     ----------

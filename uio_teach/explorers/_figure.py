@@ -30,7 +30,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 from matplotlib.text import Text
 from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter
-from matplotlib.transforms import Bbox, IdentityTransform
+from matplotlib.transforms import Bbox, IdentityTransform, TransformedBbox
 from PIL import Image
 
 from ..plotting import axis_label, symbol, time_label
@@ -49,6 +49,11 @@ _LEGEND = {
     "handlelength": 1.2,
     "framealpha": 1.0,
     "fancybox": False,
+    "borderpad": 0.3,
+    "labelspacing": 0.25,
+    "handletextpad": 0.5,
+    "columnspacing": 1.0,
+    "borderaxespad": 0.3,
 }
 
 _FOOTER_PT = 7.5  # the footer's font size (points, before ``fontscale``)
@@ -154,7 +159,8 @@ class ExplorerFigure:
     ``o`` invariant zeros, which are the fixed poles; unit circle in discrete
     time) and the applied unknown signals. Each panel has its own vertical
     scale, so a good estimate is not flattened by a bad one. Messages are
-    written under the panels, never over the curves.
+    written under the panels, never over the curves; a legend sits in a band
+    at the top of its panel that the curves do not enter.
 
     :meth:`update` only changes the data of existing lines and texts
     (``set_data``, ``set_text``) and rescales the axes; :meth:`draw` renders
@@ -198,6 +204,8 @@ class ExplorerFigure:
         ``"signals"``.
     lines : dict
         The lines of each curve by the name of the curve, one per channel.
+    bands : dict
+        By panel name, the fraction of the panel's height kept for its legend.
 
     Examples
     --------
@@ -241,6 +249,8 @@ class ExplorerFigure:
         self._signal_panel()
         for ax in self.axes.values():
             ax.tick_params(labelsize=7 * k)
+        self.bands: dict[str, float] = {}
+        self._reserve_bands()
         top = 1 - 4 / 72 / self.fig.get_figheight()
         self.title = self.fig.suptitle("", fontsize=10 * k, y=top, va="top")
         # the observers' messages go under the panels (the footer), in space kept for them
@@ -272,7 +282,7 @@ class ExplorerFigure:
         --------
         >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
         >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
-        6.5
+        7.0
         """
         texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
         return float(min(t.get_fontsize() for t in texts))
@@ -345,7 +355,7 @@ class ExplorerFigure:
                     self.lines[f"{who}.actual"] = [
                         ax.plot(
                             [], [], color="0.25", lw=2.4, alpha=0.45,
-                            label=f"{symbol(sym, i)} true", **style,
+                            label="true" if i == 0 else "_true", **style,
                         )[0]
                         for i in range(plant.q)
                     ]  # fmt: skip
@@ -454,6 +464,8 @@ class ExplorerFigure:
         style = {"drawstyle": "steps-post"} if sc.discrete else {}
         sig = self.axes["signals"]
         sig.set_ylabel("unknown inputs", fontsize=8 * k)
+        if self.narrow:  # beside the pole map: the label on the free right edge, not over the map
+            sig.yaxis.set_label_position("right")
         self.lines["d"] = [
             sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sc.input_symbol, i), **style)[0]
             for i in range(plant.q)
@@ -470,6 +482,61 @@ class ExplorerFigure:
         sig.grid(True, alpha=0.3)
         sig.yaxis.set_major_locator(MaxNLocator(4 if self.narrow else 5))
         sig.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+
+    def _reserve_bands(self) -> None:
+        """Step 5: a band at the top of each panel with a legend, kept free of curves.
+
+        A legend is laid out in as few rows as the panel's width allows; the band is its
+        height (and a little room) as a fraction of the panel's. The panel's curves are
+        clipped under the band and its vertical range puts the data under it, so that no
+        curve runs under a legend (the legends stay in place: a redraw paints them back).
+        """
+        renderer = self.fig.canvas.get_renderer()
+        pad = 2.0 * self.fig.dpi / 72  # 2 pt between the legend and the curves
+        for name, ax in self.axes.items():
+            legend = ax.get_legend()
+            if legend is None or name == "poles":  # the pole map's legend is above it
+                continue
+            handles, labels = legend.legend_handles, [t.get_text() for t in legend.get_texts()]
+            box = ax.get_window_extent(renderer)
+            for ncol in range(len(handles), 0, -1):
+                legend = ax.legend(
+                    handles=[h for h in self._legend_sources(ax, labels)],
+                    labels=labels,
+                    **{**_LEGEND, "fontsize": self.legend_pt, "ncol": ncol},
+                )
+                width = legend.get_window_extent(renderer).width
+                if width <= box.width - 2 * pad:
+                    break
+            frame = legend.get_window_extent(renderer)
+            band = min(0.6, (box.y1 - frame.y0 + pad) / box.height)
+            self.bands[name] = band
+            clip = TransformedBbox(Bbox([[0.0, 0.0], [1.0, 1.0 - band]]), ax.transAxes)
+            for line in ax.get_lines():
+                line.set_clip_box(clip)
+
+    def _legend_sources(self, ax: Any, labels: list[str]) -> list:
+        """The lines of a panel named in its legend, in the legend's order."""
+        by_label = {line.get_label(): line for line in ax.get_lines()}
+        return [by_label[label] for label in labels]
+
+    def _under_band(
+        self, name: str, current: tuple[float, float], log: bool = False
+    ) -> tuple[float, float]:
+        """The part of a panel's range under its legend's band (all of it without one)."""
+        band = self.bands.get(name, 0.0)
+        lo, hi = (math.log10(v) for v in current) if log else current
+        hi = lo + (hi - lo) * (1.0 - band)
+        return (10.0**lo, 10.0**hi) if log else (lo, hi)
+
+    def _over_band(
+        self, name: str, wanted: tuple[float, float], log: bool = False
+    ) -> tuple[float, float]:
+        """A panel's range that puts ``wanted`` under its legend's band."""
+        band = self.bands.get(name, 0.0)
+        lo, hi = (math.log10(v) for v in wanted) if log else wanted
+        hi = lo + (hi - lo) / (1.0 - band)
+        return (10.0**lo, 10.0**hi) if log else (lo, hi)
 
     def update(self, frame: Frame) -> None:
         """Show a frame: new data in the existing lines and texts, axes rescaled.
@@ -539,7 +606,9 @@ class ExplorerFigure:
                     # set, not the poles: a range from it stays put while the poles move
                     top = frame.limits.get("error")
                     ranged = [np.array([top])] if top else data
-                    ax.set_ylim(*_log_range(ranged, None if fresh else ax.get_ylim()))
+                    name = f"{who}.{row}"
+                    current = None if fresh else self._under_band(name, ax.get_ylim(), log=True)
+                    ax.set_ylim(*self._over_band(name, _log_range(ranged, current), log=True))
                     continue
                 if row == "input":  # zoomed on the true input: a wild estimate runs off the panel
                     size = finite_max(frame.d) or 1.0
@@ -549,11 +618,13 @@ class ExplorerFigure:
                     # never rounding noise magnified into a trend
                     size = frame.limits.get(row, 10.0) / 10
                     data = [np.array([-size, size])]
-                ax.set_ylim(*_keep_range(ax.get_ylim(), _nice_range(data), fresh))
+                name = f"{who}.{row}"
+                kept = _keep_range(self._under_band(name, ax.get_ylim()), _nice_range(data), fresh)
+                ax.set_ylim(*self._over_band(name, kept))
         sig = self.axes["signals"]
-        lo, hi = _nice_range([frame.d, frame.v])
-        wanted = (lo, hi + 0.5 * (hi - lo))  # room above the curves for the legend
-        sig.set_ylim(*_keep_range(sig.get_ylim(), wanted, self._fresh or not self.sticky))
+        wanted = _nice_range([frame.d, frame.v])
+        kept = _keep_range(self._under_band("signals", sig.get_ylim()), wanted, fresh)
+        sig.set_ylim(*self._over_band("signals", kept))
         self._fresh = False
         if len(t) > 1:
             for name, ax in self.axes.items():

@@ -239,7 +239,7 @@ def missile_scenario() -> Scenario:
     The default disturbance is the paper's pair of damped sinusoids
     ``v1 = 10 exp(-2t) cos(10t)``, ``v2 = 50 exp(-5t) sin(100t)``, with the
     paper's initial state and the PMO poles ``-100, -120``, all from
-    :data:`uio_teach.experiments.MISSILE` (the observers start at ``q(0) = 0``
+    :data:`uio_teach.experiments.MISSILE` (the observers start at ``z(0) = 0``
     here); 0.5 s on 1001 samples. The unknown
     inputs are reconstructed from each observer's estimate with
     :func:`uio_teach.reconstruct_input` (filtered, ``tau`` = 2 ms).

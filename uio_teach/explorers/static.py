@@ -14,8 +14,9 @@ wide screen the controls share a row above a picture at most 780 px wide; on a
 phone each control takes a row of its own and every frame is shown as drawn for
 the phone (:data:`NARROW_PX`): the two observers side by side, one row of panels
 per kind of curve, text no smaller than about 9 CSS pixels, so the page never
-scrolls sideways and nothing needs enlarging. The caption's box keeps the height
-of the longest caption, so the page does not jump while the slider moves.
+scrolls sideways and nothing needs enlarging. The caption's box is as tall as the
+caption the page opens with; from the first move of a control on, it keeps the
+height of the longest caption, so the page does not jump while the slider moves.
 
 Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 :class:`uio_teach.explorers.ExplorerFigure`, exactly as in the live explorer.
@@ -408,13 +409,15 @@ def static_explorer(
 
 
 def _png(figure: ExplorerFigure, colors: int) -> bytes:
-    """The frame's PNG, re-encoded if its base64 text happens to contain "http".
+    """The frame's PNG, rendered whole, re-encoded if its base64 text happens to contain "http".
 
     Base64 text is random-looking: a page of frames would otherwise contain
     the letters "http" somewhere now and then, which a check for external
     URLs would flag. Another compression level gives other bytes.
     """
-    png = figure.to_png(colors=colors)
+    # a whole render for every frame: a picture of the book depends on nothing drawn before it
+    figure.fig.canvas.draw()
+    png = figure.to_png(colors=colors, draw=False)
     for level in (9, 8, 7, 5, 4, 3, 2, 1):
         if "http" not in base64.b64encode(png).decode("ascii").lower():
             break
@@ -491,7 +494,7 @@ _JS = (
     "if(n){n.srcset=f.getAttribute('data-narrow');}i.src=f.getAttribute('data-src');"
     "i.alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
-    "this.mainval.value=f.getAttribute('data-label');}"
+    "this.mainval.value=f.getAttribute('data-label');r.classList.add('uio-live');}"
 )
 
 NARROW_PX = 700
@@ -509,8 +512,10 @@ NARROW_DPI = 136
 
 # The layout: on a wide screen the controls share a row above a picture at most 780 px wide; on a
 # narrow one each control takes a row of its own, the slider the full width, and the picture drawn
-# for the phone fills the column. The caption's box is as tall as the longest caption (every
-# caption is laid out, invisibly, in the same grid cell), so the page never jumps while scrubbing.
+# for the phone fills the column. The page opens with the caption's box as tall as its caption
+# (no empty space under it); from the first move of a control on, the box is as tall as the
+# longest caption (every caption is laid out, invisibly, in the same grid cell): the text below
+# moves once, at the first move, and never while scrubbing.
 _CSS = """
 .uio-static-explorer{max-width:780px;box-sizing:border-box}
 .uio-static-explorer *{box-sizing:border-box}
@@ -524,7 +529,8 @@ max-width:100%}
 .uio-static-explorer img.uio-frame{display:block;width:100%;max-width:none;height:auto;margin:0}
 .uio-static-explorer .uio-captions{display:grid}
 .uio-static-explorer .uio-captions>p{grid-area:1/1;font-size:0.85em;margin:0.2em 0}
-.uio-static-explorer .uio-sizer{visibility:hidden}
+.uio-static-explorer .uio-sizer{visibility:hidden;display:none}
+.uio-static-explorer.uio-live .uio-sizer{display:block}
 .uio-static-explorer .uio-note{font-size:0.8em;opacity:0.75;margin:0.2em 0}
 @media (max-width:@NARROW@px){
 .uio-static-explorer form{flex-direction:column;align-items:stretch;gap:0.6em}
@@ -564,7 +570,8 @@ def _html(
         f'data-label="{esc(f.label)}"></span>'
         for f in frames
     )
-    # every caption, invisible, in the caption's grid cell: the box is as tall as the longest
+    # every caption, invisible, in the caption's grid cell: once a control has moved, the box is
+    # as tall as the longest
     sizers = "".join(
         f'<p class="uio-sizer" aria-hidden="true">{esc(c)}</p>'
         for c in dict.fromkeys(f.caption for f in frames)

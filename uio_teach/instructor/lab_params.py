@@ -680,7 +680,7 @@ class MissileParams(LabParams):
         actuator of natural frequency ``wn`` and damping ``zeta``), ``B`` its
         gain, ``E`` small integers, and ``C`` measures ``x1 + c x3`` and
         ``x2 + c' x3`` (sensors that see a little of the fin deflection), so that ``M``,
-        ``Cg``, ``Pc``, ``K`` and the predicted noise differ between groups.
+        ``Cg``, ``Pc``, ``Kg`` and the predicted noise differ between groups.
         :meth:`problems` makes sure that ``CE`` is square and invertible, the
         two invariant zeros (the fixed modes) are stable and actuator-like, and
         the PMO catches ``v1``, ``v2`` within the window. The two PMO poles
@@ -723,7 +723,7 @@ class MissileParams(LabParams):
         )
 
     def distinct(self) -> dict[str, Any]:
-        """PMO poles, ``C`` (``Cg``, ``Pc``) and the column space of ``E`` (``M``, ``K``)."""
+        """PMO poles, ``C`` (``Cg``, ``Pc``) and the column space of ``E`` (``M``, ``Kg``)."""
         plant = self.plant()
         return {
             "poles": tuple(sorted(complex(p).real for p in self.poles)),
@@ -776,7 +776,7 @@ class MissileParams(LabParams):
         return out
 
     def answers(self) -> dict[str, Any]:
-        """The answer key: ``M``, ``L``, ``Cg``, ``Pc``, ``K`` and the predicted noise RMS."""
+        """The answer key: ``M``, ``L``, ``Cg``, ``Pc``, ``Kg`` and the predicted noise RMS."""
         plant = self.plant()
         C, E = plant.C, plant.E
         Mv = MISSILE_PUBLISHED.Mv
@@ -793,7 +793,7 @@ class MissileParams(LabParams):
             "L": _key(pmo.L),
             "Cg": _key(Cg),
             "Pc": _key(Pc),
-            "K": _key(Pc @ E @ CEg),
+            "Kg": _key(Pc @ E @ CEg),
             "error_poles": _key(np.sort_complex(pmo.poles())),
             "fixed_modes": _key(np.sort_complex(check_existence(plant).fixed_modes)),
             "noise_rms_predicted": _key(self.noise_sigma / (math.sqrt(2) * h) * rho, 6),

@@ -21,10 +21,10 @@ class GInverseObserver(Observer):
 
     With ``Cg = C^g`` and the orthogonal projection ``Pc = I - Cg C``::
 
-        K  = Pc E (CE)^g + Kv (I - CE (CE)^g)
+        Kg = Pc E (CE)^g + Kv (I - CE (CE)^g)      (the paper's K)
         Av = Pc A Pc - Pc E (CE)^g C A Pc,   Cv = (I - CE (CE)^g) C A Pc
-        q' = (Av - Kv Cv) q + G y + (Pc - K C) B u
-        xhat = Pc q + (Cg + Pc K) y
+        z' = (Av - Kv Cv) z + G y + (Pc - Kg C) B u
+        xhat = Pc z + (Cg + Pc Kg) y
 
     Built by :func:`design_ginverse`.
 
@@ -38,7 +38,7 @@ class GInverseObserver(Observer):
     """
 
     family = "g-inverse observer"
-    _display_names = ("Cg", "K", "Av", "Cv", "Kv", "G")
+    _display_names = ("Cg", "Kg", "Av", "Cv", "Kv", "G")
     _designer = "design_ginverse(plant, Kv=...)"
 
     def __init__(self, plant: Plant, Kv: np.ndarray) -> None:
@@ -53,15 +53,15 @@ class GInverseObserver(Observer):
         CE = C @ E
         CEg = pinv(CE)
         W = np.eye(p) - CE @ CEg
-        K = Pc @ E @ CEg + Kv @ W
+        Kg = Pc @ E @ CEg + Kv @ W
         self._Cg = read_only(Cg)
         self._Pc = read_only(Pc)
         self._Kv = read_only(Kv)
-        self._K = read_only(K)
+        self._Kg = read_only(Kg)
         self._Av = read_only(Pc @ A @ Pc - Pc @ E @ CEg @ C @ A @ Pc)
         self._Cv = read_only(W @ C @ A @ Pc)
-        self._G = read_only(Pc @ A @ Cg - K @ C @ A @ Cg + Pc @ A @ Pc @ K - K @ C @ A @ Pc @ K)
-        self._Ae = read_only((Pc - Pc @ K @ C) @ A @ Pc)
+        self._G = read_only(Pc @ A @ Cg - Kg @ C @ A @ Cg + Pc @ A @ Pc @ Kg - Kg @ C @ A @ Pc @ Kg)
+        self._Ae = read_only((Pc - Pc @ Kg @ C) @ A @ Pc)
         # orthonormal basis of range(Pc): the error lives there
         U, s, _ = np.linalg.svd(Pc)
         self._basis = U[:, : n - rank(C)]
@@ -89,9 +89,9 @@ class GInverseObserver(Observer):
         return self._Kv
 
     @property
-    def K(self) -> np.ndarray:
-        """``Pc E (CE)^g + Kv (I - CE (CE)^g)``."""
-        return self._K
+    def Kg(self) -> np.ndarray:
+        """``Pc E (CE)^g + Kv (I - CE (CE)^g)``: the gain of condition (20), the paper's ``K``."""
+        return self._Kg
 
     @property
     def Av(self) -> np.ndarray:
@@ -118,7 +118,7 @@ class GInverseObserver(Observer):
 
     @property
     def error_matrix(self) -> np.ndarray:
-        """``(Pc - Pc K C) A Pc``: ``e' = error_matrix e``, with ``e`` in range(Pc)."""
+        """``(Pc - Pc Kg C) A Pc``: ``e' = error_matrix e``, with ``e`` in range(Pc)."""
         return self._Ae
 
     def poles(self) -> np.ndarray:
@@ -136,10 +136,10 @@ class GInverseObserver(Observer):
         pl = self.plant
         return ObserverRealization(
             A=self.Fv,
-            B_u=(self.projection - self.K @ pl.C) @ pl.B,
+            B_u=(self.projection - self.Kg @ pl.C) @ pl.B,
             B_y=self.G,
             C=self.projection,
-            D_y=self.Cg + self.projection @ self.K,
+            D_y=self.Cg + self.projection @ self.Kg,
         )
 
 
@@ -153,12 +153,12 @@ def _null_basis(C: np.ndarray) -> np.ndarray:
 def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> None:
     """Verify a g-inverse observer on the data as given (identity and fixed modes)."""
     pl = obs.plant
-    Pc, K = obs.projection, obs.K
+    Pc, Kg = obs.projection, obs.Kg
     if pl.q:
         check_identity(
-            "(Pc - Pc K C) E = 0",
-            (Pc - Pc @ K @ pl.C) @ pl.E,
-            product_bound((Pc, pl.E), (Pc @ K, np.abs(pl.C) @ np.abs(pl.E))),
+            "(Pc - Pc Kg C) E = 0",
+            (Pc - Pc @ Kg @ pl.C) @ pl.E,
+            product_bound((Pc, pl.E), (Pc @ Kg, np.abs(pl.C) @ np.abs(pl.E))),
             what="the g-inverse observer",
         )
     poles = obs.poles()

@@ -21,7 +21,7 @@ __all__ = ["PMO", "design_pmo"]
 class PMO(ProjectionObserver):
     """Projection-operator full-order observer (Hui and Żak; case study; missile paper).
 
-    ``q' = F q + G y + (I - MC) B u``, ``xhat = q + M y`` with
+    ``z' = F z + G y + (I - MC) B u``, ``xhat = z + M y`` with
     ``A1 = (I - MC) A``, ``F = A1 - L C`` and ``G = (I - MC) A M + L - L C M``
     (eq. (13) of the missile paper). Built by :func:`design_pmo`.
 
