@@ -52,6 +52,9 @@ def _defined_in_the_package() -> list[type[BaseException]]:
                 inspect.isclass(value)
                 and issubclass(value, BaseException)
                 and value.__module__ == module.__name__
+                and not value.__name__.startswith(
+                    "_"
+                )  # a module's own control flow, never raised out
             ):
                 found.append(value)
     return found

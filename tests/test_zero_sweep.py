@@ -185,7 +185,7 @@ def exact_leak(plant: ut.Plant, obs) -> float:
     n = plant.n
     Dy, F, K, Co = _fr(real.D_y), _fr(real.A), _fr(real.B_y), _fr(real.C)
     if isinstance(obs, ut.GInverseObserver):
-        theta = _sub(_eye(n), _mul(_fr(obs.K), C))  # its state estimates (I - K C) x
+        theta = _sub(_eye(n), _mul(_fr(obs.Kg), C))  # its state estimates (I - Kg C) x
     else:
         theta = _sub(_eye(n), _mul(Dy, C))  # its state estimates (I - H C) x
     # e = x - xhat = R0 x + Co (theta x - w); (theta x - w)' = F (theta x - w) + R x + R1 d

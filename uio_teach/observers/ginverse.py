@@ -164,7 +164,7 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
     poles = obs.poles()
     if fixed is not None and len(fixed) <= len(poles):
         check_fixed_modes(poles, fixed, what="the g-inverse observer")
-    # from first principles: the observer state tracks (I - K C) x, xhat = Pc w + Dy y
+    # from first principles: the observer state tracks (I - Kg C) x, xhat = Pc w + Dy y
     real = obs.realization()
     obs._leak = check_decoupling(
         pl.A,
@@ -174,7 +174,7 @@ def verify_ginverse(obs: GInverseObserver, fixed: np.ndarray | None = None) -> N
         real.B_y,
         real.C,
         real.D_y,
-        K,
+        Kg,
         discrete=pl.is_discrete,
         what="the g-inverse observer",
         stacklevel=4,
