@@ -291,8 +291,8 @@ def _prose_claims() -> list[tuple[str, str]]:
         ),
         (
             "missile.md",
-            f"v_1(t) = {_num(a1)}\\, e^{{-{_num(r1)}t}} \\{k1}({_num(w1)} t), \\qquad "
-            f"v_2(t) = {_num(a2)}\\, e^{{-{_num(r2)}t}} \\{k2}({_num(w2)} t)",
+            f"v_1(t) = {_num(a1)}\\, \\mathrm{{e}}^{{-{_num(r1)}t}} \\{k1}({_num(w1)} t), \\qquad "
+            f"v_2(t) = {_num(a2)}\\, \\mathrm{{e}}^{{-{_num(r2)}t}} \\{k2}({_num(w2)} t)",
         ),
         (
             "missile.md",
@@ -304,7 +304,7 @@ def _prose_claims() -> list[tuple[str, str]]:
             "missile.md",
             f"pole ${_num(poles_missile[0])}$ for $x_1$ and ${_num(poles_missile[1])}$ for $x_2$",
         ),
-        ("missile.md", f"the error ${_num(x0_missile[0])}\\,e^{{-l_1 t}}$"),
+        ("missile.md", f"the error ${_num(x0_missile[0])}\\,\\mathrm{{e}}^{{-l_1 t}}$"),
         # fault detection: the PA9 experiment again
         ("fault_detection.md", f"the experiment's poles $\\{{{poles_pa9}\\}}$"),
         ("fault_detection.md", f"over the same {_num(PA9.duration)} s"),

@@ -801,9 +801,9 @@ def covered_curves(fig: Figure) -> list[tuple[str, str]]:
     >>> covered_curves(fig)
     [('rising', 'rising')]
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.cbook import STEP_LOOKUP_MAP
-    from matplotlib.transforms import Bbox
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # deferred: only this check draws
+    from matplotlib.cbook import STEP_LOOKUP_MAP  # deferred: as above
+    from matplotlib.transforms import Bbox  # deferred: as above
 
     if not hasattr(fig.canvas, "get_renderer"):  # a figure without pyplot: an Agg canvas
         FigureCanvasAgg(fig)
