@@ -31,12 +31,15 @@ test module that starts one at import time fails its collection.
 
 from __future__ import annotations
 
+import fcntl
 import functools
+import json
 import os
 import shlex
 import shutil
 import subprocess
 import sys
+import tempfile
 import threading
 from collections.abc import Iterator, Sequence
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
@@ -96,7 +99,10 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
         or _runs_module(words, "uio_teach.instructor.runner")  # the grader's notebook runner
     ):
         needs.add("kernel")
-    if names & {"jupyter-book", "sphinx-build"} or _runs_module(words, "jupyter_book", "sphinx"):
+    if (
+        names & {"jupyter-book", "sphinx-build", "run_chapters.py"}  # the book's chapters, run
+        or _runs_module(words, "jupyter_book", "sphinx")
+    ):
         needs.add("book")
     if "chromium" in text or "playwright" in text:
         needs.add("browser")
@@ -206,6 +212,109 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo) -> Itera
     return report
 
 
+# --- tests on two cores --------------------------------------------------------------------------
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Order the tests for ``pytest -n`` (pytest-xdist, ``--dist loadgroup
+    --no-loadscope-reorder``, as ``make test`` runs them), and keep together those that share a
+    costly fixture.
+
+    The tests of a module that share a module-scoped fixture (the graded class, the written
+    labs) are one group, run by one worker, and so are the checks of one page of the built book
+    (one worker opens the page once per width). The first test that needs the book build comes
+    first, so that one worker builds the book (``book_build``: one build for all workers) while
+    the others run the groups and then the rest; the tests that read the built book come last,
+    when the build is done. Without ``-n`` the order is the same and the marks change nothing.
+    """
+    first_book = next((i for i in items if "book_build" in getattr(i, "fixturenames", ())), None)
+
+    def rank(item: pytest.Item) -> int:
+        if item is first_book:
+            return 0
+        if "book_build" in getattr(item, "fixturenames", ()):
+            return 3
+        return 1 if _shares_module_fixture(item) else 2
+
+    for item in items:
+        if _shares_module_fixture(item):
+            item.add_marker(pytest.mark.xdist_group(item.module.__name__))  # type: ignore[attr-defined]
+        elif "book_server" in getattr(item, "fixturenames", ()) and "page" in _params(item):
+            # the checks of one built page: one worker, which opens the page once per width
+            item.add_marker(pytest.mark.xdist_group(f"page {_params(item)['page']}"))
+    items.sort(key=rank)  # stable: the collection's order within each rank
+    workerinput = getattr(config, "workerinput", None)
+    if workerinput is not None and "uio_teach_groups" in workerinput:
+        # for the scheduler of the main process (below), which sees only the tests' ids
+        groups = {}
+        for item in items:
+            marks = [
+                m.args[0] if m.args else m.kwargs.get("name", "default")
+                for m in item.iter_markers("xdist_group")
+            ]
+            if marks:
+                groups[item.nodeid] = "_".join(sorted(map(str, marks)))
+        path = Path(workerinput["uio_teach_groups"])
+        part = path.with_name(f"{path.name}.{workerinput['workerid']}")
+        part.write_text(json.dumps(groups), encoding="utf-8")
+        part.replace(path)  # whole or not at all: every worker writes the same
+
+
+# pytest-xdist's own ``loadgroup`` marks the groups by changing each test's id in a way
+# pytest 9 no longer supports (the groups are silently ignored): the course's scheduler below
+# reads the groups the workers wrote instead, through xdist's documented hooks.
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node) -> None:  # noqa: ANN001 (xdist's WorkerController)
+    node.workerinput["uio_teach_groups"] = str(_groups_file())
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log):  # noqa: ANN001, ANN201
+    if config.getoption("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class GroupScheduling(LoadScopeScheduling):
+        """``loadgroup``: the tests of a group go to one worker, every other test on its own."""
+
+        groups: dict[str, str] | None = None
+
+        def _split_scope(self, nodeid: str) -> str:
+            if self.groups is None:
+                path = _groups_file()
+                try:
+                    self.groups = json.loads(path.read_text(encoding="utf-8"))
+                except (OSError, ValueError) as exc:  # no worker wrote it: no groups
+                    self.log(f"no test groups ({exc}): every test on its own")
+                    self.groups = {}
+                path.unlink(missing_ok=True)
+            return self.groups.get(nodeid, nodeid)
+
+    return GroupScheduling(config, log)
+
+
+def _groups_file() -> Path:
+    """Where the workers write the groups for the main process (named after its id)."""
+    return Path(tempfile.gettempdir()) / f"uio-teach-xdist-groups-{os.getpid()}.json"
+
+
+def _params(item: pytest.Item) -> dict:
+    callspec = getattr(item, "callspec", None)
+    return callspec.params if callspec is not None else {}
+
+
+def _shares_module_fixture(item: pytest.Item) -> bool:
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None or getattr(item, "module", None) is None:
+        return False
+    return any(
+        d.scope in ("module", "package") for defs in info.name2fixturedefs.values() for d in defs
+    )
+
+
 # --- the book, built once per run ---------------------------------------------------------------
 
 
@@ -223,20 +332,45 @@ class BookBuild(NamedTuple):
 
 
 @pytest.fixture(scope="session")
-def book_build() -> BookBuild:
+def book_build(tmp_path_factory: pytest.TempPathFactory) -> BookBuild:
     """Build the book once per test run, as ``make book`` does, every chapter executed afresh.
 
     The execution cache is emptied and every page re-read (``--all``) first, so each chapter runs
     against the package as it is now, not as it was when the cache was filled: this build is
     what proves the chapters run (``test_chapters.py``), not a second execution of each.
+
+    With ``pytest -n`` the first worker to need it builds the book and writes down the result;
+    the others wait for it (a lock in the run's shared temporary folder) and read it.
     """
+    shared = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        shared = shared.parent  # the run's folder, above each worker's own
+    record = shared / "book_build.json"
+    with open(shared / "book_build.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
+        if record.is_file():
+            return BookBuild(**json.loads(record.read_text(encoding="utf-8")))
+        build = _build_book()
+        record.write_text(json.dumps(build._asdict()), encoding="utf-8")
+        return build
+
+
+def _build_book() -> BookBuild:
     shutil.rmtree(ROOT / "_build" / ".jupyter_cache", ignore_errors=True)
     shutil.rmtree(HTML / "reports", ignore_errors=True)
+    # as `make book`: the chapters run on every core first, then the build reads them
+    run = [sys.executable, str(ROOT / "_ext" / "run_chapters.py")]
+    first = subprocess.run(run, cwd=ROOT, capture_output=True, text=True, timeout=BOOK_BUILD_LIMIT)
     command = [jupyter_book(), "build", ".", "--all", "-W", "-n", "--keep-going"]
     proc = subprocess.run(
         command, cwd=ROOT, capture_output=True, text=True, timeout=BOOK_BUILD_LIMIT
     )
-    return BookBuild(command, proc.returncode, (proc.stdout + proc.stderr)[-8000:])
+    # a chapter that failed (or did not run) there is run again by the build, which reports it
+    (ROOT / "_build" / "run_chapters.log").write_text(
+        f"exit status {first.returncode}\n{first.stdout}\n{first.stderr}", encoding="utf-8"
+    )
+    log = (first.stdout + first.stderr)[-2000:] + (proc.stdout + proc.stderr)[-6000:]
+    return BookBuild(command, proc.returncode, log)
 
 
 @pytest.fixture(scope="session")

@@ -4,15 +4,17 @@ The book is built once per test run into the repository's ``_build/html`` with t
 ``make book``. The browser test serves that folder on 127.0.0.1, opens every page of ``_toc.yml``
 in headless Chromium (Debian's ``/usr/bin/chromium``, driven by Playwright), blocks every request
 that leaves the local server, and checks that the mathematics is typeset, every image loaded, no
-output cell shows an error and the console stays clean. A screenshot of each page is saved in
-``_build/screenshots/``. At 1280 px every display equation, every visible code line and every
-printed output fits its column. The browser tests wait on events and page state (the load event,
-fonts, images, MathJax), never on a fixed duration, and assert nothing about how long anything
-took.
+output cell shows an error and the console stays clean; each page is opened once per width and
+every check reads that load (``page_facts``), which saves a full-page screenshot in
+``_build/screenshots/`` when ``UIO_TEACH_SCREENSHOTS`` is set. At 1280 px every display
+equation, every visible code line and every printed output fits its column. The browser tests
+wait on events and page state (the load event, fonts, images, MathJax), never on a fixed
+duration, and assert nothing about how long anything took.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from html.parser import HTMLParser
 from pathlib import Path
@@ -141,6 +143,55 @@ async () => { await document.fonts.ready; return document.fonts.status; }
 """
 
 
+# The layout at a width (read by test_student_edition.py): whether the page scrolls sideways,
+# the elements that reach past the viewport outside a frame, the frames that scroll and whether
+# they show a cue, and each picture's natural and shown size.
+SCREEN_JS = """
+() => {
+  const se = document.scrollingElement;
+  // the article: the side bars are drawers off screen on a phone
+  const main = document.querySelector("article.bd-article") || document.body;
+  const out = {page: se.scrollWidth, viewport: se.clientWidth, loose: [], frames: [], images: []};
+  const scrolls = (el) => ["auto", "scroll"].includes(getComputedStyle(el).overflowX);
+  for (const el of main.querySelectorAll("*")) {
+    if (!el.checkVisibility()) continue;
+    const r = el.getBoundingClientRect();
+    if (r.width === 0 || r.right <= se.clientWidth + 0.5) continue;
+    let framed = false;
+    for (let a = el.parentElement; a && a !== main; a = a.parentElement) {
+      if (["auto", "scroll", "hidden", "clip"].includes(getComputedStyle(a).overflowX)) {
+        framed = true; break;
+      }
+    }
+    if (!framed) {
+      const name = `${el.tagName}.${String(el.className).slice(0, 30)}`;
+      out.loose.push(`${name} to ${Math.round(r.right)}`);
+    }
+  }
+  const boxes = "pre, table, .output, .cell_output, .table-wrapper, mjx-container";
+  for (const el of main.querySelectorAll(boxes)) {
+    if (!el.checkVisibility() || el.scrollWidth <= el.clientWidth + 1 || !scrolls(el)) continue;
+    const s = getComputedStyle(el);
+    const cue = /gradient/.test(s.backgroundImage) || s.scrollbarWidth === "thin"
+      || el.closest(".uio-static-explorer") !== null;
+    out.frames.push({what: `${el.tagName}.${String(el.className).slice(0, 30)}`, cue});
+  }
+  for (const img of main.querySelectorAll("img")) {
+    if (!img.checkVisibility() || !img.naturalWidth) continue;
+    const r = img.getBoundingClientRect();
+    out.images.push({
+      explorer: img.closest(".uio-static-explorer") !== null,
+      output: img.closest(".cell_output") !== null,
+      natural: img.naturalWidth, naturalHeight: img.naturalHeight,
+      width: r.width, height: r.height,
+      src: (img.getAttribute("src") || "").slice(0, 60),
+    });
+  }
+  return out;
+}
+"""
+
+
 def _new_context(browser, width: int):
     """A browser context of the given viewport width, with the safety-net timeouts."""
     context = browser.new_context(viewport={"width": width, "height": 900})
@@ -149,26 +200,82 @@ def _new_context(browser, width: int):
     return context
 
 
-def _open_local(browser, book_server: str, page: str, width: int):
+def _open_local(browser, book_server: str, page: str, width: int, listen: dict | None = None):
     """Open a page of the book (requests to other hosts aborted) once it is fully rendered.
 
     Waits on events and page state only: the load event, then the web fonts, every image and
-    MathJax's typesetting. Returns the context (close it) and the tab.
+    MathJax's typesetting. ``listen`` collects what went wrong while loading (requests blocked,
+    failed responses, console errors). Returns the context (close it) and the tab.
     """
     context = _new_context(browser, width)
     tab = context.new_page()
     host = urlsplit(book_server).hostname
-    tab.route(
-        "**/*",
-        lambda route: (
-            route.continue_() if urlsplit(route.request.url).hostname == host else route.abort()
+    found = listen if listen is not None else {}
+    for key in ("blocked", "failed", "console"):
+        found.setdefault(key, [])
+
+    def route(route) -> None:
+        if urlsplit(route.request.url).hostname == host:
+            route.continue_()
+        else:
+            found["blocked"].append(route.request.url)
+            route.abort()
+
+    tab.route("**/*", route)
+    tab.on(
+        "console",
+        lambda msg: (
+            found["console"].append(f"console: {msg.text}") if msg.type == "error" else None
         ),
     )
-    tab.goto(f"{book_server}/{page}.html", wait_until="load")
+    tab.on("pageerror", lambda exc: found["console"].append(f"page error: {exc}"))
+    tab.on(
+        "response",
+        lambda r: found["failed"].append(f"{r.status} {r.url}") if r.status >= 400 else None,
+    )
+    response = tab.goto(f"{book_server}/{page}.html", wait_until="load")
+    found["loaded"] = response is not None and response.ok
+    found["broken_images"] = tab.evaluate(_WAIT_FOR_IMAGES_JS)
+    found["typeset"] = tab.evaluate(_WAIT_FOR_MATHJAX_JS)
     tab.evaluate(_WAIT_FOR_FONTS_JS)
-    tab.evaluate(_WAIT_FOR_IMAGES_JS)
-    tab.evaluate(_WAIT_FOR_MATHJAX_JS)
     return context, tab
+
+
+# Each page is opened once per width in a test process (the tests of one page run on one
+# worker: tests/conftest.py), and everything the checks look at is read from that one load.
+_FACTS: dict[tuple[str, int], dict] = {}
+
+
+def page_facts(browser, book_server: str, page: str, width: int) -> dict:
+    """What the browser shows of ``page`` at ``width`` px: load errors, the typeset mathematics,
+    the visible prose, the outputs, the display equations, the code lines and the layout.
+
+    A full-page screenshot is saved in ``_build/screenshots/`` when the environment variable
+    ``UIO_TEACH_SCREENSHOTS`` is set (``make test UIO_TEACH_SCREENSHOTS=1``).
+    """
+    key = (page, width)
+    if key in _FACTS:
+        return _FACTS[key]
+    facts: dict = {}
+    context, tab = _open_local(browser, book_server, page, width, listen=facts)
+    try:
+        facts["has_math"] = tab.locator("main .math").count() > 0
+        facts["rendered_math"] = tab.locator("mjx-container").count()
+        facts["prose"] = tab.evaluate(_VISIBLE_PROSE_JS)
+        facts["error_outputs"] = tab.locator(_ERROR_OUTPUTS).all_inner_texts()
+        facts["cell_outputs"] = "\n".join(tab.locator(".cell_output").all_inner_texts())
+        facts["equations"] = tab.evaluate(_DISPLAY_EQUATIONS_JS)
+        facts["wide_code"] = tab.evaluate(_WIDE_CODE_JS)
+        facts["screen"] = tab.evaluate(SCREEN_JS)
+        if os.environ.get("UIO_TEACH_SCREENSHOTS"):
+            SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+            name = _screenshot_name(page).removesuffix(".png")
+            tab.screenshot(path=str(SCREENSHOTS / f"{name}-{width}px.png"), full_page=True)
+        facts["wide_outputs"] = tab.evaluate(_WIDE_OUTPUTS_JS)  # last: it opens the dropdowns
+    finally:
+        context.close()
+    _FACTS[key] = facts
+    return facts
 
 
 _ERROR_OUTPUTS = ".output.error, .output.traceback, .output.stderr"
@@ -187,61 +294,21 @@ def _screenshot_name(page: str) -> str:
 @pytest.mark.browser
 @pytest.mark.parametrize("page", PAGES)
 def test_page_in_browser(page: str, book_server: str, browser) -> None:
-    host = urlsplit(book_server).hostname
-    blocked: list[str] = []
-    console_errors: list[str] = []
-    failed: list[str] = []
-
-    context = _new_context(browser, 1280)
-    tab = context.new_page()
-
-    def route(route) -> None:
-        if urlsplit(route.request.url).hostname == host:
-            route.continue_()
-        else:
-            blocked.append(route.request.url)
-            route.abort()
-
-    tab.route("**/*", route)
-    tab.on(
-        "console",
-        lambda msg: console_errors.append(f"console: {msg.text}") if msg.type == "error" else None,
-    )
-    tab.on("pageerror", lambda exc: console_errors.append(f"page error: {exc}"))
-    tab.on(
-        "response",
-        lambda r: failed.append(f"{r.status} {r.url}") if r.status >= 400 else None,
-    )
-    try:
-        response = tab.goto(f"{book_server}/{page}.html", wait_until="load")
-        assert response is not None and response.ok, f"{page}.html did not load"
-
-        broken_images = tab.evaluate(_WAIT_FOR_IMAGES_JS)
-        typeset = tab.evaluate(_WAIT_FOR_MATHJAX_JS)
-        tab.evaluate(_WAIT_FOR_FONTS_JS)
-        has_math = tab.locator("main .math").count() > 0
-        rendered_math = tab.locator("mjx-container").count()
-        prose = tab.evaluate(_VISIBLE_PROSE_JS)
-        error_outputs = tab.locator(_ERROR_OUTPUTS).all_inner_texts()
-        cell_outputs = "\n".join(tab.locator(".cell_output").all_inner_texts())
-
-        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-        tab.screenshot(path=str(SCREENSHOTS / _screenshot_name(page)), full_page=True)
-    finally:
-        context.close()
-
-    assert not blocked, f"{page}: requests that leave the local server: {blocked}"
-    assert not failed, f"{page}: failed requests: {failed}"
-    if has_math:
-        assert typeset, f"{page}: has math but MathJax did not start"
-        assert rendered_math > 0, f"{page}: has math but no mjx-container was rendered"
-    raw = [delimiter for delimiter in ("\\(", "\\[", "$$") if delimiter in prose]
+    facts = page_facts(browser, book_server, page, 1280)
+    assert facts["loaded"], f"{page}.html did not load"
+    assert not facts["blocked"], f"{page}: requests that leave the local server: {facts['blocked']}"
+    assert not facts["failed"], f"{page}: failed requests: {facts['failed']}"
+    if facts["has_math"]:
+        assert facts["typeset"], f"{page}: has math but MathJax did not start"
+        assert facts["rendered_math"] > 0, f"{page}: has math but no mjx-container was rendered"
+    raw = [delimiter for delimiter in ("\\(", "\\[", "$$") if delimiter in facts["prose"]]
     assert not raw, f"{page}: raw TeX delimiters {raw} left in the visible text"
-    assert not broken_images, f"{page}: images that did not load: {broken_images}"
-    assert not error_outputs, f"{page}: error or stderr output cells: {error_outputs}"
-    match = _EXCEPTION_LINE.search(cell_outputs)
+    assert not facts["broken_images"], f"{page}: images that did not load: {facts['broken_images']}"
+    errors = facts["error_outputs"]
+    assert not errors, f"{page}: error or stderr output cells: {errors}"
+    match = _EXCEPTION_LINE.search(facts["cell_outputs"])
     assert match is None, f"{page}: an output cell shows an exception: {match.group(0)!r}"
-    assert not console_errors, f"{page}: browser console errors: {console_errors}"
+    assert not facts["console"], f"{page}: browser console errors: {facts['console']}"
 
 
 # --- every display equation visible -------------------------------------------------------------
@@ -271,11 +338,7 @@ _DISPLAY_EQUATIONS_JS = """
 
 
 def _display_equations(browser, book_server: str, page: str, width: int) -> list[dict]:
-    context, tab = _open_local(browser, book_server, page, width)
-    try:
-        return tab.evaluate(_DISPLAY_EQUATIONS_JS)
-    finally:
-        context.close()
+    return page_facts(browser, book_server, page, width)["equations"]
 
 
 def _describe(page: str, equation: dict) -> str:
@@ -331,11 +394,7 @@ _WIDE_CODE_JS = """
 @pytest.mark.browser
 @pytest.mark.parametrize("page", PAGES)
 def test_visible_code_lines_fit_at_1280px(page: str, book_server: str, browser) -> None:
-    context, tab = _open_local(browser, book_server, page, 1280)
-    try:
-        wide = tab.evaluate(_WIDE_CODE_JS)
-    finally:
-        context.close()
+    wide = page_facts(browser, book_server, page, 1280)["wide_code"]
     assert not wide, f"{page}: code lines wider than their column at 1280 px:\n" + "\n".join(
         f"code cell {w['cell']}: {w['width']} px in {w['box']} px: {w['text']!r}" for w in wide
     )
@@ -374,11 +433,7 @@ _WIDE_OUTPUTS_JS = """
 @pytest.mark.browser
 @pytest.mark.parametrize("page", PAGES)
 def test_printed_outputs_fit_at_1280px(page: str, book_server: str, browser) -> None:
-    context, tab = _open_local(browser, book_server, page, 1280)
-    try:
-        wide = tab.evaluate(_WIDE_OUTPUTS_JS)
-    finally:
-        context.close()
+    wide = page_facts(browser, book_server, page, 1280)["wide_outputs"]
     assert not wide, f"{page}: outputs wider than their column at 1280 px:\n" + "\n".join(
         f"output {w['output']} ({w['tag']}): {w['width']} px in {w['box']} px: {w['text']!r}"
         for w in wide

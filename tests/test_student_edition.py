@@ -20,6 +20,7 @@ What the pages hide is read from their MyST sources: code cells tagged ``solutio
 
 from __future__ import annotations
 
+import copy
 import json
 import re
 import unicodedata
@@ -29,7 +30,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
-from test_book import PAGES, ROOT, SCREENSHOTS, _open_local
+from test_book import PAGES, ROOT, page_facts
 
 # the book (conftest's built_book), its local server and the browser (conftest: one each per run)
 
@@ -310,51 +311,6 @@ def test_fonts_of_the_chapters_figures() -> None:
 
 # --- the screen --------------------------------------------------------------------------------
 
-_SCREEN_JS = """
-() => {
-  const se = document.scrollingElement;
-  // the article: the side bars are drawers off screen on a phone
-  const main = document.querySelector("article.bd-article") || document.body;
-  const out = {page: se.scrollWidth, viewport: se.clientWidth, loose: [], frames: [], images: []};
-  const scrolls = (el) => ["auto", "scroll"].includes(getComputedStyle(el).overflowX);
-  for (const el of main.querySelectorAll("*")) {
-    if (!el.checkVisibility()) continue;
-    const r = el.getBoundingClientRect();
-    if (r.width === 0 || r.right <= se.clientWidth + 0.5) continue;
-    let framed = false;
-    for (let a = el.parentElement; a && a !== main; a = a.parentElement) {
-      if (["auto", "scroll", "hidden", "clip"].includes(getComputedStyle(a).overflowX)) {
-        framed = true; break;
-      }
-    }
-    if (!framed) {
-      const name = `${el.tagName}.${String(el.className).slice(0, 30)}`;
-      out.loose.push(`${name} to ${Math.round(r.right)}`);
-    }
-  }
-  const boxes = "pre, table, .output, .cell_output, .table-wrapper, mjx-container";
-  for (const el of main.querySelectorAll(boxes)) {
-    if (!el.checkVisibility() || el.scrollWidth <= el.clientWidth + 1 || !scrolls(el)) continue;
-    const s = getComputedStyle(el);
-    const cue = /gradient/.test(s.backgroundImage) || s.scrollbarWidth === "thin"
-      || el.closest(".uio-static-explorer") !== null;
-    out.frames.push({what: `${el.tagName}.${String(el.className).slice(0, 30)}`, cue});
-  }
-  for (const img of main.querySelectorAll("img")) {
-    if (!img.checkVisibility() || !img.naturalWidth) continue;
-    const r = img.getBoundingClientRect();
-    out.images.push({
-      explorer: img.closest(".uio-static-explorer") !== null,
-      output: img.closest(".cell_output") !== null,
-      natural: img.naturalWidth, naturalHeight: img.naturalHeight,
-      width: r.width, height: r.height,
-      src: (img.getAttribute("src") || "").slice(0, 60),
-    });
-  }
-  return out;
-}
-"""
-
 
 def _explorer_text_px(image: dict, width: int) -> float:
     """The smallest text of an explorer picture as shown, in CSS pixels."""
@@ -378,14 +334,7 @@ def _explorer_text_px(image: dict, width: int) -> float:
 
 
 def measure(browser, book_server: str, page: str, width: int) -> dict:
-    context, tab = _open_local(browser, book_server, page, width)
-    try:
-        m = tab.evaluate(_SCREEN_JS)
-        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-        name = "-".join(Path(page).parts[1:] or Path(page).parts)
-        tab.screenshot(path=str(SCREENSHOTS / f"{name}-{width}px.png"), full_page=True)
-    finally:
-        context.close()
+    m = copy.deepcopy(page_facts(browser, book_server, page, width)["screen"])
     for image in m["images"]:
         if image["explorer"]:
             image["text_px"] = _explorer_text_px(image, width)

@@ -271,6 +271,60 @@ class ExplorerFigure:
         self._legend_boxes: dict[str, tuple[int, int, int, int]] = {}
         self._title_boxes: dict[str, list[tuple[int, int, int, int]]] = {}
 
+    @staticmethod
+    def _shape(sc: Scenario) -> tuple:
+        """What the figure's panels, lines, labels and legends are made from (not the data)."""
+        plant = sc.plant
+        return (
+            plant.n, plant.p, plant.q, plant.nv, plant.dt, sc.discrete, sc.reconstruct,
+            sc.input_symbol, sc.observer_name, sc.movable > 0, bool(sc.fixed_poles.size),
+            bool(sc.invariant_zeros.size),
+        )  # fmt: skip
+
+    def replace_scenario(self, scenario: Scenario) -> bool:
+        """Show another plant of the same shape in this figure (a physical parameter moved).
+
+        The panels, lines, labels and legends are kept; the invariant zeros are moved on the
+        pole map and every axis range is chosen afresh at the next :meth:`update`, and the
+        next :meth:`draw` redraws the pole map. A scenario with other panels, channels or
+        legend entries (another number of states, or zeros where there were none) cannot be
+        shown this way.
+
+        Parameters
+        ----------
+        scenario : Scenario
+            The new scenario.
+
+        Returns
+        -------
+        bool
+            Whether the figure now shows ``scenario``; ``False`` leaves it unchanged (build a
+            new figure instead).
+
+        Examples
+        --------
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+        >>> s = scenario_of("quadruple_tank")
+        >>> ef = ExplorerFigure(s)
+        >>> ef.update(compute_frame(s))
+        >>> ef.draw()
+        >>> s2 = s.rebuild(gamma1=0.8)
+        >>> ef.replace_scenario(s2), ef.scenario is s2
+        (True, True)
+        >>> ef.update(compute_frame(s2))
+        >>> ef.draw()
+        >>> ef.full_draws
+        1
+        """
+        if self._shape(scenario) != self._shape(self.scenario):
+            return False
+        self.scenario = scenario
+        zeros = scenario.invariant_zeros
+        self._zeros.set_data(zeros.real, zeros.imag)
+        self._fresh = True  # every range from the new plant's signals
+        self._keys.pop("poles", None)  # the zeros are drawn with the pole map's background
+        return True
+
     def smallest_text_pt(self) -> float:
         """The size of the smallest text drawn in the figure, in points.
 
@@ -436,7 +490,7 @@ class ExplorerFigure:
             pz.axvline(0.0, color="0.5", lw=0.8)
         pz.axhline(0.0, color="0.8", lw=0.6)
         zeros = sc.invariant_zeros
-        pz.plot(
+        (self._zeros,) = pz.plot(
             zeros.real, zeros.imag, "o", ms=9, mfc="none", mec="C2", mew=1.5,
             label="fixed" if zeros.size else "_fixed",
         )  # fmt: skip

@@ -376,7 +376,8 @@ def static_explorer(
         )
         return wide, small
 
-    # a plant control remakes the plant, its zeros and the figure for each value
+    # a plant control remakes the plant and its zeros for each value (and the figures when
+    # their panels or legends differ)
     remake = plant_control is not None and scenario.rebuild is not None
     made: dict[tuple[int, int], StaticFrame] = {}
     figure, phone = figures(scenario)
@@ -384,7 +385,11 @@ def static_explorer(
         plant_scenario = scenario
         if remake:
             plant_scenario = scenario.rebuild(**{plant_control.name: value})
-            figure, phone = figures(plant_scenario)
+            same = figure.replace_scenario(plant_scenario)
+            if phone is not None:
+                same = phone.replace_scenario(plant_scenario) and same
+            if not same:  # other panels or legends
+                figure, phone = figures(plant_scenario)
         for j, kind in enumerate(disturbances):
             s = frame_settings(scenario, base, value, kind)
             frame = compute_frame(plant_scenario, s)

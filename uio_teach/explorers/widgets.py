@@ -494,14 +494,16 @@ class Explorer(DragPoles):
             self.update()
 
     def _plant_changed(self, change: dict) -> None:
-        """A physical parameter moved: remake the scenario (plant, existence) and the figure."""
+        """A physical parameter moved: remake the scenario (plant, existence) and show it in the
+        same figure (a new one only if its panels or legends differ)."""
         old = self.scenario
         values = {pc.name: float(self.controls[pc.name].value) for pc in old.plant_controls}
         new = old.rebuild(**values)
         self.scenario = new
         _LIVE[new.name] = self
-        self.figure.fig.clear()
-        self.figure = ExplorerFigure(new, dpi=self.figure.fig.dpi)
+        if not self.figure.replace_scenario(new):  # other panels or legends: a new figure
+            self.figure.fig.clear()
+            self.figure = ExplorerFigure(new, dpi=self.figure.fig.dpi)
         fixed = new.fixed_poles
         text = f"fixed: {format_poles(fixed, 3)} (invariant zeros)" if fixed.size else ""
         self._fixed_text.value = f"<small>{html.escape(text)}</small>"
