@@ -265,6 +265,20 @@ def test_figure_is_updated_in_place(scenario):
     assert_same(ef.lines["lb.residual"][-1].get_ydata(), frame.curves["lb.residual"][-1])
 
 
+@pytest.mark.parametrize("narrow", [False, True])
+def test_every_panel_has_a_cell_of_its_own(scenario, narrow):
+    """Each panel (the pole map drawn round in discrete time too) keeps to a cell, so a change of
+    its range redraws that cell alone, not the whole figure."""
+    ef = ExplorerFigure(scenario, dpi=60, narrow=narrow)
+    ef.update(compute_frame(scenario))
+    ef.draw()
+    assert set(ef.axes) <= set(ef._cells), sorted(set(ef.axes) - set(ef._cells))
+    moved = scenario.defaults.replace(amplitude=3 * scenario.defaults.amplitude)
+    ef.update(compute_frame(scenario, moved))
+    ef.draw()
+    assert ef.full_draws == 1 and ef.partial_draws == 1
+
+
 @pytest.mark.slow
 def test_fast_draw_matches_a_full_draw(scenario):
     """Blitting and partial redraws give (almost exactly) the picture of a full draw."""

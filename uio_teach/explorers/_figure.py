@@ -901,9 +901,13 @@ class ExplorerFigure:
             return {}
         title_cut = (top + title.y0) / 2
         footer_cut = bottom - 1
-        pos = {name: ax.get_position() for name, ax in self.axes.items()}
-        lefts = sorted({round(p.x0, 6) for p in pos.values()})
-        columns = [[n for n, p in pos.items() if round(p.x0, 6) == x] for x in lefts]
+        # the columns of the grid (a pole map drawn round is narrower than its grid cell, so
+        # its left edge does not tell its column)
+        grid_column = {name: ax.get_subplotspec().colspan.start for name, ax in self.axes.items()}
+        columns = [
+            [n for n, c in grid_column.items() if c == column]
+            for column in sorted(set(grid_column.values()))
+        ]
         cuts = [0.0]
         for left, right in itertools.pairwise(columns):
             a = max(tight[n].x1 for n in left)
