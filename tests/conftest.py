@@ -268,7 +268,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_configure_node(node) -> None:  # noqa: ANN001 (xdist's WorkerController)
-    node.workerinput["uio_teach_groups"] = str(_groups_file())
+    if node.config.getoption("dist") == "loadgroup":
+        node.workerinput["uio_teach_groups"] = str(_groups_file())
 
 
 @pytest.hookimpl(optionalhook=True)
