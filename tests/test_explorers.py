@@ -742,6 +742,7 @@ def test_zero_residual_is_drawn_flat_and_said():
     assert not compute_frame(sc).residual_zero
 
 
+@pytest.mark.slow  # every explorer drawn at both sizes over its settings
 @pytest.mark.parametrize("name", [*sorted(SCENARIOS), "quadruple_tank"])
 @pytest.mark.parametrize("narrow", [False, True])
 def test_no_legend_covers_a_curve(name, narrow):

@@ -150,6 +150,7 @@ def test_bank_figure_draws_every_member_over_its_threshold_with_legible_text():
     assert min(sizes_px) >= 9, min(sizes_px)
 
 
+@pytest.mark.slow  # every course figure drawn
 def test_no_legend_of_a_course_figure_covers_a_curve():
     import matplotlib
 
