@@ -6,28 +6,28 @@
    file of the folder is read, never written; its group comes from the file
    name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
    notebook's metadata says is only compared with it; a clean copy of its
-   cells is made (:func:`~uio_teach.instructor.runner.clean_notebook`);
-2. compares the class (:func:`_identity_notes`): a notebook that disagrees
+   cells is made (``uio_teach.instructor.runner.clean_notebook``);
+2. compares the class (``_identity_notes``): a notebook that disagrees
    with its name, a group handing in twice, the same code from two groups or
    no group at all is "check by hand", never ``ok``;
 3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
-   data (:mod:`uio_teach.instructor.runner`);
+   data (``uio_teach.instructor.runner``);
 4. runs the copy in a fresh kernel inside a sandbox
-   (:mod:`uio_teach.instructor.sandbox`: only its own copy visible, no
+   (``uio_teach.instructor.sandbox``: only its own copy visible, no
    network, no other process, an unprivileged user when the grader is root,
    limits on memory, processes, writes and time); a cell that raises or
    loops is recorded and the next cells still run;
 5. checks the answers in a child process with limits of time and memory
-   (:mod:`uio_teach.instructor.checking`): answers over the size caps are not
+   (``uio_teach.instructor.checking``): answers over the size caps are not
    rebuilt, the rest are rebuilt as genuine objects and checked with **the
-   answer key's parameters** (:mod:`uio_teach.checks.grading`). The verdicts
+   answer key's parameters** (``uio_teach.checks.grading``). The verdicts
    the check cells printed count for nothing, and nothing the notebook
    defines (``PARAMS``, a patched class, a patched module) reaches the
    checks: only right values pass;
 6. appends its row to the gradebook and writes its feedback at once
-   (:mod:`uio_teach.instructor.gradebook`), so a killed or interrupted run
+   (``uio_teach.instructor.gradebook``), so a killed or interrupted run
    keeps every finished row and ``resume=True`` grades only what is missing.
 
 Whatever fails on one hand-in (reading, preparing, running, reading back,
@@ -295,7 +295,7 @@ class Handin:
     lab, group : str
         From the roster, else from the file name (never from the notebook).
     notebook : NotebookNode or None
-        The grader's clean copy (:func:`~uio_teach.instructor.runner.clean_notebook`).
+        The grader's clean copy (``uio_teach.instructor.runner.clean_notebook``).
     status, reason : str
         ``"refused"`` or ``"unreadable"`` and why (empty when it can run).
     notes : list of str
@@ -408,7 +408,7 @@ def read_handin(
     """Read one hand-in: refuse what is not a regular file, parse it, find its lab and group.
 
     The file is opened without following links; a link, a folder, a device,
-    a second name of another file or a file over :data:`MAX_HANDIN_BYTES` is
+    a second name of another file or a file over ``MAX_HANDIN_BYTES`` is
     refused, and nothing of it is read. The group and lab come from the
     roster (by file name), else from a name like ``pa9_g03.ipynb``; what the
     notebook's metadata says is kept only to compare.
@@ -814,7 +814,7 @@ def grade(
     code from two groups, no group) is "check by hand", answers over the
     caps or checks over their limits are "over limits", and any failure of
     the grader itself on one hand-in is that row's "grader error". The run
-    goes on; see :data:`NEEDS_A_LOOK`.
+    goes on; see ``NEEDS_A_LOOK``.
 
     Parameters
     ----------
@@ -846,7 +846,7 @@ def grade(
     sandbox : bool
         Run each hand-in in the sandbox (refused where it is unavailable).
         ``False`` runs the students' code with your permissions, with a
-        :class:`UnsandboxedWarning`.
+        ``UnsandboxedWarning``.
     limits : Limits, optional
         Memory, processes, file size, CPU time and writes of a run.
 

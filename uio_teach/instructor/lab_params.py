@@ -10,7 +10,7 @@ from a term config (``from_config``), draws a variant for a lab group
 The fields of each class are not written here: they are the fields of the
 lab's experiment (:mod:`uio_teach.experiments`) declared with ``lab=True``,
 with the experiment's values as defaults, their place in ``PARAMS`` and their
-config key from the same declaration (:func:`lab_params_of`). Only what is
+config key from the same declaration (``lab_params_of``). Only what is
 particular to a lab is written here: how a group's variant is drawn, when a
 variant is a fair exercise, and the answer key.
 
@@ -184,7 +184,7 @@ def _put(params: dict[str, Any], path: str, value: Any) -> None:
 class LabParams:
     """What the three parameter classes share (see the module's docstring).
 
-    The fields come from the lab's experiment (:func:`lab_params_of`);
+    The fields come from the lab's experiment (``lab_params_of``);
     ``to_params``, ``from_params``, ``from_config`` and :meth:`plant` read
     the declarations, so they need no change when a field is added.
     """
@@ -523,7 +523,7 @@ class CaseStudyParams(LabParams):
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any] | None) -> CaseStudyParams:
-        """As :meth:`LabParams.from_config`; ``case_study.poles``, if given, sets :attr:`pole`."""
+        """As ``LabParams.from_config``; ``case_study.poles``, if given, sets ``pole``."""
         params = super().from_config(config)
         poles = None if config is None else config.get("case_study.poles")
         if poles:
