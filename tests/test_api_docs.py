@@ -10,11 +10,14 @@ from numpydoc.docscrape import FunctionDoc
 
 import uio_teach as ut
 
-# The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest.
+# The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest. Every
+# module of ``uio_teach.worked`` (one per worked example) is one of them, found, not listed.
+WORKED_MODULES = tuple(f"worked.{info.name}" for info in pkgutil.iter_modules(ut.worked.__path__))
 SUBPACKAGE_API = (
     "experiments",
+    "lab_params",
     "worked",
-    "worked.quadruple_tank",
+    *WORKED_MODULES,
     "luenberger",
     "explorers",
     "explorers.widgets",

@@ -244,11 +244,11 @@ def test_a_valve_moved_in_the_same_figure_draws_what_a_new_figure_draws():
 
 
 def test_a_scenario_of_another_shape_is_not_put_in_the_figure():
-    from uio_teach.explorers import ExplorerFigure, pa9_scenario
+    from uio_teach.explorers import ExplorerFigure, scenario_of
 
     ef = ExplorerFigure(scenario_of("quadruple_tank"), dpi=50)
     before = ef.scenario
-    assert not ef.replace_scenario(pa9_scenario())
+    assert not ef.replace_scenario(scenario_of("pa9"))
     assert ef.scenario is before
 
 

@@ -314,7 +314,7 @@ def test_fonts_of_the_chapters_figures() -> None:
 
 def _explorer_text_px(image: dict, width: int) -> float:
     """The smallest text of an explorer picture as shown, in CSS pixels."""
-    from uio_teach.explorers import pa9_scenario
+    from uio_teach.explorers import scenario_of
     from uio_teach.explorers._figure import ExplorerFigure
     from uio_teach.explorers.static import (
         NARROW_DPI,
@@ -325,7 +325,7 @@ def _explorer_text_px(image: dict, width: int) -> float:
 
     narrow = width <= NARROW_PX
     figure = ExplorerFigure(
-        pa9_scenario(),
+        scenario_of("pa9"),
         dpi=NARROW_DPI if narrow else 144,
         fontscale=NARROW_FONTSCALE if narrow else WIDE_FONTSCALE,
         narrow=narrow,

@@ -34,9 +34,9 @@ import numpy as np
 
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence
-from ..experiments import MISSILE
 from ..reconstruction import catch_time, reconstruct_input
 from ..simulation import simulate
+from ..worked.missile import MISSILE
 from .common import (
     CheckResult,
     as_poles,
@@ -402,7 +402,7 @@ def missile_reconstruction(
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import MISSILE
+    >>> from uio_teach.worked.missile import MISSILE
     >>> plant = MISSILE.plant()
     >>> pmo = ut.design_pmo(plant, poles=MISSILE.poles)
     >>> run = MISSILE.simulate(pmo, observer_state=None)  # z(0) = 0
@@ -709,7 +709,7 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import MISSILE
+    >>> from uio_teach.worked.missile import MISSILE
     >>> plant = MISSILE.plant()
     >>> run = MISSILE.simulate(ut.design_pmo(plant, poles=MISSILE.poles))
     >>> vhat = ut.reconstruct_input(plant, run)

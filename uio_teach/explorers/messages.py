@@ -347,10 +347,10 @@ def lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.messages import lmi_message
     >>> from uio_teach.lmi import LMIInfeasibleError
-    >>> lmi_message(case_study_scenario(), 0.4, LMIInfeasibleError("no", "infeasible"))[:38]
+    >>> lmi_message(scenario_of("case_study"), 0.4, LMIInfeasibleError("no", "infeasible"))[:38]
     'no gain meets the bound radius 0.4: th'
     """
     discrete = scenario.discrete
@@ -391,9 +391,9 @@ def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
     Examples
     --------
     >>> import numpy as np
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.messages import zero_notes
-    >>> zero_notes(case_study_scenario(), np.array([0.5]))[0][:36]
+    >>> zero_notes(scenario_of("case_study"), np.array([0.5]))[0][:36]
     'pole 0.5 sits on the invariant zero '
     """
     zeros = scenario.invariant_zeros

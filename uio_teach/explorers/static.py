@@ -23,9 +23,9 @@ Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 
 Examples
 --------
->>> from uio_teach.explorers import case_study_scenario
+>>> from uio_teach.explorers import scenario_of
 >>> from uio_teach.explorers.static import static_explorer
->>> page = static_explorer(case_study_scenario(), values=(0.0, 0.5), disturbances=("sinusoid",))
+>>> page = static_explorer(scenario_of("case_study"), values=(0.0, 0.5), disturbances=("sinusoid",))
 >>> page.count
 2
 >>> "http" in page.html
@@ -85,9 +85,9 @@ class StaticFrame:
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(pa9_scenario(), values=(-1.0,), disturbances=("sinusoid",))
+    >>> page = static_explorer(scenario_of("pa9"), values=(-1.0,), disturbances=("sinusoid",))
     >>> page.frames[0].png[:4], page.frames[0].label
     (b'\\x89PNG', '-1')
     """
@@ -128,9 +128,9 @@ class StaticExplorer:
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",))
+    >>> page = static_explorer(scenario_of("case_study"), values=(0.0,), disturbances=("sinusoid",))
     >>> page.element_id in page.html, page.count
     (True, 1)
     """
@@ -185,9 +185,9 @@ def frame_settings(
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import frame_settings
-    >>> s = pa9_scenario()
+    >>> s = scenario_of("pa9")
     >>> frame_settings(s, s.defaults, -4.0, "random steps").poles
     (-4.0, -2.0, -3.0)
     """
@@ -214,9 +214,9 @@ def frame_caption(frame: Frame) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers import compute_frame, scenario_of
     >>> from uio_teach.explorers.static import frame_caption
-    >>> frame_caption(compute_frame(pa9_scenario()))[:38]
+    >>> frame_caption(compute_frame(scenario_of("pa9")))[:38]
     'Disturbance: sinusoid, amplitude 1, fr'
     """
     name = frame.scenario.observer_name
@@ -253,9 +253,9 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers import compute_frame, scenario_of
     >>> from uio_teach.explorers.static import frame_alt
-    >>> frame_alt(compute_frame(pa9_scenario()), "UIO pole", "-1").split(". ")[1]
+    >>> frame_alt(compute_frame(scenario_of("pa9")), "UIO pole", "-1").split(". ")[1]
     'UIO: the error size |e| decays from 1.5 to 1.5e-05'
     """
     sc = frame.scenario
@@ -337,9 +337,9 @@ def static_explorer(
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(pa9_scenario(), values=(-1.0, -2.0),
+    >>> page = static_explorer(scenario_of("pa9"), values=(-1.0, -2.0),
     ...                        disturbances=("sinusoid", "random steps"))
     >>> page.count, page.html.count('data-k="')
     (4, 4)
@@ -472,9 +472,9 @@ def static_html(
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_html
-    >>> text = static_html(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",),
+    >>> text = static_html(scenario_of("case_study"), values=(0.0,), disturbances=("sinusoid",),
     ...                    element_id="demo")
     >>> text.startswith('<div id="demo"'), 'type="range"' in text
     (True, True)

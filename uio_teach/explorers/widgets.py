@@ -61,10 +61,7 @@ from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import (
-    case_study_scenario,
     make_scenario,
-    missile_scenario,
-    pa9_scenario,
     scenario_of,
 )
 from .static import static_html
@@ -633,7 +630,7 @@ def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
 
     Three movable poles (real, or one complex pair and a real pole), the
     disturbance type, amplitude, frequency or switching period, and the
-    measurement noise. See :func:`uio_teach.explorers.pa9_scenario`.
+    measurement noise. See :mod:`uio_teach.worked.pa9`.
 
     Parameters
     ----------
@@ -655,7 +652,7 @@ def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     >>> sorted(n for n in ex.controls if n.startswith("pole"))
     ['pole 1', 'pole 2 frequency', 'pole 2 real part']
     """
-    return Explorer(pa9_scenario(), static=static, drag=drag)
+    return worked_explorer("pa9", static=static, drag=drag)
 
 
 def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
@@ -663,7 +660,7 @@ def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Exp
 
     The two fixed poles at 0.5 are the invariant zeros; in ``"LMI bound"``
     mode the gain comes from the LMI, infeasible below radius 0.5. See
-    :func:`uio_teach.explorers.case_study_scenario`.
+    :mod:`uio_teach.worked.case_study`.
 
     Parameters
     ----------
@@ -685,7 +682,7 @@ def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Exp
     >>> bool(abs(ex.frame.poles).max() <= 0.8 + 1e-6)
     True
     """
-    return Explorer(case_study_scenario(), static=static, drag=drag)
+    return worked_explorer("case_study", static=static, drag=drag)
 
 
 def missile_explorer(
@@ -696,7 +693,7 @@ def missile_explorer(
     Two movable poles of the projection-operator observer (the other two
     are fixed at the invariant zeros), the unknown inputs (by default the
     paper's damped sinusoids), noise and the reconstruction filter's time
-    constant. See :func:`uio_teach.explorers.missile_scenario`.
+    constant. See :mod:`uio_teach.worked.missile`.
 
     Parameters
     ----------
@@ -727,7 +724,7 @@ def missile_explorer(
     """
     if observer_family not in ("pmo", "ginverse"):
         raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
-    scenario = missile_scenario()
+    scenario = scenario_of("missile")
     if observer_family == "ginverse":
         scenario = dataclasses.replace(
             scenario,

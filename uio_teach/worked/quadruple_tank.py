@@ -38,7 +38,7 @@ from ..existence import check_existence
 from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
 from ..luenberger import luenberger_poles
 from ..observers import design_luenberger, design_uio
-from . import FigureEntry, WorkedExample
+from . import ExplorerOptions, FigureEntry, WorkedExample
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -310,21 +310,19 @@ EXAMPLES = (
         experiment=f"{__name__}:QUADRUPLE_TANK",
         family="uio",
         order=40,
-        explorer=MappingProxyType(
-            {
-                "title": "Quadruple tank",
-                "samples": 601,
-                "period": 100.0,
-                "pole_limits": (-0.5, 0.01),
-                "frequency_limits": (0.0, 0.5),
-                "period_limits": (10.0, 300.0),
-                "noise_limits": (0.0, 0.2),
-                "d_channels": ((1.0, 1.0), (0.5, 1.5)),
-                # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3)
-                "static_control": "plant:gamma2",
-                "static_values": (0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
-                "note": f"{__name__}:valve_verdict",
-            }
+        explorer=ExplorerOptions(
+            title="Quadruple tank",
+            samples=601,
+            period=100.0,
+            pole_limits=(-0.5, 0.01),
+            frequency_limits=(0.0, 0.5),
+            period_limits=(10.0, 300.0),
+            noise_limits=(0.0, 0.2),
+            d_channels=((1.0, 1.0), (0.5, 1.5)),
+            # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3)
+            static_control="plant:gamma2",
+            static_values=(0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
+            note=f"{__name__}:valve_verdict",
         ),
         figures=(
             FigureEntry(
