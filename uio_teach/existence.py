@@ -497,15 +497,15 @@ def zero_condition(zs: ZeroSet) -> Condition:
 def _clear_note(zs: ZeroSet, mask: np.ndarray, where: str) -> str:
     """For the zero closest to the boundary among ``mask``: its distance and its radius.
 
-    Said only when it is close (within ``CLOSE_NOTE_RTOL`` of the largest zero, the zeros' own
-    scale): the verdict is decided, and the note shows by how much.
+    Said only when it is close (within ``CLOSE_NOTE_RTOL`` of the system's own rate or of the
+    largest zero): the verdict is decided, and the note shows by how much.
     """
     d, r, z = zs.distance[mask], zs.radius[mask], zs.zeros[mask]
     finite = np.abs(zs.zeros[np.isfinite(zs.zeros)])
     if not d.size or not finite.size:
         return ""
     i = int(np.argmin(d))
-    if not d[i] <= tols.CLOSE_NOTE_RTOL * float(np.max(finite)):
+    if not d[i] <= tols.CLOSE_NOTE_RTOL * max(float(np.max(finite)), zs.scale):
         return ""
     return (
         f" (the closest, {format_complex(z[i])}, lies {d[i]:.2g} from the {where}; a "

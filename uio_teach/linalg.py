@@ -574,6 +574,9 @@ class ZeroSet(NamedTuple):
         A plant within ``backward_error`` of the data has a zero on the stability boundary.
     discrete : bool
         Which boundary: the unit circle (True) or the imaginary axis.
+    scale : float
+        The system's own rate, ``||A||`` of the balanced plant in continuous time (1 in
+        discrete time): the zeros' sizes are judged against it.
 
     Examples
     --------
@@ -592,6 +595,7 @@ class ZeroSet(NamedTuple):
     lost: int = 0
     crossing: bool = False
     discrete: bool = False
+    scale: float = 1.0
 
     @property
     def undecided(self) -> np.ndarray:
@@ -795,6 +799,7 @@ def checked_zeros(
         lost=lost,
         crossing=crossing,
         discrete=bool(discrete),
+        scale=t,
     )
 
 
