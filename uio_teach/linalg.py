@@ -575,8 +575,8 @@ class ZeroSet(NamedTuple):
     discrete : bool
         Which boundary: the unit circle (True) or the imaginary axis.
     scale : float
-        The system's own rate, ``||A||`` of the balanced plant in continuous time (1 in
-        discrete time): the zeros' sizes are judged against it.
+        The system's own rate, the spectral radius of ``A`` in continuous time (1 in discrete
+        time): the zeros' sizes are judged against it.
 
     Examples
     --------
@@ -799,7 +799,7 @@ def checked_zeros(
         lost=lost,
         crossing=crossing,
         discrete=bool(discrete),
-        scale=t,
+        scale=1.0 if discrete else t * float(np.max(np.abs(np.linalg.eigvals(A)))),
     )
 
 
