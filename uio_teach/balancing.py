@@ -373,7 +373,11 @@ def balanced_pair(
                 split = other._replace(margin=min(other.margin, 1.0))  # flagged: marginal
                 break
         else:
-            split = _split_from_modes(Ab, Cn, np.asarray(zeros, complex) / sigma) or split
+            split = (
+                _split_from_modes(Ab, Cn, np.asarray(zeros, complex) / sigma)
+                or _split_of_size(Ab, Cn, len(zeros))
+                or split
+            )
     return BalancedPair(A=Ab, C=Cn, t=t, R=R, sigma=sigma, split=split)
 
 
@@ -405,6 +409,20 @@ def _split_from_modes(A: np.ndarray, C: np.ndarray, modes: np.ndarray):
         Vo=Vo, Vu=Vu, Ao=Vo.T @ A @ Vo, Co=C @ Vo, Au=Vu.T @ A @ Vu, margin=1.0
     )
     return split if modes_agree(split.unobservable_modes, modes) else None
+
+
+def _split_of_size(A: np.ndarray, C: np.ndarray, k: int):
+    """The observability split whose unobservable part has ``k`` states, or None.
+
+    For a repeated or defective zero, whose modes scatter by ``eps**(1/k)``: the staircase is
+    run with rank thresholds from tight to loose and the first split of the right size (the
+    zeros' count, from the pencil's structure) is kept, flagged as marginal.
+    """
+    for rtol in np.geomspace(1.0, 1e12, 13):
+        split = observability_decomposition(A, C, rtol=float(rtol))
+        if split.Au.shape[0] == k:
+            return split._replace(margin=min(split.margin, 1.0))
+    return None
 
 
 def modes_agree(modes: np.ndarray, zeros: np.ndarray, radius: np.ndarray | None = None) -> bool:

@@ -238,6 +238,13 @@ class ExistenceReport:
     invariant_zeros: np.ndarray
     fixed_modes: np.ndarray
     movable: int = field(default=0)
+    zero_set: ZeroSet | None = None
+    """The zeros with their radii and distances (:func:`uio_teach.linalg.checked_zeros`)."""
+
+    @property
+    def zero_radius(self) -> np.ndarray | None:
+        """How far round-off of the data can move each invariant zero (``None``: not computed)."""
+        return None if self.zero_set is None else self.zero_set.radius
 
     @property
     def ok(self) -> bool:
@@ -699,4 +706,5 @@ def check_existence(plant: Plant) -> ExistenceReport:
         invariant_zeros=zeros,
         fixed_modes=fixed,
         movable=movable,
+        zero_set=zs,
     )
