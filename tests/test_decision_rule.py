@@ -172,8 +172,10 @@ def test_zero_count_agrees_with_slicot(family):
     pytest.importorskip("ctrlsys")
     for seed in range(0, 12, 2):  # plain and orthogonal coordinates, square and tall
         case = build(family, seed)
-        assert slicot_zero_count(case.plant) == case.zeros.size == (
-            ut.check_existence(case.plant).invariant_zeros.size
+        assert (
+            slicot_zero_count(case.plant)
+            == case.zeros.size
+            == (ut.check_existence(case.plant).invariant_zeros.size)
         ), case.label
 
 

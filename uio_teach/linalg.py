@@ -762,8 +762,6 @@ def checked_zeros(
         _, s, Vt = np.linalg.svd(BD, full_matrices=False)
         r = int(np.sum(s > delta * s[0])) if s.size and s[0] > 0 else 0
         B, D = (BD @ Vt[:r].T)[:n], (BD @ Vt[:r].T)[n:]
-    if B.shape[1] == 0 or p == 0:
-        return empty
     scale = float(np.linalg.norm(np.block([[A, B], [C, D]]), 2))
     thr = delta * scale
     drops: list[float] = []

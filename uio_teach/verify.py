@@ -407,6 +407,7 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
         return DecouplingLeak(0.0, 0.0, 0.0)
     if not all(np.all(np.isfinite(X)) for X in (A, E, C, F, K, Co, Dy, M)):
         return DecouplingLeak(np.inf, np.inf, np.inf)
+    A, E, C, F, K, Co, Dy, M = _balanced(A, E, C, F, K, Co, Dy, M)
     ext = np.longdouble
     # the rounding of the residuals' own computation: sqrt(n) times the working precision times
     # the size of their terms (rounding errors of a sum add up like a random walk)
@@ -453,6 +454,34 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
     if gain == 0:
         return DecouplingLeak(0.0, 0.0, 0.0)
     return DecouplingLeak(leak / gain, bound / gain, bound / gain / _EPS)
+
+
+def _balanced(A, E, C, F, K, Co, Dy, M):
+    """Everything in the plant's balanced units (powers of 2, exact): the leak and its bound are
+    then the same whatever units the states, inputs and outputs are measured in."""
+    from .balancing import plant_scaling  # deferred: balancing imports the algorithms above
+    from .plant import Plant
+
+    n = A.shape[0]
+    try:
+        sc = plant_scaling(Plant(A, C, E=E))
+    except (ValueError, FloatingPointError):  # pragma: no cover - data checked before
+        return A, E, C, F, K, Co, Dy, M
+    t, wy, wd = sc.t, sc.wy, sc.wd
+    if F.shape != (n, n):  # pragma: no cover - every observer here estimates theta x
+        return A, E, C, F, K, Co, Dy, M
+    with np.errstate(all="ignore"):
+        out = (
+            A / t[:, None] * t[None, :],
+            E / t[:, None] * wd[None, :],
+            wy[:, None] * C * t[None, :],
+            F / t[:, None] * t[None, :],
+            K / t[:, None] / wy[None, :],
+            Co / t[:, None] * t[None, :],
+            Dy / t[:, None] / wy[None, :],
+            M / t[:, None] / wy[None, :],
+        )
+    return out if all(np.all(np.isfinite(X)) for X in out) else (A, E, C, F, K, Co, Dy, M)
 
 
 def _test_points(lam: np.ndarray, discrete: bool) -> np.ndarray:
