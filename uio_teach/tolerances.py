@@ -101,10 +101,14 @@ AMPLIFICATION_LIMIT = 1e6
 """Above this, a UIO amplifies round-off notably: ``||E|| ||C|| / sigma_min(C E)`` (the size of
 ``H``) or ``||K|| ||C|| / ||A||`` (the size of the gain) is named as the cause of a leak."""
 
+GAIN_EXACT_RTOL = 1e-9
+"""An explicit gain with ``L D`` below this fraction of its largest entry meets ``L D = 0``: it
+is taken as it is (the rounding of a gain computed in double precision)."""
+
 GAIN_ROUNDED_RTOL = 1e-3
-"""An explicit gain with ``L D`` within this fraction of ``||L||`` is a rounded copy of a gain
-with ``L D = 0`` (printed to a few decimals): it is projected, with a warning; beyond, refused.
-Below ``IDENTITY_RTOL`` it is taken as it is."""
+"""An explicit gain with ``L D`` within this fraction of its largest entry is a rounded copy of
+a gain with ``L D = 0`` (printed to a few decimals): it is projected, with a warning; beyond,
+refused."""
 
 DECAY_RTOL = 1e-6
 """An LMI gain meets a requested decay rate when every pole is within this fraction of it
