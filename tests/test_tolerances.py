@@ -4,7 +4,8 @@ Each tolerance has a pin: a case a tenth of the way inside what it must accept a
 times outside, both built from the declared value, judged by the package reading the live one.
 ``test_tolerance_holds`` checks both at the declared value; ``test_tolerance_is_pinned`` sets it
 a hundred times looser and a hundred times tighter and checks that its pin then fails (a moved
-tolerance fails a named test). A new tolerance without a pin fails ``test_every_tolerance_has_a_pin``.
+tolerance fails a named test). A new tolerance without a pin fails
+``test_every_tolerance_has_a_pin``.
 """
 
 from __future__ import annotations
