@@ -26,10 +26,7 @@ from uio_teach.observers.projection import decoupled_gain
 from uio_teach.placement import strip_fixed
 from uio_teach.simulation import _check_discrete_grid
 from uio_teach.verify import (
-    DecouplingError,
     DecouplingWarning,
-    PlacementAccuracyError,
-    PlacementAccuracyWarning,
     check_decoupling,
     check_identity,
     check_poles,
