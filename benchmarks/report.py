@@ -169,6 +169,20 @@ def read_import(text: str) -> list[list[str]]:
     ]
 
 
+def read_decisions(text: str) -> list[list[str]]:
+    r = _json_line(text)
+    return [
+        [
+            f"existence verdicts on {r['plants']} constructed plants with exactly known zeros "
+            "(right / undecided / wrong; zeros counted right; designs returned / silent leaks)",
+            f"{r['right']} / {r['undecided']} / {r['wrong']}; {r['count right']}; "
+            f"{r['designs']} / {r['silent_leaks']}",
+            f"SLICOT AB08ND agrees on {r['slicot agrees']} zero counts",
+            "",
+        ]
+    ]
+
+
 # name -> (script and arguments, reader); the summary lists them in this order
 BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "simulate": (["bench_simulate.py"], read_simulate),
@@ -176,6 +190,7 @@ BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "book": (["bench_book.py", "--runs", "1"], read_book),
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
+    "decisions": (["bench_decisions.py"], read_decisions),
 }
 
 
