@@ -1,7 +1,7 @@
 """Answers out of a kernel as data and back: the checks give the same verdicts on the copies.
 
 The lab chapters' own solution code runs here, in-process; its answers go through JSON
-(:mod:`uio_teach.checks.answers`) and are graded by :mod:`uio_teach.checks.grading` with the
+(:mod:`uio_teach.checks.answers`) and are graded by :mod:`uio_teach.grading.lab_checks` with the
 lab's parameters: every check passes, as it does on the originals, and a wrong value still fails.
 The registry's answer names are read against the chapters' check cells.
 """
@@ -19,8 +19,9 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.checks import answers, grading
-from uio_teach.checks.grading import GRADED, Missing, grade_answers, missing_message
+from uio_teach.checks import answers
+from uio_teach.grading import lab_checks as grading
+from uio_teach.grading.lab_checks import GRADED, Missing, grade_answers, missing_message
 from uio_teach.instructor.labs import LABS
 
 BOOK = Path(__file__).resolve().parents[1] / "book"

@@ -35,10 +35,11 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from uio_teach.instructor import cli, grade, sandbox
-from uio_teach.instructor.gradebook import safe_cell
+from uio_teach.grading import grade, sandbox
+from uio_teach.grading.gradebook import safe_cell
+from uio_teach.grading.sandbox import Limits, sandbox_problem
+from uio_teach.instructor import cli
 from uio_teach.instructor.labs import LABS
-from uio_teach.instructor.sandbox import Limits, sandbox_problem
 
 pytestmark = [pytest.mark.kernel, pytest.mark.filterwarnings("ignore::DeprecationWarning")]
 
@@ -700,7 +701,7 @@ def test_an_environment_under_tmp_is_still_there_inside(tmp_path, monkeypatch):
         os.chown(work, user, user)
         os.chmod(tmp_path, 0o755)
     code = (
-        f"from uio_teach.instructor.sandbox import drop_privileges; drop_privileges({user!r}); "
+        f"from uio_teach.grading.sandbox import drop_privileges; drop_privileges({user!r}); "
         f"import sys; sys.path.insert(0, {str(env / 'lib')!r}); "
         "import marker_under_tmp; print(marker_under_tmp.VALUE)"
     )

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from uio_teach.checks.grading import GRADED
-from uio_teach.instructor import grade, output
-from uio_teach.instructor.gradebook import Gradebook, GradebookBusy, Submission
+from uio_teach.grading import grade
+from uio_teach.grading.gradebook import Gradebook, GradebookBusy, Submission
+from uio_teach.grading.lab_checks import GRADED
+from uio_teach.instructor import output
 
 IDS = ("pa9.design", "pa9.plot")
 

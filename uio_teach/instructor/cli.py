@@ -636,7 +636,7 @@ def _labs(args: argparse.Namespace) -> int:
 
 
 def _grade(args: argparse.Namespace) -> int:
-    from . import grade  # deferred on purpose (see the imports)
+    from ..grading import grade  # deferred on purpose (see the imports)
 
     missing = [p for p in args.submissions if not os.path.lexists(p)]
     if missing:

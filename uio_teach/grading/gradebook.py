@@ -20,7 +20,7 @@ alone and the run refused before any notebook runs.
 
 Examples
 --------
->>> from uio_teach.instructor.gradebook import Submission
+>>> from uio_teach.grading.gradebook import Submission
 >>> s = Submission("a.ipynb", "pa9", "g01", "ok",
 ...                results={"pa9.design": {"passed": True, "items": []}},
 ...                expected=("pa9.design", "pa9.plot"))
@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .output import (
+from ..instructor.output import (
     MANIFEST,
     FolderBusy,
     FolderLock,
@@ -116,7 +116,7 @@ class Submission:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import Submission
+    >>> from uio_teach.grading.gradebook import Submission
     >>> s = Submission("pa9_g01.ipynb", "pa9", "g01", "unreadable",
     ...                errors=["not a notebook"], expected=("pa9.design",))
     >>> s.row(["pa9.design"])
@@ -237,7 +237,7 @@ def safe_cell(value: Any) -> str:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import safe_cell
+    >>> from uio_teach.grading.gradebook import safe_cell
     >>> print(safe_cell('=HYPERLINK("http://x")'), safe_cell("-3"), safe_cell("a\\nb"))
     '=HYPERLINK("http://x") -3 a b
     """
@@ -260,7 +260,7 @@ def feedback_folder(out: str | os.PathLike[str]) -> Path:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import feedback_folder
+    >>> from uio_teach.grading.gradebook import feedback_folder
     >>> feedback_folder("marks/grades.csv").as_posix()
     'marks/grades_feedback'
     """
@@ -285,7 +285,7 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.gradebook import check_gradebook_target
+    >>> from uio_teach.grading.gradebook import check_gradebook_target
     >>> from uio_teach.instructor.output import OutputError
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     mine = pathlib.Path(tmp) / "grades_feedback"
@@ -324,7 +324,7 @@ def feedback_names(files: Sequence[str]) -> dict[str, str]:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import feedback_names
+    >>> from uio_teach.grading.gradebook import feedback_names
     >>> feedback_names(["a/x.ipynb", "b/x.ipynb"])
     {'a/x.ipynb': 'x.txt', 'b/x.ipynb': 'b_x.txt'}
     """
@@ -352,7 +352,7 @@ def export_path(out: str | os.PathLike[str], kind: str) -> Path:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import export_path
+    >>> from uio_teach.grading.gradebook import export_path
     >>> export_path("marks/grades.csv", "canvas").as_posix()
     'marks/grades_canvas.csv'
     """
@@ -403,7 +403,7 @@ class Gradebook:
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.gradebook import Gradebook, Submission
+    >>> from uio_teach.grading.gradebook import Gradebook, Submission
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     out = pathlib.Path(tmp) / "grades.csv"
     ...     with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:

@@ -24,14 +24,14 @@
   sandbox then holds no capability and no privilege on the host's files.
 
 The total written into the work folder is capped by the runner
-(:mod:`uio_teach.instructor.runner`), which stops a run that exceeds it.
+(:mod:`uio_teach.grading.runner`), which stops a run that exceeds it.
 :func:`sandbox_problem` says why isolation is unavailable (no ``bwrap``, user
 namespaces disabled, or the real interpreter cannot start or import the
 package inside), or ``None``.
 
 Examples
 --------
->>> from uio_teach.instructor.sandbox import Limits
+>>> from uio_teach.grading.sandbox import Limits
 >>> Limits().memory_mb
 4096
 """
@@ -110,7 +110,7 @@ class Limits:
 
     Examples
     --------
-    >>> from uio_teach.instructor.sandbox import Limits
+    >>> from uio_teach.grading.sandbox import Limits
     >>> Limits(memory_mb=2048).memory_mb, Limits().processes
     (2048, 256)
     """
@@ -180,7 +180,7 @@ def sandbox_user(index: int) -> int | None:
     Examples
     --------
     >>> import os
-    >>> from uio_teach.instructor.sandbox import UID_BASE, sandbox_user
+    >>> from uio_teach.grading.sandbox import UID_BASE, sandbox_user
     >>> sandbox_user(3) == (UID_BASE + 3 if os.geteuid() == 0 else None)
     True
     """
@@ -192,7 +192,7 @@ def sandbox_user(index: int) -> int | None:
 def _probe_command(user: int | None) -> list[str]:
     """The real interpreter, importing the package and the notebook runner, as a hand-in would."""
     code = (
-        "from uio_teach.instructor.sandbox import drop_privileges; "
+        "from uio_teach.grading.sandbox import drop_privileges; "
         f"drop_privileges({user!r}); "
         "import uio_teach, nbclient, ipykernel, numpy; "
         "open('/tmp/probe', 'w').write('x'); open('probe', 'w').write('x'); "
@@ -262,7 +262,7 @@ def sandbox_problem() -> str | None:
 
     Examples
     --------
-    >>> from uio_teach.instructor.sandbox import sandbox_problem
+    >>> from uio_teach.grading.sandbox import sandbox_problem
     >>> sandbox_problem() is None or isinstance(sandbox_problem(), str)
     True
     """
@@ -300,7 +300,7 @@ class Sandbox:
     Examples
     --------
     >>> from pathlib import Path
-    >>> from uio_teach.instructor.sandbox import Sandbox
+    >>> from uio_teach.grading.sandbox import Sandbox
     >>> cmd = Sandbox(Path("/tmp/x")).wrap(["python3", "-c", "pass"])
     >>> "--unshare-net" in cmd and "--unshare-pid" in cmd
     True

@@ -4,7 +4,7 @@ The answers a notebook exported are untrusted data: a right solution may carry
 a figure with thousands of empty axes, or an array of millions of entries,
 that would keep the checks busy for minutes. So the grader never rebuilds
 them in its own process. :func:`check_in_child` starts a fresh Python process
-(``python -m uio_teach.instructor.checking``) that
+(``python -m uio_teach.grading.checking``) that
 
 1. limits its own memory (address space) and CPU time;
 2. parses each answer file and measures it against the caps of
@@ -12,7 +12,7 @@ them in its own process. :func:`check_in_child` starts a fresh Python process
    figure, characters of a string, items of a list): an answer over a cap is
    not rebuilt, its checks fail saying why, and the row is "over limits";
 3. rebuilds the rest as genuine objects of the package and runs the lab's
-   checks with the answer key's parameters (:mod:`uio_teach.checks.grading`);
+   checks with the answer key's parameters (:mod:`uio_teach.grading.lab_checks`);
 4. writes the results back as JSON.
 
 The grader waits for it at most ``timeout`` seconds (then kills it: "over
@@ -20,7 +20,7 @@ limits"), and kills it at once when the grading run is interrupted.
 
 Examples
 --------
->>> from uio_teach.instructor.checking import TooLarge, measure
+>>> from uio_teach.grading.checking import TooLarge, measure
 >>> measure({"x": [1, 2, 3]})
 >>> try:
 ...     measure({"__uio__": "figure", "axes": [{}] * 100})
@@ -148,7 +148,7 @@ def _assigns(source: str, name: str) -> bool:
 
 def _missing(name: str, position: int | None, errors: list[dict[str, Any]]) -> Any:
     """Why ``name`` is absent at ``position``: the cell that raised before it, if any."""
-    from ..checks.grading import Missing  # deferred on purpose: the child imports the checks
+    from .lab_checks import Missing  # deferred on purpose: the child imports the checks
 
     before = [e for e in errors if position is None or e["position"] < position]
     if not before:
@@ -174,7 +174,7 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
         ``results`` (list of dict), ``notes`` (list of str), ``over`` (bool).
     """
     from ..checks.answers import AnswerError, from_data, parse  # deferred: the child only
-    from ..checks.grading import GRADED, Missing, grade_answers, lab_plant
+    from .lab_checks import GRADED, Missing, grade_answers, lab_plant
 
     lab, params = request["lab"], request["params"]
     positions, errors = request["positions"], request["errors"]
@@ -258,7 +258,7 @@ def main(argv: list[str]) -> int:
     int
     """
     if len(argv) != 3 or argv[0] != "--check":
-        print("usage: python -m uio_teach.instructor.checking --check MEMORY_MB CPU_SECONDS")
+        print("usage: python -m uio_teach.grading.checking --check MEMORY_MB CPU_SECONDS")
         return 2
     _limit(int(argv[1]), int(argv[2]))
     request = json.loads(sys.stdin.buffer.read())
@@ -304,7 +304,7 @@ def check_in_child(
         ``stop`` was set while the checks ran.
     """
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
-    command = [sys.executable, "-m", "uio_teach.instructor.checking", "--check"]
+    command = [sys.executable, "-m", "uio_teach.grading.checking", "--check"]
     command += [str(int(memory_mb)), str(int(timeout) + 5)]
     with tempfile.TemporaryFile() as data:  # the request, read by the child as its stdin
         data.write(json.dumps(request).encode())

@@ -6,28 +6,28 @@
    file of the folder is read, never written; its group comes from the file
    name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
    notebook's metadata says is only compared with it; a clean copy of its
-   cells is made (``uio_teach.instructor.runner.clean_notebook``);
+   cells is made (``uio_teach.grading.runner.clean_notebook``);
 2. compares the class (``_identity_notes``): a notebook that disagrees
    with its name, a group handing in twice, the same code from two groups or
    no group at all is "check by hand", never ``ok``;
 3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
-   data (``uio_teach.instructor.runner``);
+   data (``uio_teach.grading.runner``);
 4. runs the copy in a fresh kernel inside a sandbox
-   (``uio_teach.instructor.sandbox``: only its own copy visible, no
+   (``uio_teach.grading.sandbox``: only its own copy visible, no
    network, no other process, an unprivileged user when the grader is root,
    limits on memory, processes, writes and time); a cell that raises or
    loops is recorded and the next cells still run;
 5. checks the answers in a child process with limits of time and memory
-   (``uio_teach.instructor.checking``): answers over the size caps are not
+   (``uio_teach.grading.checking``): answers over the size caps are not
    rebuilt, the rest are rebuilt as genuine objects and checked with **the
-   answer key's parameters** (``uio_teach.checks.grading``). The verdicts
+   answer key's parameters** (``uio_teach.grading.lab_checks``). The verdicts
    the check cells printed count for nothing, and nothing the notebook
    defines (``PARAMS``, a patched class, a patched module) reaches the
    checks: only right values pass;
 6. appends its row to the gradebook and writes its feedback at once
-   (``uio_teach.instructor.gradebook``), so a killed or interrupted run
+   (``uio_teach.grading.gradebook``), so a killed or interrupted run
    keeps every finished row and ``resume=True`` grades only what is missing.
 
 Whatever fails on one hand-in (reading, preparing, running, reading back,
@@ -39,7 +39,7 @@ killed are removed by the next.
 
 Examples
 --------
->>> from uio_teach.instructor.grade import group_from_name
+>>> from uio_teach.grading.grade import group_from_name
 >>> group_from_name("submissions/pa9_g03.ipynb")
 ('pa9', 'g03')
 """
@@ -67,8 +67,8 @@ from typing import Any
 
 import nbformat
 
-from ..checks.grading import GRADED
 from ..errors import UIOTeachError, UIOTeachWarning
+from ..instructor.lab_registry import LABS
 from .checking import check_in_child
 from .gradebook import (
     FAIL,
@@ -79,7 +79,7 @@ from .gradebook import (
     check_gradebook_target,
     feedback_folder,
 )
-from .labs import LABS
+from .lab_checks import GRADED
 from .runner import RunOutcome, clean_notebook, prepare, run_notebook
 from .sandbox import Limits, sandbox_problem, sandbox_user
 
@@ -139,7 +139,7 @@ def group_from_name(path: str | os.PathLike[str]) -> tuple[str, str]:
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import group_from_name
+    >>> from uio_teach.grading.grade import group_from_name
     >>> group_from_name("pa9_g12.ipynb"), group_from_name("lab_pa9.ipynb")
     (('pa9', 'g12'), ('', ''))
     """
@@ -169,7 +169,7 @@ def read_answer_key(path: str | os.PathLike[str]) -> dict[tuple[str, str], dict[
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import read_answer_key
+    >>> from uio_teach.grading.grade import read_answer_key
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     key = pathlib.Path(tmp) / "answer_key.csv"
     ...     _ = key.write_text('lab,group,params\\npa9,g01,"{""poles"": [-1, -2, -3]}"\\n')
@@ -241,7 +241,7 @@ def clean_leftovers(root: str | os.PathLike[str] | None = None) -> list[Path]:
     Examples
     --------
     >>> import tempfile
-    >>> from uio_teach.instructor.grade import clean_leftovers
+    >>> from uio_teach.grading.grade import clean_leftovers
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     clean_leftovers(tmp)
     []
@@ -284,7 +284,7 @@ class Handin:
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import Handin
+    >>> from uio_teach.grading.grade import Handin
     >>> Handin("pa9_g01.ipynb", "pa9", "g01").status
     ''
 
@@ -295,7 +295,7 @@ class Handin:
     lab, group : str
         From the roster, else from the file name (never from the notebook).
     notebook : NotebookNode or None
-        The grader's clean copy (``uio_teach.instructor.runner.clean_notebook``).
+        The grader's clean copy (``uio_teach.grading.runner.clean_notebook``).
     status, reason : str
         ``"refused"`` or ``"unreadable"`` and why (empty when it can run).
     notes : list of str
@@ -426,7 +426,7 @@ def read_handin(
     Examples
     --------
     >>> import tempfile, pathlib, os
-    >>> from uio_teach.instructor.grade import read_handin
+    >>> from uio_teach.grading.grade import read_handin
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     link = pathlib.Path(tmp) / "pa9_g01.ipynb"
     ...     os.symlink("/etc/passwd", link)
@@ -667,7 +667,7 @@ def write_gradebook(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import Submission, write_gradebook
+    >>> from uio_teach.grading.grade import Submission, write_gradebook
     >>> s = Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",))
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
@@ -718,7 +718,7 @@ def read_roster(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import read_roster
+    >>> from uio_teach.grading.grade import read_roster
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     roster = pathlib.Path(tmp) / "groups.csv"
     ...     _ = roster.write_text("file,lab,group,student,name\\nx.ipynb,pa9,g01,s1,Ann\\n")
@@ -870,7 +870,7 @@ def grade(
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import grade, GradeError
+    >>> from uio_teach.grading.grade import grade, GradeError
     >>> try:
     ...     grade([], "grades.csv", timeout=0)
     ... except GradeError as err:
@@ -971,7 +971,7 @@ def handin_files(
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import handin_files
+    >>> from uio_teach.grading.grade import handin_files
     >>> handin_files(["b.ipynb", "a.ipynb"])
     ['b.ipynb', 'a.ipynb']
     """

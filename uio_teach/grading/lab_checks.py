@@ -19,7 +19,7 @@ Examples
 --------
 >>> import numpy as np
 >>> import uio_teach as ut
->>> from uio_teach.checks.grading import Missing, grade_answers
+>>> from uio_teach.grading.lab_checks import Missing, grade_answers
 >>> plant = ut.examples.pa9()
 >>> obs = ut.design_uio(plant, poles=[-1, -2, -3])
 >>> answers = {"H": obs.H, "T": obs.T, "K1": obs.K1, "F": obs.F, "K2": obs.K2}
@@ -39,8 +39,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .. import examples
-from ..experiments import plant_from_params
-from . import (
+from ..checks import (
     case_study_lmi,
     case_study_plot,
     case_study_pole,
@@ -60,7 +59,8 @@ from . import (
     pa9_plot,
     pa9_simulation,
 )
-from .common import CheckResult
+from ..checks.common import CheckResult
+from ..experiments import plant_from_params
 
 __all__ = ["GradedCheck", "Missing", "GRADED", "lab_plant", "grade_answers", "missing_message"]
 
@@ -85,7 +85,7 @@ class Missing:
 
     Examples
     --------
-    >>> from uio_teach.checks.grading import Missing
+    >>> from uio_teach.grading.lab_checks import Missing
     >>> Missing("H").cell is None
     True
     """
@@ -333,7 +333,7 @@ def lab_plant(lab: str, params: Mapping[str, Any] | None) -> Any:
 
     Examples
     --------
-    >>> from uio_teach.checks.grading import lab_plant
+    >>> from uio_teach.grading.lab_checks import lab_plant
     >>> lab_plant("pa9", {"poles": [-1, -2, -3]}).n
     3
     """
@@ -384,7 +384,7 @@ def missing_message(missing: Missing) -> str:
 
     Examples
     --------
-    >>> from uio_teach.checks.grading import Missing, missing_message
+    >>> from uio_teach.grading.lab_checks import Missing, missing_message
     >>> print(missing_message(Missing("fig")))
     fig is missing: no cell assigned it before this check. Name your result fig.
     """

@@ -10,7 +10,7 @@ the end that writes every answer variable of the lab to ``answers/final.json``
 (used for a check whose cell the group deleted).
 
 :func:`run_notebook` runs that copy in a fresh kernel, in a separate process,
-inside the :class:`~uio_teach.instructor.sandbox.Sandbox` (unless told not to),
+inside the :class:`~uio_teach.grading.sandbox.Sandbox` (unless told not to),
 with a time limit per cell (the cell is interrupted, the next ones run) and
 for the whole notebook (then every process of the run is killed), and a cap
 on all it writes into its folder (the run is stopped beyond). It reads back
@@ -28,7 +28,7 @@ anything else reads it.
 
 Examples
 --------
->>> from uio_teach.instructor.runner import check_function
+>>> from uio_teach.grading.runner import check_function
 >>> check_function("checks.pa9_design(H, T, K1, F, K2, poles=PARAMS['poles'])")
 'pa9_design'
 """
@@ -53,7 +53,7 @@ from typing import Any
 
 import nbformat
 
-from ..checks.grading import GRADED
+from .lab_checks import GRADED
 from .sandbox import HOME, Limits, Sandbox, drop_privileges
 
 __all__ = [
@@ -197,7 +197,7 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
 
     Examples
     --------
-    >>> from uio_teach.instructor.runner import clean_notebook
+    >>> from uio_teach.grading.runner import clean_notebook
     >>> raw = {"nbformat": 4, "cells": [
     ...     {"cell_type": "code", "source": "x = 1", "metadata": {"tags": 5}}]}
     >>> nb, notes = clean_notebook(raw)
@@ -250,7 +250,7 @@ def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, d
     nb : nbformat.NotebookNode
         The hand-in, as :func:`clean_notebook` made it (modified in place and returned).
     lab : str
-        Its lab (a key of :data:`uio_teach.checks.grading.GRADED`; another
+        Its lab (a key of :data:`uio_teach.grading.lab_checks.GRADED`; another
         lab gets no export cells).
     params : mapping or None
         The group's parameters from the answer key.
@@ -482,7 +482,7 @@ def run_notebook(
     stop : threading.Event, optional
         When set (the grader was interrupted), the run is killed at once.
     user : int, optional
-        The user id the sandbox runs as (:func:`~uio_teach.instructor.sandbox.sandbox_user`).
+        The user id the sandbox runs as (:func:`~uio_teach.grading.sandbox.sandbox_user`).
 
     Returns
     -------
@@ -502,7 +502,7 @@ def run_notebook(
     command = [
         sys.executable,
         "-m",
-        "uio_teach.instructor.runner",
+        "uio_teach.grading.runner",
         "--run",
         os.fspath(inside / "submission.ipynb"),
         os.fspath(inside / "executed.ipynb"),
@@ -662,7 +662,7 @@ def main(argv: Sequence[str]) -> int:
     """
     if len(argv) == 6 and argv[0] == "--run":
         return _execute(argv[1], argv[2], float(argv[3]), argv[4], argv[5])
-    print("usage: python -m uio_teach.instructor.runner --run SRC DST CELL_TIMEOUT LIMITS PID")
+    print("usage: python -m uio_teach.grading.runner --run SRC DST CELL_TIMEOUT LIMITS PID")
     return 2
 
 
