@@ -11,7 +11,7 @@ import pytest
 
 from uio_teach.grading import grade
 from uio_teach.grading.gradebook import Gradebook, GradebookBusy, Submission
-from uio_teach.grading.lab_checks import GRADED
+from uio_teach.grading.lab_checks import lab_checks
 from uio_teach.instructor import output
 
 IDS = ("pa9.design", "pa9.plot")
@@ -171,8 +171,8 @@ def test_unreadable_submissions_are_graded_without_a_kernel(tmp_path):
     assert [s.status for s in graded] == ["unreadable", "unreadable"]
     table = rows(out)
     assert [(r["group"], r["total"], r["out_of"]) for r in table] == [
-        ("g01", "0", str(len(GRADED["pa9"]))),
-        ("g02", "0", str(len(GRADED["pa9"]))),
+        ("g01", "0", str(len(lab_checks("pa9").checks))),
+        ("g02", "0", str(len(lab_checks("pa9").checks))),
     ]
     text = (tmp_path / "grades_feedback" / "pa9_g01.txt").read_text(encoding="utf-8")
     assert "not a notebook" in text

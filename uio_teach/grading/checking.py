@@ -11,8 +11,9 @@ them in its own process. :func:`check_in_child` starts a fresh Python process
    :data:`CAPS` (entries of an array and of all arrays, axes and lines of a
    figure, characters of a string, items of a list): an answer over a cap is
    not rebuilt, its checks fail saying why, and the row is "over limits";
-3. rebuilds the rest as genuine objects of the package and runs the lab's
-   checks with the answer key's parameters (:mod:`uio_teach.grading.lab_checks`);
+3. rebuilds the rest as genuine objects of the package and runs the lab
+   chapter's own check cells with the answer key's parameters
+   (:mod:`uio_teach.grading.lab_checks`);
 4. writes the results back as JSON.
 
 The grader waits for it at most ``timeout`` seconds (then kills it: "over
@@ -165,8 +166,9 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     request : mapping
-        ``lab``, ``params``, ``positions`` (capture tag -> cell), ``errors``
-        (the cells that raised, as dicts) and ``captures`` (tag -> answer text).
+        ``checks`` (the lab's check cells, ``LabChecks.to_dict()``), ``params``,
+        ``positions`` (capture tag -> cell), ``errors`` (the cells that raised,
+        as dicts) and ``captures`` (tag -> answer text).
 
     Returns
     -------
@@ -174,9 +176,10 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
         ``results`` (list of dict), ``notes`` (list of str), ``over`` (bool).
     """
     from ..checks.answers import AnswerError, from_data, parse  # deferred: the child only
-    from .lab_checks import GRADED, Missing, grade_answers, lab_plant
+    from .lab_checks import LabChecks, Missing, grade_answers, lab_plant, setup_namespace
 
-    lab, params = request["lab"], request["params"]
+    checks = LabChecks.from_dict(request["checks"])
+    lab, params = checks.lab, request["params"]
     positions, errors = request["positions"], request["errors"]
     notes: list[str] = []
     over = False
@@ -187,7 +190,10 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
         except AnswerError as err:
             notes.append(f"the answers after one check could not be read ({err})")
             parsed[tag] = None
-    plant = lab_plant(lab, params)
+    namespace = setup_namespace(checks, params)
+    plant = namespace.get("plant")
+    if plant is None:
+        plant = lab_plant(lab, params)
     cache: dict[tuple[str, str], Any] = {}
 
     def rebuild(tag: str, name: str) -> Any:
@@ -213,19 +219,19 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
                     )
         return cache[(tag, name)]
 
-    every = sorted({n for check in GRADED[lab] for n in check.names})
+    every = checks.names
     if parsed.get("final") is not None:
         final = {n: rebuild("final", n) for n in every}
     else:
         final = {n: _missing(n, None, errors) for n in every}
     per_check = []
-    for index, check in enumerate(GRADED[lab]):
+    for index, check in enumerate(checks.checks):
         tag = str(index)
         if parsed.get(tag) is not None:
             per_check.append({n: rebuild(tag, n) for n in check.names})
         else:  # its check cell was deleted or never reached: what the notebook ended with
             per_check.append({n: final[n] for n in check.names})
-    results = grade_answers(lab, final, params, plant=plant, per_check=per_check)
+    results = grade_answers(checks, final, params, per_check=per_check, namespace=namespace)
     return {"results": [r.to_dict() for r in results], "notes": notes, "over": over}
 
 

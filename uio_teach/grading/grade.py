@@ -79,7 +79,7 @@ from .gradebook import (
     check_gradebook_target,
     feedback_folder,
 )
-from .lab_checks import GRADED
+from .lab_checks import LabChecks, LabChecksError, course_checks
 from .runner import RunOutcome, clean_notebook, prepare, run_notebook
 from .sandbox import Limits, sandbox_problem, sandbox_user
 
@@ -505,10 +505,6 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
     return notes
 
 
-def _defaults(lab: str) -> dict[str, Any]:
-    return LABS[lab].params().to_params()
-
-
 def _error_notes(outcome: RunOutcome) -> list[str]:
     notes = []
     for e in outcome.errors:
@@ -526,6 +522,7 @@ class _Run:
     """The settings every hand-in of one grading run shares."""
 
     key: Mapping[tuple[str, str], dict[str, Any]] | None
+    checks: Mapping[str, LabChecks]
     root: Path
     sandbox: bool
     timeout: float
@@ -538,8 +535,8 @@ class _Run:
 def _grade_one(handin: Handin, identity: list[str], index: int, run: _Run) -> Submission:
     start = time.perf_counter()
     sub = Submission(handin.file, handin.lab, handin.group, "ok")
-    if handin.lab in GRADED:
-        sub.expected = tuple(c.check_id for c in GRADED[handin.lab])
+    if handin.lab in run.checks:
+        sub.expected = run.checks[handin.lab].check_ids
     try:
         _run_one(sub, handin, identity, index, run)
     except InterruptedError:
@@ -563,9 +560,10 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         return
     sub.errors += handin.notes
     sub.errors += identity
-    if lab not in GRADED:
+    if lab not in run.checks:
         sub.status = "unknown lab"
-        sub.reason = f"lab {lab!r} is not one of the course's labs ({', '.join(GRADED)}): not run"
+        labs = ", ".join(run.checks)
+        sub.reason = f"lab {lab!r} is not one of the course's labs ({labs}): not run"
         sub.errors.append(sub.reason)
         return
     params = None if key is None else key.get((lab, group))
@@ -575,10 +573,11 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         sub.reason = f"{why}; not run: name the file <lab>_<group>.ipynb or list it in --roster"
         sub.errors.append(sub.reason)
         return
+    checks = run.checks[lab]
     if params is None:
-        params = _defaults(lab)
+        params = checks.default_params()
     sub.params = params
-    copy, positions = prepare(handin.notebook, lab, params if key is not None else None)
+    copy, positions = prepare(handin.notebook, checks, params if key is not None else None)
     folder = run.root / f"{index:04d}"
     try:
         outcome = run_notebook(
@@ -599,7 +598,7 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
     sub.status = outcome.status
     sub.errors += _error_notes(outcome)
     request = {
-        "lab": lab,
+        "checks": checks.to_dict(),
         "params": params,
         "positions": outcome.positions,
         "errors": [
@@ -768,7 +767,7 @@ def _self_test(limits: Limits) -> str | None:
             "language": "python",
         }
         nb.cells.append(nbformat.v4.new_code_cell("import uio_teach\nx = 1 + 1"))
-        copy, positions = prepare(nb, "", None)
+        copy, positions = prepare(nb, None, None)
         root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
         try:
             outcome = run_notebook(
@@ -883,6 +882,10 @@ def grade(
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise GradeError(f"jobs: must be a whole number >= 1, got {jobs!r}")
     key = read_answer_key(answer_key) if answer_key is not None else None
+    try:
+        checks = course_checks()
+    except LabChecksError as err:
+        raise GradeError(f"cannot read the labs' check cells: {err}") from None
     files_roster, students = read_roster(roster) if roster is not None else ({}, {})
     check_gradebook_target(out)  # before the notebooks run, not after
     limits = limits or Limits(cpu_seconds=int(timeout) + 60)
@@ -913,7 +916,8 @@ def grade(
     identity = _identity_notes(handins)
     columns: list[str] = []
     for h in handins:
-        columns += [c.check_id for c in GRADED.get(h.lab, ()) if c.check_id not in columns]
+        ids = checks[h.lab].check_ids if h.lab in checks else ()
+        columns += [c for c in ids if c not in columns]
     graded: list[Submission] = []
     with Gradebook(out, files, columns, resume=resume, students=students) as book:
         todo = [(i, h) for i, h in enumerate(handins) if not book.has(h.file)]
@@ -928,7 +932,15 @@ def grade(
                 encoding="utf-8",
             )
             run = _Run(
-                key, root, sandbox, timeout, min(cell_timeout, timeout), check_timeout, limits, stop
+                key,
+                checks,
+                root,
+                sandbox,
+                timeout,
+                min(cell_timeout, timeout),
+                check_timeout,
+                limits,
+                stop,
             )
             running: dict[Future[Submission], Handin] = {}
             queue = list(todo)

@@ -28,9 +28,10 @@ anything else reads it.
 
 Examples
 --------
->>> from uio_teach.grading.runner import check_function
->>> check_function("checks.pa9_design(H, T, K1, F, K2, poles=PARAMS['poles'])")
-'pa9_design'
+>>> from uio_teach.grading.runner import clean_notebook
+>>> nb, notes = clean_notebook({"nbformat": 4, "cells": [{"cell_type": "code", "source": "x"}]})
+>>> nb.cells[0].source, notes
+('x', [])
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ from typing import Any
 
 import nbformat
 
-from .lab_checks import GRADED
+from .lab_checks import LabChecks, check_function
 from .sandbox import HOME, Limits, Sandbox, drop_privileges
 
 __all__ = [
@@ -62,7 +63,6 @@ __all__ = [
     "clean_notebook",
     "prepare",
     "run_notebook",
-    "check_function",
     "read_limited",
     "GRADING_TAG",
     "MAX_FILE_BYTES",
@@ -76,7 +76,6 @@ MAX_FILE_BYTES = 256 * 1024 * 1024
 MAX_ANSWER_BYTES = 64 * 1024 * 1024
 """The largest answer file read back (a larger one is a row "over limits")."""
 _TAIL_BYTES = 64 * 1024
-_CALL = re.compile(r"\bchecks\.(\w+)\s*\(")
 _SETUP = """\
 def _uio_export(_uio_tag, _uio_names):
     from uio_teach.checks import answers as _uio_answers
@@ -136,21 +135,6 @@ class RunOutcome:
     positions: dict[str, int] = field(default_factory=dict)
     errors: list[CellError] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
-
-
-def check_function(source: str) -> str | None:
-    """The check function a check cell calls (``checks.<name>(...)``), or None.
-
-    Parameters
-    ----------
-    source : str
-
-    Returns
-    -------
-    str or None
-    """
-    match = _CALL.search(source)
-    return match[1] if match else None
 
 
 def _tags(cell: Any) -> list[str]:
@@ -242,16 +226,18 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     return nb, notes
 
 
-def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, dict[str, int]]:
+def prepare(
+    nb: Any, checks: LabChecks | None, params: Mapping[str, Any] | None
+) -> tuple[Any, dict[str, int]]:
     """The copy to run: outputs cleared, the key's parameters set, the export cells added.
 
     Parameters
     ----------
     nb : nbformat.NotebookNode
         The hand-in, as :func:`clean_notebook` made it (modified in place and returned).
-    lab : str
-        Its lab (a key of :data:`uio_teach.grading.lab_checks.GRADED`; another
-        lab gets no export cells).
+    checks : LabChecks or None
+        The check cells of its lab (:func:`uio_teach.grading.lab_checks.lab_checks`);
+        None (no lab of the course) adds no export cells.
     params : mapping or None
         The group's parameters from the answer key.
 
@@ -260,8 +246,8 @@ def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, d
     (NotebookNode, dict)
         The copy, and capture tag -> index of its cell.
     """
-    graded = GRADED.get(lab, ())
-    by_function = {c.check_id.replace(".", "_"): i for i, c in enumerate(graded)}
+    graded = checks.checks if checks is not None else ()
+    by_function = {c.function: i for i, c in enumerate(graded)}
     every = sorted({n for c in graded for n in c.names})
     cells = [_ours(_SETUP)]
     has_params = False
