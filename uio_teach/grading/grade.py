@@ -631,6 +631,8 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         sub.status, sub.reason = "check by hand", identity[0]
     elif not group:
         sub.status, sub.reason = "check by hand", "no group: graded with the course's own numbers"
+    if sub.status == "grader error" and not identity:
+        sub.reason = next((n for n in outcome.notes if "runner failed" in n), "the grader failed")
     if sub.status in ("error", "timeout") and not sub.reason:
         sub.reason = (sub.errors or [sub.status])[0]
 

@@ -15,10 +15,14 @@ with a time limit per cell (the cell is interrupted, the next ones run) and
 for the whole notebook (then every process of the run is killed), and a cap
 on all it writes into its folder (the run is stopped beyond). It reads back
 only data: the answer files (regular files, no links, bounded size, kept as
-text for the checking process) and the errors of the executed copy, read as
-plain JSON and matched against the grader's own copy (a copy the notebook
-rewrote gives no cell errors, never a crash). Nothing the notebook prints
-decides anything, and the runner's own output is kept to its last lines.
+text for the checking process) and the runner's log of the cells that raised,
+matched against the grader's own copy (a log the notebook rewrote gives no
+cell errors, never a crash). The notebook is never saved while it runs, so a
+run costs in proportion to its cells; what it prints or displays beyond
+:data:`MAX_OUTPUT_BYTES` is cut, and the row says so. Nothing the notebook
+prints decides anything, and the runner's own output is kept to its last
+lines; a failure of the runner itself is the grader's ("grader error"), never
+the notebook's.
 
 :func:`clean_notebook` turns the JSON of a hand-in into a fresh notebook of the
 grader's own: code, markdown and raw cells with their source and their string
@@ -66,13 +70,24 @@ __all__ = [
     "read_limited",
     "GRADING_TAG",
     "MAX_FILE_BYTES",
+    "MAX_OUTPUT_BYTES",
     "MAX_ANSWER_BYTES",
 ]
 
 GRADING_TAG = "uio-teach-grade"
 """The tag of the cells the grader adds."""
 MAX_FILE_BYTES = 256 * 1024 * 1024
-"""The largest executed notebook read back."""
+"""The largest file of the run read back."""
+MAX_OUTPUT_BYTES = 32 * 1024 * 1024
+"""The most output a run keeps (printed text, figures, rich displays): beyond, it is cut and
+the row says so. The notebook's own streams are cut at half of it inside the kernel, so the runner
+never receives more than it keeps."""
+OUTPUT_CUT = "output-cut"
+"""The file that says a run's output was cut (written in its folder)."""
+ERRORS = "errors.jsonl"
+"""The runner's log of the cells that raised, one JSON line each, written as each cell ends."""
+RUNNER_FAILED = "runner-failed.json"
+"""What the runner writes when it fails itself (not the notebook): the grader's error."""
 MAX_ANSWER_BYTES = 64 * 1024 * 1024
 """The largest answer file read back (a larger one is a row "over limits")."""
 _TAIL_BYTES = 64 * 1024
@@ -83,6 +98,21 @@ def _uio_export(_uio_tag, _uio_names):
     _uio_values = {_n: _uio_ns[_n] for _n in _uio_names if _n in _uio_ns}
     with open(f"answers/{_uio_tag}.json", "w", encoding="utf-8") as _uio_fh:
         _uio_fh.write(_uio_answers.dumps(_uio_values))
+def _uio_cap(_uio_stream, _uio_left=[%d]):
+    _uio_write = _uio_stream.write
+    def write(text):
+        if _uio_left[0] <= 0:
+            return len(text)
+        _uio_left[0] -= len(text)
+        if _uio_left[0] < 0:
+            open("%s", "w").close()
+            return _uio_write(text[: len(text) + _uio_left[0]]) or len(text)
+        return _uio_write(text)
+    _uio_stream.write = write
+import sys as _uio_sys
+_uio_cap(_uio_sys.stdout)
+_uio_cap(_uio_sys.stderr)
+del _uio_cap
 """
 
 
@@ -249,7 +279,7 @@ def prepare(
     graded = checks.checks if checks is not None else ()
     by_function = {c.function: i for i, c in enumerate(graded)}
     every = sorted({n for c in graded for n in c.names})
-    cells = [_ours(_SETUP)]
+    cells = [_ours(_SETUP % (MAX_OUTPUT_BYTES // 2, OUTPUT_CUT))]
     has_params = False
     placed: set[int] = set()
     for cell in nb.cells:
@@ -313,36 +343,42 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _errors(executed: Any, prepared: Any) -> list[CellError] | None:
-    """The student's cells that raised, from the executed copy's JSON (None if it was rewritten).
+def _errors(log: bytes, prepared: Any) -> list[CellError] | None:
+    """The student's cells that raised, from the runner's log (None if it is not the runner's).
 
     The cells' code and tags come from ``prepared`` (the grader's own copy);
-    only the error outputs are read from ``executed``, and only as strings.
+    only the position, the exception's class and its message are read from
+    the log, and only as strings; a position that is not a cell of the
+    student's is not the runner's.
     """
-    cells = executed.get("cells") if isinstance(executed, dict) else None
-    if not isinstance(cells, list) or len(cells) != len(prepared.cells):
-        return None
-    out = []
+    numbers = {}
     number = 0
-    for position, (cell, mine) in enumerate(zip(cells, prepared.cells, strict=True)):
-        if mine.get("cell_type") != "code" or GRADING_TAG in _tags(mine):
-            continue
-        number += 1
-        outputs = cell.get("outputs", []) if isinstance(cell, dict) else []
-        for output in outputs if isinstance(outputs, list) else []:
-            if isinstance(output, dict) and output.get("output_type") == "error":
-                out.append(
-                    CellError(
-                        number,
-                        position,
-                        _one_line(output.get("ename", ""), 60),
-                        _one_line(output.get("evalue", "")),
-                        str(mine.get("source", "")),
-                        "check" in _tags(mine),
-                    )
-                )
-                break
-    return out
+    for position, mine in enumerate(prepared.cells):
+        if mine.get("cell_type") == "code" and GRADING_TAG not in _tags(mine):
+            number += 1
+            numbers[position] = number
+    out: dict[int, CellError] = {}
+    for line in log.decode("utf-8", "replace").splitlines():
+        try:
+            entry = json.loads(line)
+            position = entry["position"]
+        except (ValueError, KeyError, TypeError, RecursionError):
+            return None
+        if not isinstance(position, int) or position not in numbers:
+            return None
+        mine = prepared.cells[position]
+        out.setdefault(
+            position,
+            CellError(
+                numbers[position],
+                position,
+                _one_line(entry.get("ename", ""), 60),
+                _one_line(entry.get("evalue", "")),
+                str(mine.get("source", "")),
+                "check" in _tags(mine),
+            ),
+        )
+    return [out[p] for p in sorted(out)]
 
 
 def _kill_group(pgid: int) -> None:
@@ -491,7 +527,7 @@ def run_notebook(
         "uio_teach.grading.runner",
         "--run",
         os.fspath(inside / "submission.ipynb"),
-        os.fspath(inside / "executed.ipynb"),
+        os.fspath(inside / ERRORS),
         repr(float(cell_timeout)),
         limit_arg,
         "" if sandbox else os.fspath(pid_file),
@@ -544,17 +580,29 @@ def run_notebook(
         proc.wait()
         tail.join(timeout=5)
     outcome = RunOutcome(status, positions=dict(positions), notes=notes)
-    raw = read_limited(work / "executed.ipynb")
-    errors = None
-    if raw is not None:
-        try:
-            errors = _errors(json.loads(raw.decode("utf-8")), nb)
-        except (ValueError, RecursionError):  # half written or rewritten: no cell errors
-            errors = None
-    if errors is None and raw is not None:
-        notes.append("the executed copy was changed by the notebook: its cell errors are unknown")
+    raw = read_limited(work / ERRORS)
+    errors = _errors(raw, nb) if raw is not None else []
+    if errors is None:
+        notes.append("the runner's log of cell errors was changed by the notebook: not read")
     outcome.errors = errors or []
-    if status == "ok" and proc.returncode != 0:
+    failed = read_limited(work / RUNNER_FAILED, 4096)
+    if failed is not None:  # the runner's own failure: never the notebook's
+        try:
+            why = _one_line(json.loads(failed.decode("utf-8")).get("error", ""), 160)
+        except (ValueError, AttributeError, RecursionError):
+            why = "unknown"
+        status = "grader error"
+        notes.insert(0, f"the grader's notebook runner failed ({why}), not the notebook")
+    cut = read_limited(work / OUTPUT_CUT, 4096)
+    if cut is not None and status in ("ok", "error", "timeout"):
+        if not any(n.startswith("the notebook's output") for n in notes):
+            notes.insert(
+                0,
+                f"the notebook's output (what it printed or displayed) came to more than "
+                f"{MAX_OUTPUT_BYTES >> 20} MB and was cut there; its answers are graded as usual",
+            )
+        status = "over limits"
+    elif status == "ok" and proc.returncode != 0:
         text = tail.text()
         noise = ("[IPKernelApp]", "WARNING", "[W ", "[I ", "To connect another client")
         lines = [x for x in text.splitlines() if x.strip() and not x.lstrip().startswith(noise)]
@@ -593,16 +641,48 @@ def run_notebook(
     return outcome
 
 
-def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str) -> int:
-    """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts)."""
+def _size(msg: Mapping[str, Any]) -> int:
+    """About how many bytes an output message carries (its text and its data)."""
+    content = msg.get("content") or {}
+    size = len(content.get("text") or "")
+    for value in (content.get("data") or {}).values():
+        size += len(value) if isinstance(value, str) else len(json.dumps(value))
+    return size
+
+
+def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str) -> int:
+    """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts).
+
+    Nothing is saved per cell: each cell that raised is appended to ``log``
+    (one JSON line) as it ends, and its outputs are dropped (the grader reads
+    answers from their files, never outputs), so the cost of a run grows with
+    its cells and its memory does not. Output beyond :data:`MAX_OUTPUT_BYTES`
+    is cut (the file :data:`OUTPUT_CUT` says so). A failure of the runner
+    itself is written to :data:`RUNNER_FAILED`, for the grader to report as
+    its own.
+    """
     from nbclient import NotebookClient  # deferred on purpose: only the runner needs it
+    from nbclient.exceptions import DeadKernelError
 
     *numbers, user = limits.split(",")
     drop_privileges(int(user) if user else None)  # before anything else: no root, no capability
     memory, processes, file_mb, cpu = (int(v) for v in numbers)
     Limits(memory, processes, file_mb, cpu).apply()
+    folder = Path(src).parent
     nb = nbformat.read(src, as_version=4)
-    client = NotebookClient(
+
+    class Client(NotebookClient):  # type: ignore[misc]
+        kept = 0
+
+        def output(self, outs: Any, msg: Any, display_id: Any, cell_index: int) -> Any:
+            if msg.get("msg_type") != "error":
+                self.kept += _size(msg)
+                if self.kept > MAX_OUTPUT_BYTES:
+                    (folder / OUTPUT_CUT).touch()
+                    return None
+            return super().output(outs, msg, display_id, cell_index)
+
+    client = Client(
         nb,
         timeout=cell_timeout,
         kernel_name="python3",
@@ -613,7 +693,7 @@ def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str
             "evalue": f"the cell ran longer than {cell_timeout:g} s and was interrupted",
             "traceback": [],
         },
-        resources={"metadata": {"path": os.path.dirname(os.path.abspath(src))}},
+        resources={"metadata": {"path": os.fspath(folder)}},
     )
 
     def started(**_: Any) -> None:
@@ -621,22 +701,39 @@ def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str
         if pid and pid_file:
             Path(pid_file).write_text(str(pid))
 
-    def save(**_: Any) -> None:  # a run stopped at the time limit still shows its errors
-        part = dst + ".part"
-        nbformat.write(nb, part)
-        os.replace(part, dst)
+    with open(log, "a", encoding="utf-8") as errors:
 
-    client.on_notebook_start = started
-    client.on_cell_executed = save
-    try:
-        client.execute()
-    finally:
-        save()
+        def executed(cell: Any, cell_index: int, **_: Any) -> None:
+            for out in cell.get("outputs", []):
+                if out.get("output_type") == "error":
+                    entry = {
+                        "position": cell_index,
+                        "ename": str(out.get("ename", ""))[:200],
+                        "evalue": str(out.get("evalue", ""))[:2000],
+                    }
+                    errors.write(json.dumps(entry) + "\n")
+                    errors.flush()
+                    break
+            cell.outputs = []  # read; kept no longer
+
+        client.on_notebook_start = started
+        client.on_cell_executed = executed
+        try:
+            client.execute()
+        except DeadKernelError:
+            raise  # the notebook ended its kernel: the notebook's doing
+        except (Exception, MemoryError) as exc:  # the runner's own failure, never the notebook's
+            why = f"{type(exc).__name__}: {_one_line(exc, 120)}".rstrip(": ")
+            try:
+                (folder / RUNNER_FAILED).write_text(json.dumps({"error": why}))
+            except OSError:
+                pass
+            return 3
     return 0
 
 
 def main(argv: Sequence[str]) -> int:
-    """The runner's command line: ``--run SRC DST CELL_TIMEOUT LIMITS PID_FILE``.
+    """The runner's command line: ``--run SRC LOG CELL_TIMEOUT LIMITS PID_FILE``.
 
     Parameters
     ----------
@@ -648,7 +745,7 @@ def main(argv: Sequence[str]) -> int:
     """
     if len(argv) == 6 and argv[0] == "--run":
         return _execute(argv[1], argv[2], float(argv[3]), argv[4], argv[5])
-    print("usage: python -m uio_teach.grading.runner --run SRC DST CELL_TIMEOUT LIMITS PID")
+    print("usage: python -m uio_teach.grading.runner --run SRC LOG CELL_TIMEOUT LIMITS PID")
     return 2
 
 
