@@ -19,7 +19,7 @@ text for the checking process) and the runner's log of the cells that raised,
 matched against the grader's own copy (a log the notebook rewrote gives no
 cell errors, never a crash). The notebook is never saved while it runs, so a
 run costs in proportion to its cells; what it prints or displays beyond
-:data:`MAX_OUTPUT_BYTES` is cut, and the row says so. Nothing the notebook
+ ``Limits.output_mb`` is cut, and the row says so. Nothing the notebook
 prints decides anything, and the runner's own output is kept to its last
 lines; a failure of the runner itself is the grader's ("grader error"), never
 the notebook's.
@@ -70,7 +70,6 @@ __all__ = [
     "read_limited",
     "GRADING_TAG",
     "MAX_FILE_BYTES",
-    "MAX_OUTPUT_BYTES",
     "MAX_ANSWER_BYTES",
 ]
 
@@ -78,10 +77,6 @@ GRADING_TAG = "uio-teach-grade"
 """The tag of the cells the grader adds."""
 MAX_FILE_BYTES = 256 * 1024 * 1024
 """The largest file of the run read back."""
-MAX_OUTPUT_BYTES = 32 * 1024 * 1024
-"""The most output a run keeps (printed text, figures, rich displays): beyond, it is cut and
-the row says so. The notebook's own streams are cut at half of it inside the kernel, so the runner
-never receives more than it keeps."""
 OUTPUT_CUT = "output-cut"
 """The file that says a run's output was cut (written in its folder)."""
 ERRORS = "errors.jsonl"
@@ -207,7 +202,7 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     Raises
     ------
     ValueError
-        ``raw`` is not a notebook of format 4 (one line).
+        ``raw`` is not a notebook of format 4 or 3 (one line naming its format).
 
     Examples
     --------
@@ -220,7 +215,24 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     """
     if not isinstance(raw, dict):
         raise ValueError("not a notebook (not a JSON object)")
-    if raw.get("nbformat") != 4 or not isinstance(raw.get("cells"), list):
+    version = raw.get("nbformat")
+    converted = []
+    if "nbformat" not in raw:
+        raise ValueError("not a notebook (no nbformat field)")
+    if version == 3:
+        raw = _upgrade(raw)
+        converted.append("a notebook of format 3 (nbformat 3), converted to format 4 to run")
+    elif isinstance(version, int) and not isinstance(version, bool) and version < 3:
+        raise ValueError(
+            f"a notebook of format {version} (nbformat {version}), too old to convert: open it "
+            "in Jupyter and save it again (format 4)"
+        )
+    elif version != 4:
+        raise ValueError(
+            f"a notebook of format {_one_line(repr(version), 40)} (nbformat): the grader reads "
+            "formats 4 and 3"
+        )
+    if not isinstance(raw.get("cells"), list):
         raise ValueError("not a notebook of format 4 (no list of cells)")
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {
@@ -228,7 +240,7 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
         "display_name": "Python 3",
         "language": "python",
     }
-    notes: list[str] = []
+    notes: list[str] = converted
 
     def note(text: str) -> None:
         if text not in notes:
@@ -256,8 +268,26 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     return nb, notes
 
 
+def _upgrade(raw: dict[str, Any]) -> Any:
+    """A notebook of format 3 as format 4 (nbformat's converter), or a one-line ValueError."""
+    try:
+        node = nbformat.from_dict(raw)
+        node.setdefault("nbformat_minor", 0)
+        new = nbformat.converter.convert(node, 4)
+        return json.loads(json.dumps(new))
+    except Exception as err:  # the converter raises many kinds on a malformed notebook
+        raise ValueError(
+            f"a notebook of format 3 (nbformat 3) that could not be converted to format 4 "
+            f"({type(err).__name__}): open it in Jupyter and save it again"
+        ) from None
+
+
 def prepare(
-    nb: Any, checks: LabChecks | None, params: Mapping[str, Any] | None
+    nb: Any,
+    checks: LabChecks | None,
+    params: Mapping[str, Any] | None,
+    *,
+    output_mb: int = Limits.output_mb,
 ) -> tuple[Any, dict[str, int]]:
     """The copy to run: outputs cleared, the key's parameters set, the export cells added.
 
@@ -270,6 +300,10 @@ def prepare(
         None (no lab of the course) adds no export cells.
     params : mapping or None
         The group's parameters from the answer key.
+    output_mb : int
+        The output a run keeps (``Limits.output_mb``): the notebook's streams
+        are cut at half of it in the kernel, so the runner never receives much
+        more than it keeps.
 
     Returns
     -------
@@ -279,7 +313,7 @@ def prepare(
     graded = checks.checks if checks is not None else ()
     by_function = {c.function: i for i, c in enumerate(graded)}
     every = sorted({n for c in graded for n in c.names})
-    cells = [_ours(_SETUP % (MAX_OUTPUT_BYTES // 2, OUTPUT_CUT))]
+    cells = [_ours(_SETUP % (output_mb * 1024 * 1024 // 2, OUTPUT_CUT))]
     has_params = False
     placed: set[int] = set()
     for cell in nb.cells:
@@ -520,6 +554,7 @@ def run_notebook(
     inside = Path(HOME) if sandbox else work
     pid_file = folder / "kernel.pid"
     limit_arg = f"{limits.memory_mb},{limits.processes},{limits.file_mb},{limits.cpu_seconds}"
+    limit_arg += f",{limits.output_mb}"
     limit_arg += f",{user if sandbox and user is not None else ''}"
     command = [
         sys.executable,
@@ -599,7 +634,7 @@ def run_notebook(
             notes.insert(
                 0,
                 f"the notebook's output (what it printed or displayed) came to more than "
-                f"{MAX_OUTPUT_BYTES >> 20} MB and was cut there; its answers are graded as usual",
+                f"{limits.output_mb} MB and was cut there; its answers are graded as usual",
             )
         status = "over limits"
     elif status == "ok" and proc.returncode != 0:
@@ -656,7 +691,7 @@ def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str
     Nothing is saved per cell: each cell that raised is appended to ``log``
     (one JSON line) as it ends, and its outputs are dropped (the grader reads
     answers from their files, never outputs), so the cost of a run grows with
-    its cells and its memory does not. Output beyond :data:`MAX_OUTPUT_BYTES`
+    its cells and its memory does not. Output beyond the limit's ``output_mb``
     is cut (the file :data:`OUTPUT_CUT` says so). A failure of the runner
     itself is written to :data:`RUNNER_FAILED`, for the grader to report as
     its own.
@@ -666,7 +701,7 @@ def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str
 
     *numbers, user = limits.split(",")
     drop_privileges(int(user) if user else None)  # before anything else: no root, no capability
-    memory, processes, file_mb, cpu = (int(v) for v in numbers)
+    memory, processes, file_mb, cpu, output_mb = (int(v) for v in numbers)
     Limits(memory, processes, file_mb, cpu).apply()
     folder = Path(src).parent
     nb = nbformat.read(src, as_version=4)
@@ -677,7 +712,7 @@ def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str
         def output(self, outs: Any, msg: Any, display_id: Any, cell_index: int) -> Any:
             if msg.get("msg_type") != "error":
                 self.kept += _size(msg)
-                if self.kept > MAX_OUTPUT_BYTES:
+                if self.kept > output_mb * 1024 * 1024:
                     (folder / OUTPUT_CUT).touch()
                     return None
             return super().output(outs, msg, display_id, cell_index)
