@@ -69,6 +69,15 @@ def solved() -> dict[str, dict]:
     return out
 
 
+def test_the_graders_labs_are_the_registrys():
+    """The grader finds the labs by their chapters (it need not load the labs' parameters); the
+    term's tooling registers them: the two agree, lab by lab and chapter by chapter."""
+    labs = lab_checks.course_labs(BOOK)
+    assert {lab: path.name for lab, path in labs.items()} == {
+        lab: entry.source for lab, entry in LABS.items()
+    }
+
+
 def test_the_grader_runs_the_chapters_own_check_cells():
     """One source per check: the grader's check cells are the chapter's, in its order, with the
     registry's columns; the answers they read are the names the chapter's solutions define."""

@@ -24,6 +24,8 @@ SUBPACKAGE_API = (
     "instructor.figures",
     "instructor.output",
     "grading.grade",
+    "grading.rosters",
+    "grading.merge",
     "instructor.labs",
     "instructor.book",
 )

@@ -4,7 +4,8 @@
 
 1. reads it without following links (:func:`read_handin`): only a regular
    file of the folder is read, never written; its group comes from the file
-   name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
+   name (``pa9_g03.ipynb``) or the roster
+   (:func:`~uio_teach.grading.rosters.read_roster`), and what the
    notebook's metadata says is only compared with it; a clean copy of its
    cells is made (``uio_teach.grading.runner.clean_notebook``);
 2. compares the class (``_identity_notes``): a notebook that disagrees
@@ -65,7 +66,6 @@ from typing import Any
 import nbformat
 
 from ..errors import UIOTeachWarning
-from ..instructor.lab_registry import LABS
 from .checking import check_in_child
 from .copies import fingerprint
 from .gradebook import (
@@ -77,7 +77,7 @@ from .gradebook import (
     check_gradebook_target,
     feedback_folder,
 )
-from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks
+from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks, course_labs
 from .merge import check_shard, shard_of
 from .rosters import (
     GradeError,
@@ -345,10 +345,10 @@ def read_handin(
     ----------
     path : str or path-like
     roster : mapping, optional
-        File name -> (lab, group), from :func:`read_roster`.
+        File name -> (lab, group), from :func:`~uio_teach.grading.rosters.read_roster`.
     keep : iterable of str
         The answer variables of the labs: names a copy cannot change
-        (see :mod:`uio_teach.grading.copies`).
+        (see ``uio_teach.grading.copies``).
 
     Returns
     -------
@@ -393,9 +393,7 @@ def read_handin(
     handin.meta_lab, handin.meta_group, source = _meta(raw)
     if not handin.lab:
         stem = Path(source).stem if source else Path(file).stem
-        handin.lab = handin.meta_lab or next(
-            (k for k, v in LABS.items() if Path(v.source).stem == stem), ""
-        )
+        handin.lab = handin.meta_lab or next((k for k in course_labs() if f"lab_{k}" == stem), "")
     handin.code = _fingerprint(handin.notebook, keep)
     return handin
 
@@ -711,7 +709,7 @@ def grade(
         graded with its group's parameters (and runs with them). Without it,
         with the course's own numbers.
     roster : path, optional
-        A CSV naming each hand-in's group (see :func:`read_roster`).
+        A CSV naming each hand-in's group (see :func:`~uio_teach.grading.rosters.read_roster`).
     timeout : float
         Seconds a notebook may run in all; then every process of its run is
         killed and it is graded on what it computed ("timeout").

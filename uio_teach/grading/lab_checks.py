@@ -59,6 +59,7 @@ __all__ = [
     "read_lab_checks",
     "lab_checks",
     "course_checks",
+    "course_labs",
     "check_function",
     "lab_plant",
     "setup_namespace",
@@ -367,13 +368,42 @@ def _cached(path: str, mtime: float, lab: str) -> LabChecks:
     return read_lab_checks(path, lab)
 
 
+def course_labs(book: str | os.PathLike[str] | None = None) -> dict[str, Path]:
+    """The labs of the course: lab id -> its chapter, ``book/lab_<id>.md``.
+
+    The chapters are the registry the grader reads (the term's tooling keeps
+    its own, ``uio_teach.instructor.lab_registry.LABS``, which a test holds
+    equal to this): grading needs neither the labs' parameter classes nor the
+    algorithms they load.
+
+    Parameters
+    ----------
+    book : path, optional
+        The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
+
+    Returns
+    -------
+    dict
+
+    Examples
+    --------
+    >>> from uio_teach.grading.lab_checks import course_labs
+    >>> sorted(course_labs())
+    ['case_study', 'missile', 'pa9']
+    """
+    from ..instructor.book import default_book_dir  # deferred: only where the chapters are
+
+    folder = Path(book) if book is not None else default_book_dir()
+    return {path.stem[4:]: path for path in sorted(folder.glob("lab_*.md"))}
+
+
 def lab_checks(lab: str, book: str | os.PathLike[str] | None = None) -> LabChecks:
     """The check cells of the course's lab ``lab``, read from its chapter.
 
     Parameters
     ----------
     lab : str
-        A lab of the course (``uio_teach.instructor.lab_registry.LABS``).
+        A lab of the course (:func:`course_labs`).
     book : path, optional
         The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
 
@@ -386,13 +416,10 @@ def lab_checks(lab: str, book: str | os.PathLike[str] | None = None) -> LabCheck
     LabChecksError
         Not a lab of the course, or its chapter cannot be graded.
     """
-    from ..instructor.book import default_book_dir  # deferred: only where the chapters are
-    from ..instructor.lab_registry import LABS
-
-    if lab not in LABS:
-        raise LabChecksError(f"{lab!r} is not a lab of the course ({', '.join(LABS)})")
-    path = Path(book) if book is not None else default_book_dir()
-    path = path / LABS[lab].source
+    labs = course_labs(book)
+    if lab not in labs:
+        raise LabChecksError(f"{lab!r} is not a lab of the course ({', '.join(labs)})")
+    path = labs[lab]
     try:
         mtime = path.stat().st_mtime
     except OSError:
@@ -412,15 +439,21 @@ def course_checks(book: str | os.PathLike[str] | None = None) -> dict[str, LabCh
     -------
     dict
 
+    Raises
+    ------
+    LabChecksError
+        The book holds no lab chapter, or one cannot be graded.
+
     Examples
     --------
     >>> from uio_teach.grading.lab_checks import course_checks
     >>> {lab: len(c.checks) for lab, c in course_checks().items()}
-    {'pa9': 5, 'case_study': 6, 'missile': 6}
+    {'case_study': 6, 'missile': 6, 'pa9': 5}
     """
-    from ..instructor.lab_registry import LABS  # deferred: the child process needs none
-
-    return {lab: lab_checks(lab, book) for lab in LABS}
+    labs = course_labs(book)
+    if not labs:
+        raise LabChecksError("no lab chapter (book/lab_*.md) found: is the book installed?")
+    return {lab: lab_checks(lab, book) for lab in labs}
 
 
 def lab_plant(lab: str, params: Mapping[str, Any] | None) -> Any:

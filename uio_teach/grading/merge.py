@@ -85,6 +85,15 @@ def shard_of(file: str | os.PathLike[str], shards: int) -> int:
 def check_shard(shard: Sequence[int]) -> tuple[int, int]:
     """``(K, N)`` as given, checked: whole numbers with 1 <= K <= N.
 
+    Parameters
+    ----------
+    shard : sequence of int
+        ``(K, N)``.
+
+    Returns
+    -------
+    (int, int)
+
     Raises
     ------
     GradeError
@@ -107,6 +116,14 @@ def check_shard(shard: Sequence[int]) -> tuple[int, int]:
 
 def parse_shard(text: str) -> tuple[int, int]:
     """``"K/N"`` as ``(K, N)`` (see :func:`check_shard`).
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    (int, int)
 
     Examples
     --------
@@ -177,6 +194,25 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
         ``out`` is one of the gradebooks.
     uio_teach.instructor.output.OutputError
         A gradebook cannot be read, or ``out``'s feedback folder is not ours.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.grading.gradebook import Gradebook, Submission
+    >>> from uio_teach.grading.merge import merge, shard_of
+    >>> files = [f"pa9_g{i:02d}.ipynb" for i in range(1, 7)]
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     parts = []
+    ...     for k in (1, 2):
+    ...         part = pathlib.Path(tmp) / f"grades_{k}.csv"
+    ...         with Gradebook(part, files, ["pa9.design"], shard=(k, 2)) as book:
+    ...             for f in files:
+    ...                 if shard_of(f, 2) == k:
+    ...                     book.add(Submission(f, "pa9", f[4:7], "ok"))
+    ...         parts.append(part)
+    ...     out = merge(parts, pathlib.Path(tmp) / "grades.csv")
+    ...     len(out.read_text(encoding="utf-8").splitlines())
+    7
     """
     if not gradebooks:
         raise MergeError("no gradebook to merge")

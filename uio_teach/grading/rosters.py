@@ -95,6 +95,14 @@ def group_id(group: str) -> str:
 def is_late(path: str | os.PathLike[str]) -> bool:
     """Whether an LMS download marks the hand-in late (Canvas: ``_LATE_`` in its name).
 
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    bool
+
     Examples
     --------
     >>> from uio_teach.grading.rosters import is_late
@@ -121,7 +129,7 @@ def group_from_name(
     path : str or path-like
         The file.
     labs : iterable of str, optional
-        The course's labs (those of ``uio_teach.instructor.lab_registry.LABS`` by default).
+        The course's labs (its lab chapters, ``book/lab_<id>.md``, by default).
 
     Returns
     -------
@@ -137,9 +145,9 @@ def group_from_name(
     ('case_study', 'g02')
     """
     if labs is None:
-        from ..instructor.lab_registry import LABS  # deferred: the registry loads the labs
+        from .lab_checks import course_labs  # deferred: only to find the book
 
-        labs = LABS
+        labs = course_labs()
     stem = _COPY.sub("", Path(path).stem)
     known = "|".join(re.escape(lab) for lab in sorted(labs, key=len, reverse=True))
     if known:
@@ -152,7 +160,25 @@ def group_from_name(
 
 
 def file_sha256(path: str | os.PathLike[str]) -> str:
-    """The SHA-256 of a file's bytes (what a gradebook records of its key and roster)."""
+    """The SHA-256 of a file's bytes (what a gradebook records of its key and roster).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from uio_teach.grading.rosters import file_sha256
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (pathlib.Path(tmp) / "a.csv").write_bytes(b"")
+    ...     file_sha256(pathlib.Path(tmp) / "a.csv")[:12]
+    'e3b0c44298fc'
+    """
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for chunk in iter(lambda: fh.read(1 << 20), b""):

@@ -29,7 +29,7 @@ import time
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn, TextIO
+from typing import Any, NoReturn, TextIO
 
 import matplotlib
 
@@ -254,7 +254,23 @@ exit status:
 
 
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are one line: ``uio-teach labs: error: ...``."""
+    """An argument parser whose usage errors are one line: ``uio-teach labs: error: ...``.
+
+    A description given as a function is made only when the help is shown (the labs' help
+    lists what a term config sets that labs ignore, which loads the labs: no other command
+    pays for that, and grading starts sooner).
+    """
+
+    def __init__(self, *args: Any, description: Any = None, **kwargs: Any) -> None:
+        self._describe = description if callable(description) else None
+        super().__init__(
+            *args, description=None if callable(description) else description, **kwargs
+        )
+
+    def format_help(self) -> str:
+        if self._describe is not None:
+            self.description, self._describe = self._describe(), None
+        return super().format_help()
 
     def error(self, message: str) -> NoReturn:
         text = " ".join(str(message).split())
@@ -424,7 +440,7 @@ def build_parser() -> argparse.ArgumentParser:
     labs = commands.add_parser(
         "labs",
         help="write the lab notebooks (student and solution versions)",
-        description=_labs_description(),
+        description=_labs_description,
         epilog=_LABS_EPILOG,
         formatter_class=_Formatter,
     )
