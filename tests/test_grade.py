@@ -864,10 +864,10 @@ def test_no_sandbox_grades_the_same_says_so_loudly_and_no_group_is_never_ok(tmp_
 def test_a_failure_of_the_grader_on_one_hand_in_is_that_rows_and_the_run_goes_on(
     tmp_path, monkeypatch, capsys
 ):
-    def broken(nb, lab, params):
+    def broken(nb, checks, params, **kwargs):
         if any("boom" in c.source for c in nb.cells):
             raise KeyError("a bug of the grader")
-        return real(nb, lab, params)
+        return real(nb, checks, params, **kwargs)
 
     real = grade.prepare
     monkeypatch.setattr(grade, "prepare", broken)
@@ -886,9 +886,9 @@ def test_a_failure_of_the_grader_on_one_hand_in_is_that_rows_and_the_run_goes_on
 
 
 def explode_on(stem: str, real):
-    def read(path, roster=None):
+    def read(path, roster=None, **kwargs):
         if Path(path).stem == stem:
             raise MemoryError
-        return real(path, roster)
+        return real(path, roster, **kwargs)
 
     return read

@@ -357,3 +357,28 @@ def test_resuming_a_shard_with_another_shard_is_refused(tmp_path):
     with pytest.raises(Exception, match="resume it with the same --shard"):
         with Gradebook(out, files, ["pa9.design"], resume=True, shard=(2, 2)):
             pass
+
+
+# the summary ------------------------------------------------------------------------------------
+
+
+def test_the_summary_after_resume_counts_the_whole_gradebook(tmp_path, capsys):
+    from uio_teach.instructor import cli
+
+    folder = tmp_path / "handed_in"
+    folder.mkdir()
+    for group in ("g01", "g02"):
+        (folder / f"pa9_{group}.ipynb").write_text("{ not a notebook")
+    out = str(tmp_path / "grades.csv")
+    args = ["grade", str(folder), "--out", out, "--no-sandbox", "-q"]
+    assert cli.main(args) == 0
+    assert (
+        "2 rows need a look (2 unreadable) of the 2 rows in grades.csv" in capsys.readouterr().err
+    )
+    (folder / "pa9_g03.ipynb").write_text("[]")
+    assert cli.main([*args, "--resume"]) == 0
+    err = capsys.readouterr().err
+    assert "3 rows need a look (3 unreadable) of the 3 rows in grades.csv" in err
+    assert "no Canvas import written" not in err  # -q: only what needs a look
+    assert cli.main([*args[:-1], "--resume"]) == 0
+    assert "no Canvas import written: without --roster" in capsys.readouterr().err
