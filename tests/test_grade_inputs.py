@@ -382,3 +382,16 @@ def test_the_summary_after_resume_counts_the_whole_gradebook(tmp_path, capsys):
     assert "no Canvas import written" not in err  # -q: only what needs a look
     assert cli.main([*args[:-1], "--resume"]) == 0
     assert "no Canvas import written: without --roster" in capsys.readouterr().err
+
+
+def test_shard_and_merge_usage_errors_are_one_line(tmp_path, capsys):
+    from uio_teach.instructor import cli
+
+    assert cli.main(["grade", str(tmp_path), "--out", "g.csv", "--shard", "3/2"]) == 2
+    assert "--shard: expected K/N with 1 <= K <= N, got 3/2" in capsys.readouterr().err
+    assert cli.main(["merge", str(tmp_path / "none.csv"), "--out", "g.csv"]) == 2
+    assert "no such gradebook" in capsys.readouterr().err
+    one = _book(tmp_path / "g_1.csv", CLASS[:4], (1, 2))
+    assert cli.main(["merge", str(one), "--out", str(tmp_path / "m.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "shard 2/2 missing" in err

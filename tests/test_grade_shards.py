@@ -45,9 +45,11 @@ def sandbox_here() -> None:
 
 
 def walker() -> str:
-    """A cell that walks every readable path and raises with each course file it can read."""
+    """A cell that walks every readable path and raises with each course file it can read: a
+    file named as a chapter, a lab notebook, a key or a hand-in of the course that speaks of
+    the course, or a folder ``_course`` that holds the book."""
     names = sorted(p.name for p in (ROOT / "book").glob("*.md"))
-    names += ["answer_key.csv", "_course", "_toc.yml", "references.bib", LATE]
+    names += ["answer_key.csv", "_toc.yml", "references.bib", LATE]
     return f"""\
 import json, os
 names = set({names!r})
@@ -57,9 +59,20 @@ for root, dirs, files in os.walk("/"):
         dirs[:] = []
         continue
     for name in files + dirs:
-        if name in names or name.startswith("lab_") and name.endswith((".md", ".ipynb")):
-            path = os.path.join(root, name)
-            if os.access(path, os.R_OK) and "jupyter_book" not in path:
+        path = os.path.join(root, name)
+        if name == "_course":
+            try:
+                if "book" in os.listdir(path):
+                    found.append(path)
+            except OSError:
+                pass
+        elif name in names or name.startswith("lab_") and name.endswith((".md", ".ipynb")):
+            try:
+                with open(path, "rb") as fh:
+                    text = fh.read(1 << 16)
+            except OSError:
+                continue
+            if b"uio_teach" in text or b"nknown input" in text or b"uio-teach" in text:
                 found.append(path)
 print("y" * 3_000_000)
 raise RuntimeError("WALK " + json.dumps(found[:20]))
@@ -326,3 +339,36 @@ def test_no_course_file_is_readable_in_the_sandbox_of_a_wheel_in_a_venv(
     assert Path(where.strip()).is_relative_to(site)
     walk = next((out.parent / "grades_feedback").glob("x*.txt")).read_text(encoding="utf-8")
     assert "WALK []" in walk, walk
+
+
+@pytest.mark.subprocess
+def test_the_sandbox_hides_the_course_inside_a_mounted_environment(
+    sandbox_here, tmp_path, monkeypatch
+):
+    """A site folder the sandbox mounts (a wheel's environment) that holds the package with its
+    chapters: the walker finds them when nothing hides them, and nothing once the sandbox does."""
+    from uio_teach.grading import sandbox
+
+    site = tmp_path / "venv" / "lib" / "site-packages"
+    chapter = site / "uio_teach" / "_course" / "book" / "lab_pa9.md"
+    chapter.parent.mkdir(parents=True)
+    chapter.write_text("# Lab: Practical Assignment 9\nunknown input observers\n")
+    (site / "uio_teach" / "__init__.py").write_text("")
+    monkeypatch.setattr(sys, "path", [*sys.path, str(site)])
+    monkeypatch.setattr(sandbox, "hidden_paths", lambda: [site / "uio_teach"])
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "walk.py").write_text(walker().replace('print("y" * 3_000_000)\n', ""))
+
+    def walk() -> list[str]:
+        proc = sandbox.Sandbox(work).popen(
+            [sys.executable, "walk.py"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        _, err = proc.communicate(timeout=600)
+        line = next(x for x in err.splitlines() if x.startswith("RuntimeError: WALK"))
+        return json.loads(line.split("WALK ", 1)[1])
+
+    assert walk() == []
+    monkeypatch.setattr(sandbox, "_masks", lambda mounted: [])
+    found = walk()  # the control: the walker sees the chapters where nothing hides them
+    assert str(chapter) in found and str(chapter.parents[1]) in found

@@ -633,8 +633,11 @@ def _positive(name: str, value: Any) -> None:
 _SELF_TEST: dict[tuple[Any, ...], str | None] = {}
 
 
-def _self_test(limits: Limits) -> str | None:
-    """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None."""
+def _self_test(limits: Limits, stop: threading.Event | None = None) -> str | None:
+    """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None.
+
+    ``stop`` (the run was interrupted) ends it at once; that answer is not kept.
+    """
     key = (sys.executable, dataclasses.replace(limits, cpu_seconds=0))  # CPU time aside
     if key in _SELF_TEST:
         return _SELF_TEST[key]
@@ -659,9 +662,12 @@ def _self_test(limits: Limits) -> str | None:
                 cell_timeout=120,
                 limits=limits,
                 user=sandbox_user(0),
+                stop=stop,
             )
         finally:
             _remove(root)
+        if outcome.status == "interrupted":
+            return "the run was interrupted"
         if outcome.status != "ok" or "final" not in outcome.captures:
             why = "; ".join(_error_notes(outcome)) or outcome.status
             problem = f"a one-cell notebook does not run in the sandbox ({_one_line(why, 300)})"
@@ -872,7 +878,7 @@ def _grade_all(
     run = dataclasses.replace(settings, root=root)
     pool = ThreadPoolExecutor(max_workers=jobs)
     tester = ThreadPoolExecutor(max_workers=1)
-    test = tester.submit(_self_test, limits) if sandbox else None
+    test = tester.submit(_self_test, limits, stop) if sandbox else None
     opened = False
     held: list[Submission] = []
     try:
