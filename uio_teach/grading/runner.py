@@ -93,18 +93,18 @@ def _uio_export(_uio_tag, _uio_names):
     _uio_values = {_n: _uio_ns[_n] for _n in _uio_names if _n in _uio_ns}
     with open(f"answers/{_uio_tag}.json", "w", encoding="utf-8") as _uio_fh:
         _uio_fh.write(_uio_answers.dumps(_uio_values))
-def _uio_cap(_uio_stream, _uio_left=[%d]):
+import os as _uio_os, sys as _uio_sys
+def _uio_cap(_uio_stream, _uio_left=[%d], _uio_mark=_uio_os.path.abspath("%s")):
     _uio_write = _uio_stream.write
     def write(text):
         if _uio_left[0] <= 0:
             return len(text)
         _uio_left[0] -= len(text)
         if _uio_left[0] < 0:
-            open("%s", "w").close()
+            open(_uio_mark, "w").close()
             return _uio_write(text[: len(text) + _uio_left[0]]) or len(text)
         return _uio_write(text)
     _uio_stream.write = write
-import sys as _uio_sys
 _uio_cap(_uio_sys.stdout)
 _uio_cap(_uio_sys.stderr)
 del _uio_cap
