@@ -26,7 +26,9 @@ SUBPACKAGE_API = (
     "instructor.config",
     "instructor.figures",
     "instructor.output",
-    "instructor.grade",
+    "grading.grade",
+    "grading.rosters",
+    "grading.merge",
     "instructor.labs",
     "instructor.book",
 )
@@ -95,7 +97,7 @@ SLOW_DOCTESTS = {
 
 # Modules whose docstring examples start a process: the sandbox's probe runs Python (and the
 # package's notebook runner) inside bubblewrap.
-PROCESS_DOCTESTS = {"uio_teach.instructor.sandbox": ("subprocess", "kernel")}
+PROCESS_DOCTESTS = {"uio_teach.grading.sandbox": ("subprocess", "kernel")}
 
 
 def _modules():
