@@ -374,8 +374,15 @@ def lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:
     )
 
 
+NEXT_TO = 0.02
+"""A movable pole is "next to" an invariant zero within this fraction of the larger size."""
+
+
 def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
     """A note for each movable pole placed on (or next to) an invariant zero.
+
+    "Next to" is relative: the gap is at most :data:`NEXT_TO` of the larger of
+    ``|pole|`` and ``|zero|``. No note where no observer exists.
 
     Parameters
     ----------
@@ -398,15 +405,19 @@ def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
     """
     zeros = scenario.invariant_zeros
     out: list[str] = []
+    if scenario.existence is not None and not scenario.existence.ok:
+        return out  # no observer: no pole of it sits anywhere
     for p in movable:
         if not zeros.size:
             break
         gaps = np.abs(zeros - p)
         j = int(np.argmin(gaps))
         z = zeros[j]
-        if gaps[j] > 0.02 * max(1.0, abs(z)):
+        # relative: "next to" means within NEXT_TO of the larger of the two sizes
+        size = max(abs(z), abs(p))
+        if gaps[j] > NEXT_TO * size:
             continue
-        where = "sits on" if gaps[j] <= 1e-9 * max(1.0, abs(z)) else "is next to"
+        where = "sits on" if gaps[j] <= 1e-9 * max(size, np.finfo(float).tiny) else "is next to"
         text = (
             f"pole {format_poles([p], 3)} {where} the invariant zero {format_poles([z], 3)}, "
             "where a fixed pole already is: the error there decays no faster than that fixed "
@@ -591,9 +602,12 @@ def explain(
     str
     """
     name = scenario.observer_name
+    exists = scenario.existence is None or scenario.existence.ok
     parts = []
     if scenario.family == "ginverse":
         parts.append(f"The {name} has no gain to tune: its poles are set by its structure.")
+    elif not exists:
+        parts.append(f"No {name} exists for this plant; its message says why.")
     elif movable.size:
         what = "The LMI bound picks" if s.mode == "lmi" else "The pole controls move"
         parts.append(f"{what} the {name} poles {format_poles(movable, 3)}.")
@@ -601,11 +615,13 @@ def explain(
         parts.append(f"No pole of the {name} can be moved.")
     elif not poles.size:  # the design failed for these settings: its message says why
         parts.append(f"No {name} could be designed for these settings; its message says why.")
-    if fixed.size:
+    if fixed.size and exists:
         parts.append(
             f"Fixed whatever the gain: {format_poles(fixed, 3)} (the invariant zeros, o on "
             "the pole map)."
         )
+    elif fixed.size:
+        parts.append(f"The invariant zeros: {format_poles(fixed, 3)} (o on the pole map).")
     if scenario.reconstruct:
         parts.append(
             "The input panels are zoomed on the true input (grey): larger swings of a "
