@@ -145,8 +145,14 @@ class ErrorVerdict:
             return True
         return not self.zero and self.peak > (1 + TOLERANCE) * self.start
 
-    def words(self) -> str:
+    def words(self, stable: bool = True) -> str:
         """What the error does, as the end of a sentence that starts "the error ...".
+
+        Parameters
+        ----------
+        stable : bool
+            Every pole of the error is stable. If not, an error that ends smaller
+            than it starts "shrinks ... within the window": it does not decay.
 
         Returns
         -------
@@ -159,6 +165,8 @@ class ErrorVerdict:
         'grows from 1.73 to 1.88'
         >>> ErrorVerdict(start=0.0, end=1e-13, peak=1e-13, rounding=1e-9).words()
         'is zero to rounding'
+        >>> ErrorVerdict(start=1.73, end=1.6, peak=1.73).words(stable=False)
+        'shrinks from 1.73 to 1.6 within the window'
         """
         a, b, m = (f"{x:.3g}" for x in (self.start, self.end, self.peak))
         if not self.finite:
@@ -167,6 +175,10 @@ class ErrorVerdict:
             return "is zero to rounding"
         if self.grows:
             return f"grows from {a} to {b}"
+        if self.decays and not stable:
+            if self.outgrows_start:
+                return f"rises to {m}, then shrinks to {b} (from {a}) within the window"
+            return f"shrinks from {a} to {b} within the window"
         if self.decays:
             if self.outgrows_start:
                 return f"rises to {m}, then decays to {b} (from {a})"
@@ -254,7 +266,7 @@ def stability_message(
     >>> text = stability_message("UIO", np.array([0.02, -3.0]), np.array([True, True]), v, False)
     >>> print(*text.split("; "), sep="\n")
     pole 0.02 in the right half-plane: that mode grows, but slowly
-    within this window the error does not yet outgrow its start (it decays from 1.73 to 1.6)
+    the error shrinks from 1.73 to 1.6 within the window, not yet above its start
     """
     if not poles.size or verdict is None:
         return ""
@@ -271,7 +283,7 @@ def stability_message(
             this = "this pole makes" if grow.size == 1 else "these poles make"
             return (
                 f"{this} the {name} unstable: the error grows ({word} {listed} {where}; "
-                f"|e| {verdict.words().removeprefix('grows ')})"
+                f"|e| {verdict.words(stable=False).removeprefix('grows ')})"
                 if verdict.finite
                 else f"{this} the {name} unstable: the error grows ({word} {listed} {where})"
             )
@@ -279,17 +291,17 @@ def stability_message(
             it = "it" if grow.size == 1 else "them"
             return (
                 f"{word} {listed} {where}, but this start does not excite {it}: the error "
-                f"does not grow here (it {verdict.words()}; noise or another start would make "
-                "it grow)"
+                f"does not grow here (it {verdict.words(stable=False)}; noise or another start "
+                "would make it grow)"
             )
         if not verdict.outgrows_start:
             return (
-                f"{word} {listed} {where}: that mode grows, but slowly; within this window the "
-                f"error does not yet outgrow its start (it {verdict.words()})"
+                f"{word} {listed} {where}: that mode grows, but slowly; the error "
+                f"{verdict.words(stable=False)}, not yet above its start"
             )
         return (
             f"{word} {listed} {where}: that mode grows, but slowly; within this window the "
-            f"error {verdict.words()}, and grows later"
+            f"error {verdict.words(stable=False)}, and grows later"
         )
     edge_poles = poles[bad]
     word = "pole" if edge_poles.size == 1 else "poles"

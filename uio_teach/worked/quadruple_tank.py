@@ -329,6 +329,12 @@ def valve_verdict(gamma1: float, gamma2: float, v0: Any = None) -> str:
             )
             tail = "through them, so CE = 0"
         return f"{what} the measured levels only {tail}, the rank condition fails and no UIO exists"
+    if report["rank condition"].holds is not True:  # a valve so nearly closed that CE is singular
+        i, g = min(((1, gamma1), (2, gamma2)), key=lambda pair: pair[1])
+        return (
+            f"gamma{i} = {g:.3g}: pump {i} sends almost nothing to lower tank {i}, so CE is "
+            "singular to round-off, the rank condition fails and no UIO exists"
+        )
     zeros = np.sort(report.invariant_zeros.real)
     total = gamma1 + gamma2
     if abs(total - 1) <= 4 * np.finfo(float).eps:  # 0.7 + 0.3 is 1 to round-off
@@ -352,6 +358,8 @@ def valve_verdict(gamma1: float, gamma2: float, v0: Any = None) -> str:
             f"and a UIO exists; its slowest fixed pole {slow:.3g} ({-1 / slow:.3g} s per e-fold) "
             "is a mode of the error that no gain moves"
         )
+    if not zeros.size:  # pragma: no cover - the rank condition holds: the plant has its zeros
+        return f"{head}, and no UIO with a stable error exists"
     worst = float(zeros[-1])
     if abs(worst) <= 1e-9 * max(1.0, float(np.max(np.abs(zeros)))):
         place = "an invariant zero sits at the origin (to round-off)"
