@@ -472,9 +472,10 @@ EXAMPLES = (
                 "period_limits": (10.0, 300.0),
                 "noise_limits": (0.0, 0.2),
                 "d_channels": ((1.0, 1.0), (0.5, 1.5)),
-                # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3)
+                # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3; at 0 the
+                # rank condition fails)
                 "static_control": "plant:gamma2",
-                "static_values": (0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
+                "static_values": (0.0, 0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
                 "note": f"{__name__}:valve_verdict",
             }
         ),
