@@ -118,7 +118,10 @@ class StudentEdition(SphinxTransform):
     default_priority = 15
 
     def _attached(self, node: nodes.Node) -> bool:
+        """Still in the page (a removed node keeps its ``parent``, so each link is checked)."""
         while node.parent is not None:
+            if not any(child is node for child in node.parent.children):
+                return False
             node = node.parent
         return node is self.document
 

@@ -229,7 +229,7 @@ class QuadrupleTankExperiment(Experiment):
         return np.linalg.lstsq(real.C, -real.D_y @ y0, rcond=None)[0]
 
     def simulate(self, observer: Any, **changes: Any) -> UIOResponse:
-        """As :meth:`Experiment.simulate`; a run whose levels go below empty is refused.
+        """As :meth:`uio_teach.experiments.Experiment.simulate`; a level below empty is refused.
 
         Parameters
         ----------
@@ -262,7 +262,7 @@ class QuadrupleTankExperiment(Experiment):
 
     @property
     def v0(self) -> tuple[float, float]:
-        """The pump voltages of the operating point (V): setting P-'s."""
+        """Setting P-'s pump voltages at the operating point, in V."""
         return tank_operating_point().v0
 
     @property
