@@ -226,13 +226,16 @@ def _choices(control):
 @pytest.mark.slow
 def test_every_control_value_gives_a_picture_or_a_message(name):
     ex = EXPLORERS[name](static=False)
+    # the choices of the opening controls, fixed: a plant slider may remake the pole controls
+    # (a valve that leaves no UIO leaves no pole to move), and hypothesis wants fixed strategies
+    options = {key: _choices(control) for key, control in ex.controls.items()}
 
     @st.composite
     def changes(draw):
         out = []
         for _ in range(draw(st.integers(1, 4))):
-            key = draw(st.sampled_from(sorted(ex.controls)))
-            out.append((key, draw(_choices(ex.controls[key]))))
+            key = draw(st.sampled_from(sorted(options)))
+            out.append((key, draw(options[key])))
         return out
 
     # a sample: the edges and a seeded random subset of every control's range are swept, word

@@ -668,14 +668,15 @@ def missile_noise(
         )
     h = float(resp.time[1] - resp.time[0])
     CE = resp.plant.C @ resp.plant.E
-    rho = np.linalg.norm(np.linalg.pinv(CE), axis=1)
-    predicted = float(sigma) / (math.sqrt(2) * h) * rho
+    beta = np.linalg.norm(np.linalg.pinv(CE), axis=1)  # row i of (CE)^+, as the exercise
+    predicted = float(sigma) / (math.sqrt(2) * h) * beta
     ratio = got / predicted
     near = bool(np.all(np.abs(ratio - 1) <= 0.25))
     result.add(
         None,
         f"your RMS errors are {'within' if near else 'not within'} 25 % of the prediction "
-        "σ ρ_i / (√2 h): the differentiator amplifies the noise by 1/h.",
+        f"σ β_i / (√2 h) = {predicted[0]:.3g}, {predicted[1]:.3g} (β_i the length of row i of "
+        "(CE)^+): the differentiator amplifies the noise by 1/h.",
     )
     return result
 

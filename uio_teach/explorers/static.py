@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._display import format_complex, format_poles
+from ..linalg import is_stable
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, Scenario, Settings
@@ -261,17 +262,19 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
     sc = frame.scenario
     parts = [f"{sc.title} explorer at {label} {value}."]
     rows = (
-        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message),
+        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message, frame.poles),
         (
             "Luenberger observer",
             frame.luenberger,
             frame.luenberger_verdict,
             frame.luenberger_message,
+            frame.luenberger_poles,
         ),
     )
-    for who, observer, verdict, message in rows:
+    for who, observer, verdict, message, poles in rows:
         if verdict is not None:
-            parts.append(f"{who}: the error size |e| {verdict.words()}.")
+            stable = bool(np.all(is_stable(poles, sc.discrete))) if poles.size else True
+            parts.append(f"{who}: the error size |e| {verdict.words(stable)}.")
         elif observer is None:
             parts.append(f"{who}: no curve (no design).")
         elif "overflows" in message:

@@ -203,6 +203,8 @@ class Explorer(DragPoles):
         self._static = static
         self._static_html: str | None = None
         self._holding = 0
+        self._reverting = False
+        self._refused = ""
         self.controls: dict[str, W.Widget] = {}
         self._slots: list[_Slot] = []
         self.figure = ExplorerFigure(scenario, dpi=dpi)
@@ -495,7 +497,24 @@ class Explorer(DragPoles):
         same figure (a new one only if its panels or legends differ)."""
         old = self.scenario
         values = {pc.name: float(self.controls[pc.name].value) for pc in old.plant_controls}
-        new = old.rebuild(**values)
+        if self._reverting:
+            return
+        try:
+            new = old.rebuild(**values)
+        except ValueError as exc:  # a plant the model refuses (a level below empty, ...)
+            self._refused = (
+                f"{change['owner'].description} = {change['new']:g} is refused: {exc}; the "
+                "plant is kept as it was"
+            )
+            self._reverting = True
+            try:
+                change["owner"].value = change["old"]
+            finally:
+                self._reverting = False
+            if not self._holding:
+                self.update()
+            return
+        self._refused = ""
         self.scenario = new
         _LIVE[new.name] = self
         if not self.figure.replace_scenario(new):  # other panels or legends: a new figure
@@ -537,7 +556,12 @@ class Explorer(DragPoles):
             )
             return
         self.frame = frame
-        self.message.value = _message_html(frame)
+        refused = (
+            f'<div style="color:#c0392b">{html.escape(self._refused)}</div>'
+            if self._refused
+            else ""
+        )
+        self.message.value = _message_html(frame) + refused
 
     def close(self) -> None:
         """Close the figure's canvas and the widgets (frees their memory at once).

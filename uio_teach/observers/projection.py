@@ -126,6 +126,12 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
     )
 
 
+def _entries(M: np.ndarray) -> str:
+    """The entries of a small matrix with 3 significant digits (a tiny non-zero shows as one)."""
+    rows = np.atleast_2d(M)
+    return "[" + "; ".join(", ".join(f"{x:.3g}" for x in row) for row in rows) + "]"
+
+
 def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
     """Check an explicit gain (shape n x p, ``gain D = 0``).
 
@@ -142,7 +148,7 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
         return G
     if residual <= tols.GAIN_ROUNDED_RTOL * scale:
         warnings.warn(
-            f"{name} D = {np.array2string(GD.ravel(), precision=2)} is not exactly 0 (a rounded "
+            f"{name} D = {_entries(GD)} is not exactly 0 (a rounded "
             f"gain?); using the nearest gain with {name} D = 0",
             UserWarning,
             stacklevel=3,
@@ -150,7 +156,7 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
         return G - GD @ pinv(plant.D)
     raise ValueError(
         f"{name} D must be 0 so that the measurement disturbance does not enter the "
-        f"error; got {name} D = {np.array2string(GD, precision=4)}"
+        f"error; got {name} D = {_entries(GD)}"
     )
 
 

@@ -369,7 +369,7 @@ class WorkedExample:
     >>> from uio_teach.worked import WORKED
     >>> tank = WORKED["quadruple_tank"]
     >>> tank.plant_factory()(gamma1=0.43, gamma2=0.34).name
-    'quadruple tank (P- levels, gamma 0.43, 0.34)'
+    'quadruple tank (P- pumps, gamma 0.43, 0.34)'
     >>> tank.poles_key(), tank.lab is None
     ('quadruple_tank.poles', True)
     """
