@@ -30,6 +30,7 @@ import asyncio
 import functools
 import html
 import os
+import posixpath
 import sys
 import threading
 import time
@@ -61,6 +62,9 @@ PDF_OPTIONS = {
     "tagged": True,
     "outline": True,
 }
+# The sheet's printable width in CSS pixels (A4, 210 mm less the margins): the pages are laid out
+# at this width before printing, so what does not fit on paper is found (and scaled) first.
+VIEWPORT = {"width": round((210 - 32) / 25.4 * 96), "height": 1100}
 # Seconds a page may take to load and typeset, and a print to finish: a limit, not a timing.
 PAGE_LIMIT = 300
 
@@ -86,6 +90,8 @@ class Printed:
     pdfs: list[Path] = field(default_factory=list)
     seconds: float = 0.0
     pages: int = 0  # sheets of paper, over every PDF
+    # per PDF, what reaches past the margins of the sheet (cut off on paper): nothing, we hope
+    overflow: dict[str, list[str]] = field(default_factory=dict)
 
 
 # --- the site's pages, in the order of its navigation --------------------------------------------
@@ -144,6 +150,16 @@ class _NavParser(HTMLParser):
             self._text.append(data)
 
 
+def pdf_name(root_doc: str, docname: str) -> str:
+    """The PDF of a page (without ``.pdf``): its name relative to the root page's folder.
+
+    ``book/pa9`` of a book whose root is ``book/index`` prints to ``pa9.pdf``; a page in a
+    folder of its own to ``folder-page.pdf``.
+    """
+    folder = posixpath.dirname(root_doc)
+    return (posixpath.relpath(docname, folder) if folder else docname).replace("/", "-")
+
+
 def root_page(site: Path) -> str:
     """The site's first page, relative to the site (``index.html`` may only redirect to it)."""
     index = site / "index.html"
@@ -163,14 +179,13 @@ def site_pages(site: Path) -> list[Page]:
     parser.feed((site / root).read_text(encoding="utf-8"))
     if not parser.links:
         raise PrintError(f"{site / root} has no navigation (.bd-docs-nav): not a built book?")
-    folder = root.rsplit("/", 1)[0] + "/" if "/" in root else ""
     pages, seen = [], set()
     for href, text, part in parser.links:
         path = urljoin(root, href.split("#", 1)[0]) if href not in ("", "#") else root
         if path in seen or urlsplit(href).scheme:
             continue
         seen.add(path)
-        name = path.removeprefix(folder).removesuffix(".html").replace("/", "-")
+        name = pdf_name(root.removesuffix(".html"), path.removesuffix(".html"))
         pages.append(Page(path=path, name=name, title=text, part=part))
     return pages
 
@@ -235,6 +250,25 @@ PREPARE_JS = """
       a.removeAttribute('href');
     }
   }
+  // what is wider than the sheet: a display equation or a table scaled down to fit, then
+  // whatever still reaches past the margin (it would be cut off on paper)
+  const article = document.querySelector('article.bd-article') || document.body;
+  const width = article.getBoundingClientRect().width;
+  const fit = 'mjx-container[display="true"], table, .uio-static-explorer, div.output > pre';
+  for (const e of article.querySelectorAll(fit)) {
+    const room = e.parentElement.getBoundingClientRect().width;
+    if (e.scrollWidth > room + 1 && room > 0) e.style.zoom = String(room / e.scrollWidth);
+  }
+  const right = article.getBoundingClientRect().right + 1;
+  const overflow = [];
+  for (const e of article.querySelectorAll('pre, img, table, mjx-container, code, p, li, svg')) {
+    const box = e.getBoundingClientRect();
+    if (box.width > 0 && box.right > right) {
+      const where = e.closest('section[id]');
+      overflow.push(`${e.tagName.toLowerCase()} ${Math.round(box.right - right + 1)}px past ` +
+        `the margin in #${where ? where.id : ''}: ${e.textContent.trim().slice(0, 60)}`);
+    }
+  }
   // the headings that will be printed, in order: the PDF's outline is made from them
   const headings = [...document.querySelectorAll('h1, h2, h3, h4, h5, h6')]
     .filter((h) => h.getClientRects().length > 0)
@@ -250,6 +284,8 @@ PREPARE_JS = """
   const author = document.querySelector('p.component-author');
   return {
     headings,
+    overflow,
+    width,
     author: author ? author.textContent.trim().replace(/^By\\s+/, '') : '',
   };
 }
@@ -491,6 +527,64 @@ def destination_pages(pdf: bytes, names: Sequence[str]) -> dict[str, int]:
     return out
 
 
+def structure(reader) -> dict[str, list]:  # noqa: ANN001 (a pypdf PdfReader)
+    """The structure tree of a tagged PDF: its element types in reading order, and the
+    alternative text (``/Alt``, or None) of every ``/Figure``."""
+    from pypdf.generic import ArrayObject, DictionaryObject
+
+    root = reader.trailer["/Root"].get("/StructTreeRoot")
+    types: list[str] = []
+    alts: list[str | None] = []
+
+    def walk(node) -> None:  # noqa: ANN001
+        node = node.get_object()
+        if isinstance(node, ArrayObject):
+            for kid in node:
+                walk(kid)
+            return
+        if not isinstance(node, DictionaryObject) or "/S" not in node:
+            return  # a marked-content reference, an object reference or a number
+        types.append(str(node["/S"]))
+        if node["/S"] == "/Figure":
+            alt = node.get("/Alt")
+            alts.append(str(alt) if alt is not None else None)
+        if "/K" in node:
+            walk(node["/K"])
+
+    if root is not None and "/K" in root.get_object():
+        walk(root.get_object()["/K"])
+    return {"types": types, "figure_alts": alts}
+
+
+def audit_pdf(path: Path) -> list[str]:
+    """What a PDF lacks to be accessible: tags, language, outline, title, figures' texts."""
+    from pypdf import PdfReader
+
+    reader = PdfReader(path)
+    catalog = reader.trailer["/Root"]
+    problems = []
+    tree = structure(reader)
+    if not tree["types"]:
+        problems.append("no structure tree (not tagged)")
+    mark = catalog.get("/MarkInfo")
+    if mark is None or not mark.get_object().get("/Marked"):
+        problems.append("not marked as tagged (/MarkInfo /Marked)")
+    if not str(catalog.get("/Lang", "")).strip():
+        problems.append("no language (/Lang)")
+    if not reader.outline:
+        problems.append("no outline")
+    title = str((reader.metadata or {}).get("/Title", "")).strip()
+    if not title or "://" in title or title.endswith((".html", ".pdf")):
+        problems.append(f"no title in the metadata (/Title {title!r})")
+    prefs = catalog.get("/ViewerPreferences")
+    if prefs is None or not prefs.get_object().get("/DisplayDocTitle"):
+        problems.append("viewers are not asked to show the title (/DisplayDocTitle)")
+    missing = sum(1 for alt in tree["figure_alts"] if not (alt or "").strip())
+    if missing:
+        problems.append(f"{missing} figure(s) without a text alternative (/Alt)")
+    return [f"{path.name}: {p}" for p in problems]
+
+
 # --- printing ------------------------------------------------------------------------------------
 
 
@@ -523,12 +617,14 @@ async def _open(context, url: str):  # noqa: ANN001, ANN202 (Playwright's Browse
     return tab
 
 
-async def print_page(context, job: Job, page: Page) -> Path:  # noqa: ANN001
-    """Print one page of the site to ``<out>/<name>.pdf``."""
+async def print_page(context, job: Job, page: Page) -> tuple[Path, list[str]]:  # noqa: ANN001
+    """Print one page of the site to ``<out>/<name>.pdf``; what reaches past its margins."""
     tab = await _open(context, job.base + page.path)
     try:
         title = _page_title(await tab.title(), job.book_title)
+        await tab.emulate_media(media="print")
         prepared = await tab.evaluate(PREPARE_JS, {"title": title, "keepLinks": False})
+
         target = job.out / f"{page.name}.pdf"
         await tab.pdf(
             path=target,
@@ -538,13 +634,14 @@ async def print_page(context, job: Job, page: Page) -> Path:  # noqa: ANN001
         )
         headings = [h["text"] for h in prepared["headings"]]
         finish_pdf(target, title, prepared["author"], headings)
-        return target
+        return target, prepared["overflow"]
     finally:
         await tab.close()
 
 
-async def print_book(context, job: Job) -> Path:  # noqa: ANN001
-    """Print the whole book, with its contents' page numbers, to ``<out>/<book_name>.pdf``."""
+async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN001
+    """Print the whole book, with its contents' page numbers, to ``<out>/<book_name>.pdf``;
+    what reaches past its margins."""
     tab = await _open(context, job.base + job.pages[0].path)
     try:
         await tab.add_style_tag(content=BOOK_CSS)
@@ -562,7 +659,9 @@ async def print_book(context, job: Job) -> Path:  # noqa: ANN001
         bad = await tab.evaluate(TYPESET_JS)
         if bad:
             raise PrintError(f"the whole book: math not typeset: {bad[:3]}")
+        await tab.emulate_media(media="print")
         prepared = await tab.evaluate(PREPARE_JS, {"title": job.book_title, "keepLinks": True})
+
         targets = await tab.evaluate(
             "() => [...document.querySelectorAll('.print-toc-page')].map(e => e.dataset.target)"
         )
@@ -588,12 +687,12 @@ async def print_book(context, job: Job) -> Path:  # noqa: ANN001
         target.write_bytes(pdf)
         headings = [h["text"] for h in prepared["headings"]]
         finish_pdf(target, job.book_title, prepared["author"], headings)
-        return target
+        return target, prepared["overflow"]
     finally:
         await tab.close()
 
 
-async def _print_all(job: Job, jobs: int, book: Job | None) -> list[Path]:
+async def _print_all(job: Job, jobs: int, book: Job | None) -> list[tuple[Path, list[str]]]:
     """Print ``job``'s pages and, if given, the whole book of ``book``'s pages."""
     from playwright.async_api import async_playwright
 
@@ -615,9 +714,7 @@ async def _print_all(job: Job, jobs: int, book: Job | None) -> list[Path]:
                 await route.abort()
 
         try:
-            context = await browser.new_context(
-                color_scheme="light", viewport={"width": 1000, "height": 1400}
-            )
+            context = await browser.new_context(color_scheme="light", viewport=VIEWPORT)
             await context.route("**/*", offline)
             gate = asyncio.Semaphore(jobs)
 
@@ -674,14 +771,19 @@ def print_site(
             meta=f"Printed on {time.localtime().tm_mday} {time.strftime('%B %Y')} from the "
             "book's web pages",
         )
-        pdfs = asyncio.run(_print_all(job, jobs or os.cpu_count() or 1, job if book else None))
+        results = asyncio.run(_print_all(job, jobs or os.cpu_count() or 1, job if book else None))
+    pdfs = [path for path, _ in results]
+    problems = [line for path in pdfs for line in audit_pdf(path)]
+    if problems:
+        raise PrintError("printed, but not accessible:\n" + "\n".join(problems))
     if not only:  # a page no longer in the book leaves no PDF behind
         for stale in set(out.glob("*.pdf")) - set(pdfs):
             stale.unlink()
     from pypdf import PdfReader
 
     sheets = sum(len(PdfReader(p).pages) for p in pdfs)
-    return Printed(pdfs=pdfs, seconds=time.perf_counter() - start, pages=sheets)
+    overflow = {path.name: lines for path, lines in results if lines}
+    return Printed(pdfs, time.perf_counter() - start, sheets, overflow)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -707,6 +809,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PrintError as err:
         print(f"pdf_print: {err}", file=sys.stderr)
         return 1
+    for name, lines in printed.overflow.items():
+        for line in lines[:10]:
+            print(f"pdf_print: warning: {name}: {line}", file=sys.stderr)
     print(
         f"printed {len(printed.pdfs)} PDF(s), {printed.pages} pages, into {args.out} in "
         f"{printed.seconds:.1f} s"
