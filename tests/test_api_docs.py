@@ -16,6 +16,8 @@ SUBPACKAGE_API = (
     "worked",
     "worked.quadruple_tank",
     "luenberger",
+    "figure_text",
+    "colour_vision",
     "explorers",
     "explorers.widgets",
     "explorers.static",
