@@ -270,7 +270,11 @@ def _legend_above(ax: Any) -> int:
         fontsize=texts[0].get_fontsize() if texts else None,
         frameon=False,
     )
-    return -(-len(labels) // ncols)
+    rows = -(-len(labels) // ncols)
+    if ax.get_title():  # the title goes above the legend
+        size = texts[0].get_fontsize() if texts else 10.0
+        ax.set_title(ax.get_title(), pad=8 + rows * 1.45 * size)
+    return rows
 
 
 def _spoken(label: str) -> str:
