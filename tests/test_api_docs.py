@@ -19,6 +19,8 @@ SUBPACKAGE_API = (
     "worked",
     *WORKED_MODULES,
     "luenberger",
+    "figure_text",
+    "colour_vision",
     "explorers",
     "explorers.widgets",
     "explorers.static",

@@ -438,3 +438,28 @@ def test_rerunning_a_cell_frees_the_previous_explorer():
     widgets.case_study_explorer(static=False)
     gc.collect()
     assert ref() is None
+
+
+@pytest.mark.parametrize("make", ["pa9_explorer", "case_study_explorer", "tank_explorer"])
+def test_every_control_has_a_label_and_the_picture_is_put_in_words(make):
+    """Every control carries its label (ipywidgets writes it as the control's <label>); the
+    picture's text alternative is under it, in a live region read out when it changes."""
+    from uio_teach.explorers import widgets
+
+    options = {"static": False} if make == "tank_explorer" else {"static": False, "drag": False}
+    ex = getattr(widgets, make)(**options)
+    try:
+        unnamed = [
+            name
+            for name, control in ex.controls.items()
+            if not (getattr(control, "description", "") or "").strip()
+        ]
+        assert not unnamed, f"{make}: controls without a label: {unnamed}"
+        before = ex.words.value
+        assert 'role="status"' in before and 'aria-live="polite"' in before, before
+        assert "explorer at observer poles" in before and "error" in before, before
+        ex.set(**{"amplitude": 0.0})  # no disturbance: the Luenberger error decays too
+        assert ex.words.value != before
+        assert ex.words in ex.widget.children
+    finally:
+        ex.close()

@@ -502,7 +502,9 @@ _JS = (
     "if(n){n.srcset=f.getAttribute('data-narrow');}i.src=f.getAttribute('data-src');"
     "i.alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
-    "this.mainval.value=f.getAttribute('data-label');r.classList.add('uio-live');}"
+    "this.mainval.value=f.getAttribute('data-label');"
+    "this.main.setAttribute('aria-valuetext',f.getAttribute('data-label'));"
+    "r.classList.add('uio-live');}"
 )
 
 NARROW_PX = 700
@@ -533,6 +535,7 @@ margin:0.3em 0}
 max-width:100%}
 .uio-static-explorer .uio-slider{display:inline-flex;align-items:center;gap:0.5em}
 .uio-static-explorer input[type=range]{margin:0;vertical-align:middle}
+.uio-static-explorer :focus-visible{outline:3px solid #c2185b;outline-offset:2px}
 .uio-static-explorer .uio-picture{max-width:100%}
 .uio-static-explorer img.uio-frame{display:block;width:100%;max-width:none;height:auto;margin:0}
 .uio-static-explorer .uio-captions{display:grid}
@@ -594,12 +597,13 @@ def _html(
         f'<source media="(max-width:{NARROW_PX}px)" srcset="{first.narrow_url}">' if phone else ""
     )
     return (
-        f'<div id="{eid}" class="uio-static-explorer">'
+        f'<div id="{eid}" class="uio-static-explorer" role="group" '
+        f'aria-label="{esc(scenario.title)} explorer">'
         f"<style>{css}</style>"
         f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}">'
         f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
         f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
-        f'step="1" value="{i0}" aria-label="{label}"> '
+        f'step="1" value="{i0}" aria-label="{label}" aria-valuetext="{esc(first.label)}"> '
         f'<output name="mainval">{esc(first.label)}</output></span></label>'
         f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'

@@ -64,7 +64,7 @@ from .scenarios import (
     make_scenario,
     scenario_of,
 )
-from .static import static_html
+from .static import frame_alt, static_html
 
 __all__ = [
     "Explorer",
@@ -211,6 +211,8 @@ class Explorer(DragPoles):
         self.frame: Frame | None = None
         self.image = W.Image(format="png", layout=W.Layout(width="100%", max_width="900px"))
         self.message = W.HTML()
+        # the picture in words, updated with it: its text alternative, read out on each change
+        self.words = W.HTML(layout=W.Layout(max_width="900px"))
         self.canvas: Any = None
         self._dragging: tuple[int, str] | None = None
         if drag is None:
@@ -318,7 +320,7 @@ class Explorer(DragPoles):
         boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in groups]
         controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
         view = self.canvas if self.canvas is not None else self.image
-        self.widget = W.VBox([controls, view, self.message])
+        self.widget = W.VBox([controls, view, self.words, self.message])
 
     @staticmethod
     def _pattern_label(k: int, pairs: int) -> str:
@@ -562,6 +564,11 @@ class Explorer(DragPoles):
             else ""
         )
         self.message.value = _message_html(frame) + refused
+        said = frame_alt(frame, "observer poles", format_poles(self.settings.poles, 3))
+        self.words.value = (
+            '<p role="status" aria-live="polite" style="font-size:0.85em;margin:0.2em 0">'
+            f"{html.escape(said)}</p>"
+        )
 
     def close(self) -> None:
         """Close the figure's canvas and the widgets (frees their memory at once).
