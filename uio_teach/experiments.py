@@ -55,8 +55,9 @@ __all__ = [
 
 PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
 """The kinds of value a :class:`Param` declares."""
-CONTROLS = ("amplitude", "frequency", "noise", "plant")
-"""The explorer controls a declared field can set (:attr:`Param.control`)."""
+CONTROLS = ("amplitude", "frequency", "noise")
+"""The explorer's own controls that a declared field can set (:attr:`Param.control`); a
+field with a ``range`` and none of these gets a slider of its own."""
 
 
 @dataclass(frozen=True)
@@ -104,12 +105,15 @@ class Param:
     omit_default : bool
         Left out of ``PARAMS`` while it has its default value.
     range : (float, float), optional
-        The range a student explores (the explorers' sliders).
+        The range a student explores: the field gets a slider in the
+        explorer (of its own, or the control that ``control`` names). Only
+        for ``"int"`` and ``"float"`` fields.
     control : str
-        The explorer's control that the field sets, with ``range``:
+        The explorer's own control that the field sets, with ``range``:
         ``"amplitude"``, ``"frequency"`` or ``"noise"`` (the disturbance and
-        measurement controls), or ``"plant"`` (a slider of its own for a
-        physical parameter, a field of ``plant_fields``).
+        measurement controls); empty: a slider of its own, which remakes the
+        explorer's run with the field's new value (a physical parameter of
+        the plant, a time, ...).
 
     Examples
     --------
@@ -139,13 +143,18 @@ class Param:
     def __post_init__(self) -> None:
         if self.kind not in PARAM_KINDS:
             raise ValueError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
-        if (self.range is None) != (not self.control) or (
-            self.control and self.control not in CONTROLS
-        ):
+        if self.control and (self.control not in CONTROLS or self.range is None):
             raise ValueError(
-                f"a Param with a range names its explorer control (one of {CONTROLS}) and "
-                f"a control needs a range; got range={self.range!r}, control={self.control!r}"
+                f"a Param's control must be one of {CONTROLS} and comes with a range; got "
+                f"range={self.range!r}, control={self.control!r}"
             )
+        if self.range is not None:
+            lo, hi = self.range
+            if self.kind not in ("int", "float") or not lo < hi:
+                raise ValueError(
+                    "a Param's range (a slider) needs an int or float field and low < high; "
+                    f"got kind={self.kind!r}, range={self.range!r}"
+                )
 
     def config_key(self, section: str, name: str = "") -> str | None:
         """The key of the term config (``None``: not in the config).
@@ -444,7 +453,18 @@ class Experiment:
         """
         samples, duration = values.pop("samples", None), values.pop("duration", None)
         if samples is not None or duration is not None:
-            values.setdefault("timepts", self.grid(samples=samples, duration=duration))
+            if "timepts" in values:
+                raise ValueError(
+                    "give the time grid either as timepts or as samples/duration, not both "
+                    "(one of them would be dropped)"
+                )
+            values["timepts"] = self.grid(samples=samples, duration=duration)
+        names = {f.name for f in fields(self) if f.init}
+        unknown = sorted(set(values) - names)
+        if unknown:
+            raise ValueError(
+                f"the experiment {self.name!r} has no field {', '.join(map(repr, unknown))}"
+            )
         return replace(self, **values)
 
     # the run ------------------------------------------------------------------------------------

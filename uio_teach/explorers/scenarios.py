@@ -78,7 +78,13 @@ def _range(experiment: Any, control: str) -> tuple[float, float]:
 
 
 def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
-    """The sliders of an experiment's physical parameters: its ``plant_fields`` with a range.
+    """The sliders of an experiment's own fields: each declared field with a range and no control.
+
+    A field declared with a ``range`` and no ``control`` (none of the
+    explorer's own amplitude, frequency and noise controls) gets a slider of
+    its own, whatever it is: a physical parameter of the plant (a field of
+    ``plant_fields``), a time, a gain. Moving it remakes the scenario with the
+    field's new value (``Scenario.rebuild``).
 
     Parameters
     ----------
@@ -105,8 +111,8 @@ def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
             limits=specs[name].range,
             value=float(getattr(experiment, name)),
         )
-        for name in type(experiment).plant_fields
-        if name in specs and specs[name].control == "plant"
+        for name, spec in specs.items()
+        if spec.range is not None and not spec.control
     )
 
 
@@ -289,13 +295,16 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     entry = WORKED[name]
     opts = entry.explorer
     run = entry.run()
-    fields = {f for f, _ in experiment_params(run)}
+    fields = {f for f, spec in experiment_params(run) if spec.range and not spec.control}
     unknown = sorted(set(values) - fields)
     if unknown:
         raise RegistryError(
             f"the {name} explorer has no slider {', '.join(map(repr, unknown))}; "
-            f"its experiment declares {', '.join(sorted(fields))}"
+            f"its sliders: {', '.join(sorted(fields)) or 'none'}"
         )
+    specs = dict(experiment_params(run))
+    # a slider gives floats: an integer field takes its nearest integer
+    values = {f: round(v) if specs[f].kind == "int" else v for f, v in values.items()}
     run = run.with_values(**values)
     plant = run.plant()
     declared = {spec.control: f for f, spec in experiment_params(run) if spec.control}

@@ -198,8 +198,9 @@ class ExplorerOptions:
         The static book's main control: ``"pole"``, ``"amplitude"`` or
         ``"plant:<field>"`` (a field's own slider).
     note : str or None
-        ``"module:function"`` called with the fields that have sliders: a
-        sentence on this plant (``None``: none).
+        ``"module:function"`` called with the plant's physical parameters
+        (the experiment's ``plant_fields``): a sentence on this plant
+        (``None``: none).
     input_symbol : str
         The unknown input's symbol in the figure.
 

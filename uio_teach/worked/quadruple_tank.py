@@ -111,7 +111,6 @@ class QuadrupleTankExperiment(Experiment):
         positive=True,
         maximum=0.99,
         range=(0.05, 0.95),
-        control="plant",
     )
     gamma2: float = param(
         0.60,
@@ -120,7 +119,6 @@ class QuadrupleTankExperiment(Experiment):
         positive=True,
         maximum=0.99,
         range=(0.05, 0.95),
-        control="plant",
     )
     step_size: float = param(
         0.5, "float", "size of the step", unit="V", key="pump1.step", maximum=MAX_VALUE
