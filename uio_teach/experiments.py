@@ -40,10 +40,11 @@ import numpy as np
 from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
-from .worked import WORKED
+from .worked import WORKED, RegistryView
 
 __all__ = [
     "Experiment",
+    "ContinuousExperiment",
     "EXPERIMENTS",
     "Param",
     "param",
@@ -561,38 +562,39 @@ class Experiment:
         return simulate(self.plant(), observer, timepts, **kwargs)
 
 
-class _FromRegistry(Mapping):
-    """A view of the worked examples' registry (:data:`uio_teach.worked.WORKED`), read on use."""
+@dataclass(frozen=True)
+class ContinuousExperiment(Experiment):
+    """A continuous-time experiment: its length (s) and number of time points are config keys.
 
-    def __init__(self, what: str) -> None:
-        self._what = what
+    Examples
+    --------
+    >>> from uio_teach.experiments import ContinuousExperiment, experiment_params
+    >>> spec = dict(experiment_params(ContinuousExperiment))["duration"]
+    >>> spec.unit, spec.config_key("pa9", "duration")
+    ('s', 'pa9.duration')
+    """
 
-    def _items(self) -> dict[str, Any]:
-        if self._what == "experiments":
-            return {name: entry.run() for name, entry in WORKED.items()}
-        return {name: entry.plant_factory() for name, entry in WORKED.items() if entry.lab}
-
-    def __getitem__(self, name: str) -> Any:
-        return self._items()[name]
-
-    def __iter__(self):
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"{self._what.upper()}({', '.join(self)})"
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
+    )
 
 
-EXPERIMENTS: Mapping[str, Experiment] = _FromRegistry("experiments")
+EXPERIMENTS: Mapping[str, Experiment] = RegistryView(
+    "EXPERIMENTS", lambda worked: {name: entry.run() for name, entry in worked.items()}
+)
 """The experiment of every worked example, by name.
 
 The names are the tables of the term config; the values the experiments of the worked
 examples' modules (a view of :data:`uio_teach.worked.WORKED`)."""
 
 
-LAB_PLANTS: Mapping[str, Callable[[], Plant]] = _FromRegistry("lab plants")
+LAB_PLANTS: Mapping[str, Callable[[], Plant]] = RegistryView(
+    "LAB_PLANTS",
+    lambda worked: {name: entry.plant_factory() for name, entry in worked.items() if entry.lab},
+)
 """The course's plant of each lab, as a factory (the worked examples of
 :data:`uio_teach.worked.WORKED` that have a lab)."""
 

@@ -55,6 +55,7 @@ __all__ = [
     "LabEntry",
     "ExplorerOptions",
     "RegistryError",
+    "RegistryView",
     "WORKED",
     "discover",
     "resolve",
@@ -423,10 +424,54 @@ class WorkedExample:
         return None if spec is None else spec.config_key(self.name, "poles")
 
 
-class _Registry(Mapping):
+class RegistryView(Mapping):
+    """A read-only mapping made from the registry each time it is read.
+
+    What the package derives from the worked examples (the experiments by
+    name, the figures, the labs, the poles keys of the term config) is a view:
+    it follows the registry, a worked example found later included
+    (:func:`discover`), and nothing keeps a copy that could go stale.
+
+    Parameters
+    ----------
+    name : str
+        How it prints (``"FIGURES"``, ...).
+    items : callable
+        ``items(WORKED) -> dict``: the mapping, made from the registry.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import RegistryView
+    >>> titles = RegistryView("TITLES", lambda worked: {n: e.title for n, e in worked.items()})
+    >>> titles["missile"], len(titles) >= 4
+    ('The missile autopilot', True)
+    """
+
+    def __init__(self, name: str, items: Callable[[Mapping[str, WorkedExample]], dict]) -> None:
+        self._name = name
+        self._make = items
+
+    def _items(self) -> dict:
+        return self._make(WORKED)
+
+    def __getitem__(self, key: Any) -> Any:
+        return self._items()[key]
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(self._items())
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __repr__(self) -> str:
+        return f"{self._name}({', '.join(map(str, self))})"
+
+
+class _Registry(RegistryView):
     """The worked examples by name, found in the modules of the packages read on first use."""
 
     def __init__(self) -> None:
+        super().__init__("WORKED", lambda _worked: self._load())
         self._entries: dict[str, WorkedExample] | None = None
         self._packages: list[tuple[list[str], str]] = [(list(__path__), __name__)]
 
@@ -453,18 +498,6 @@ class _Registry(Mapping):
                 raise RegistryError(f"worked examples declared twice: {', '.join(twice)}")
             self._entries = {e.name: e for e in found}
         return self._entries
-
-    def __getitem__(self, name: str) -> WorkedExample:
-        return self._load()[name]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._load())
-
-    def __len__(self) -> int:
-        return len(self._load())
-
-    def __repr__(self) -> str:
-        return f"WORKED({', '.join(self)})"
 
 
 WORKED: Mapping[str, WorkedExample] = _Registry()
