@@ -169,7 +169,10 @@ def test_the_api_page_lists_its_module(motor_package):
         worked_api = importlib.import_module("worked_api")
     finally:
         sys.path.remove(str(ROOT / "_ext"))
-    assert worked_api.worked_modules()[-1] == "extra_examples.dc_motor"
+    assert list(worked_api.worked_modules().items())[-1] == (
+        "extra_examples.dc_motor",
+        "A DC motor",
+    )
     lines = worked_api.module_lines("extra_examples.dc_motor")
     assert ".. automodule:: extra_examples.dc_motor" in lines
 

@@ -244,3 +244,19 @@ def test_a_time_grid_given_twice_is_refused():
         run.with_values(timepts=[0.0, 1.0], samples=11)
     with pytest.raises(ValueError, match=r"has no field 'sine_phase'"):
         run.with_values(sine_phase=0.7)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"poles": (-5.0, -6.0, -7.0)}, r"its experiment sets the starting poles"),
+        ({"static_control": "plant:gamma1"}, r"static_control 'plant:gamma1' names no slider"),
+    ],
+)
+def test_an_explorer_option_that_would_be_ignored_is_refused(monkeypatch, change, message):
+    entry = dataclasses.replace(
+        WORKED["pa9"], explorer=dataclasses.replace(WORKED["pa9"].explorer, **change)
+    )
+    monkeypatch.setitem(WORKED._load(), "pa9", entry)
+    with pytest.raises(RegistryError, match=message):
+        entry.make_scenario()

@@ -329,6 +329,20 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
                 f"{control!r} and '{option}_limits' are required"
             )
 
+    if opts.poles is not None and run.poles is not None:
+        raise RegistryError(
+            f"the {name} explorer: its experiment sets the starting poles {run.poles}; "
+            "drop the option poles (it is for an experiment without poles, an LMI gain)"
+        )
+    sliders = plant_controls(run)
+    if opts.static_control.startswith("plant:"):
+        wanted = opts.static_control.split(":", 1)[1]
+        if wanted not in {c.name for c in sliders}:
+            raise RegistryError(
+                f"the {name} explorer: static_control {opts.static_control!r} names no slider; "
+                f"its sliders: {', '.join(c.name for c in sliders) or 'none'}"
+            )
+
     def value(control: str, default: float) -> float:
         given = getattr(run, declared[control]) if control in declared else start.get(control)
         return default if given is None else given
@@ -371,7 +385,7 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
         static_values=opts.static_values,
         static_control=opts.static_control,
         input_symbol=opts.input_symbol,
-        plant_controls=plant_controls(run),
+        plant_controls=sliders,
         rebuild=functools.partial(experiment_scenario, name),
         note=resolve(opts.note)(**physical) if opts.note else "",
     )

@@ -176,13 +176,18 @@ class ExplorerOptions:
         The starting poles, when the experiment has none (an LMI gain).
     disturbance : str
         The starting disturbance type.
-    amplitude, frequency : float or None
-        The starting amplitude and frequency, for an experiment that declares
-        no field for them (then ``amplitude_limits`` and
-        ``disturbance_frequency_limits`` are required too).
-    amplitude_limits, disturbance_frequency_limits, noise_limits : (float, float) or None
-        The ranges of controls that no declared field sets (given while a
+    amplitude : float or None
+        The starting amplitude, for an experiment that declares no field for
+        it (then ``amplitude_limits`` is required too).
+    frequency : float or None
+        The starting frequency, likewise (with ``disturbance_frequency_limits``).
+    amplitude_limits : (float, float) or None
+        The amplitude's range, when no declared field sets it (given while a
         field declares one: an error, the value would be set twice).
+    disturbance_frequency_limits : (float, float) or None
+        The frequency's range, likewise.
+    noise_limits : (float, float) or None
+        The noise's range, likewise (default: 0 to 0.5).
     decay : float
         The starting LMI bound.
     decay_limits : (float, float) or None
@@ -191,10 +196,12 @@ class ExplorerOptions:
         The starting time constant of the input reconstruction's filter.
     tau_limits : (float, float) or None
         Its range (``None``: the inputs are not reconstructed).
-    d_channels, v_channels : tuple of tuple
-        How each channel of ``d`` (``v``) follows the disturbance controls:
+    d_channels : tuple of tuple
+        How each channel of ``d`` follows the disturbance controls:
         ``(gain, speed)`` or ``(gain, speed, decay, kind)`` per channel
-        (``d_channels`` empty: ``(1, 1)`` for each unknown input).
+        (empty: ``(1, 1)`` for each unknown input).
+    v_channels : tuple of tuple
+        The same for the measurement disturbance ``v`` (empty: none).
     static_control : str
         The static book's main control: ``"pole"``, ``"amplitude"`` or
         ``"plant:<field>"`` (a field's own slider).
