@@ -43,7 +43,7 @@ from typing import Any
 
 import matplotlib.style
 
-from ..worked import WORKED, resolve, run_from_config
+from ..worked import WORKED, RegistryView, resolve, run_from_config
 from .config import (
     ConfigError,
     FigureConfig,
@@ -140,30 +140,16 @@ class FigureSpec:
     table: bool = False
 
 
-class _Figures(Mapping):
-    """The figures of every worked example of the registry, in its order (read on use)."""
-
-    def _items(self) -> dict[str, FigureSpec]:
-        out = {}
-        for entry in WORKED.values():
-            for fig in entry.figures:
-                out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
-        return out
-
-    def __getitem__(self, name: str) -> FigureSpec:
-        return self._items()[name]
-
-    def __iter__(self):
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"FIGURES({', '.join(self)})"
+def _figures(worked: Mapping[str, Any]) -> dict[str, FigureSpec]:
+    """The figures of every worked example of the registry, in its order."""
+    out = {}
+    for entry in worked.values():
+        for fig in entry.figures:
+            out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
+    return out
 
 
-FIGURES: Mapping[str, FigureSpec] = _Figures()
+FIGURES: Mapping[str, FigureSpec] = RegistryView("FIGURES", _figures)
 """Every output of ``uio-teach figures``, by name, in the order they are made."""
 
 

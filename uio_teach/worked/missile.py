@@ -32,7 +32,12 @@ from .. import examples, signals
 from .._display import format_poles
 from ..examples import MISSILE_PUBLISHED
 from ..existence import check_existence
-from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_SEED, MAX_VALUE, Experiment, param
+from ..experiments import (
+    MAX_SEED,
+    MAX_VALUE,
+    ContinuousExperiment,
+    param,
+)
 from ..lab_params import (
     MIN_INITIAL_ERROR,
     LabParams,
@@ -52,7 +57,7 @@ __all__ = ["MissileExperiment", "MISSILE", "MissileParams"]
 
 
 @dataclass(frozen=True)
-class MissileExperiment(Experiment):
+class MissileExperiment(ContinuousExperiment):
     """The missile autopilot: the paper's ``x0`` and ``v1, v2``, the PMO started at ``xhat(0) = 0``.
 
     The unknown inputs are the paper's damped sinusoids
@@ -85,12 +90,6 @@ class MissileExperiment(Experiment):
         "poles",
         "PMO poles (the paper's are not given; see chapter 5)",
         key="pmo_poles",
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
     )
     v_parameters: tuple[tuple[float, float, float, str], ...] = examples.MISSILE_INPUTS
     noise_sigma: float = param(

@@ -35,12 +35,10 @@ from .. import signals
 from .._display import format_poles
 from ..existence import check_existence
 from ..experiments import (
-    MAX_DURATION,
-    MAX_SAMPLES,
     MAX_SEED,
     MAX_VALUE,
     SEED_DOC,
-    Experiment,
+    ContinuousExperiment,
     param,
     plant_from_params,
 )
@@ -62,7 +60,7 @@ __all__ = ["PA9Experiment", "PA9", "PA9Params"]
 
 
 @dataclass(frozen=True)
-class PA9Experiment(Experiment):
+class PA9Experiment(ContinuousExperiment):
     """Practical Assignment 9: the decoupling UIO, a sinusoidal and a piecewise-constant ``d``.
 
     Attributes
@@ -112,12 +110,6 @@ class PA9Experiment(Experiment):
     )
     seed: int | None = param(
         4, "int", SEED_DOC, config="seed", minimum=0, maximum=MAX_SEED, omit_default=True
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
     )
     sine_amplitude: float = param(
         1.0,

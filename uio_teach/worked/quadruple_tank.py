@@ -118,7 +118,6 @@ class QuadrupleTankExperiment(Experiment):
         minimum=0.0,
         maximum=0.99,
         range=(0.0, 0.95),
-        control="plant",
     )
     gamma2: float = param(
         0.60,
@@ -127,7 +126,6 @@ class QuadrupleTankExperiment(Experiment):
         minimum=0.0,
         maximum=0.99,
         range=(0.0, 0.95),
-        control="plant",
     )
     step_size: float = param(
         0.5, "float", "size of the step", unit="V", key="pump1.step", maximum=MAX_VALUE
