@@ -56,8 +56,9 @@ margin relative to the value, so it is the same in any unit of time. Also the ma
 the LMI certifies."""
 
 REAL_RTOL = 1e-10
-"""``sort_poles``: an imaginary part below this fraction of the value's size is round-off of a
-real value (a real pole computed as ``-2 + 1e-15j``)."""
+"""Round-off of a value: an imaginary part below this fraction of its size is round-off of a real
+value (``sort_poles``: a real pole computed as ``-2 + 1e-15j``), and two requested poles within
+this fraction of their size are one pole requested twice (``check_poles``)."""
 
 MODES_RTOL = 1e-5
 """The fixed modes (unobservable modes of the designs' pair) agree with the invariant zeros when
