@@ -203,7 +203,8 @@ def check_poles(
         # backward check: is the requested value an eigenvalue of a matrix close to F?
         smin = np.linalg.svd(F - req[i] * np.eye(n), compute_uv=False)[-1]
         explained[i] = smin <= 10 * n * _EPS * max(normF, abs(req[i]))
-    ok = tight | (explained & (err <= tols.WARN_RTOL * size))
+    # an error at the round-off of F's eigenvalues themselves is no error, whatever the pole
+    ok = tight | (explained & (err <= tols.WARN_RTOL * size)) | (err <= 10 * n * _EPS * normF)
     if np.all(ok):
         return obtained
     bad = ~ok
