@@ -36,7 +36,7 @@ import nbformat
 import pytest
 
 from uio_teach.grading import grade, sandbox
-from uio_teach.grading.gradebook import safe_cell
+from uio_teach.grading.gradebook import file_cell
 from uio_teach.grading.sandbox import Limits, sandbox_problem
 from uio_teach.instructor import cli
 from uio_teach.instructor.labs import LABS
@@ -422,7 +422,7 @@ def graded(labs, tmp_path_factory) -> dict:
     feedback = out.parent / "grades_feedback"
     by_name = {}
     for name, path in subs.items():
-        cell = safe_cell(str(path))
+        cell = file_cell(str(path))
         by_name[name] = table.get(cell)
     texts = {}
     for name, path in subs.items():
