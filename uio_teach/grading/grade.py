@@ -72,6 +72,7 @@ from typing import Any
 import nbformat
 
 from ..errors import UIOTeachWarning
+from ..instructor.output import sha256_file
 from .checking import check_in_child
 from .copies import fingerprint
 from .gradebook import (
@@ -87,7 +88,6 @@ from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks, cou
 from .merge import check_shard, shard_of
 from .rosters import (
     GradeError,
-    file_sha256,
     group_from_name,
     group_id,
     is_late,
@@ -787,8 +787,8 @@ def grade(
         raise GradeError(f"cannot read the labs' check cells: {err}") from None
     files_roster, students = read_roster(roster) if roster is not None else ({}, {})
     sources = {
-        "answer_key_sha256": file_sha256(answer_key) if answer_key is not None else None,
-        "roster_sha256": file_sha256(roster) if roster is not None else None,
+        "answer_key_sha256": sha256_file(answer_key) if answer_key is not None else None,
+        "roster_sha256": sha256_file(roster) if roster is not None else None,
     }
     if shard is not None:
         shard = check_shard(shard)
