@@ -836,7 +836,9 @@ def test_grade_usage_errors(tmp_path, capsys):
 
 
 def test_without_a_sandbox_grading_is_refused_unless_asked(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(grade, "_self_test", lambda limits: "bubblewrap (bwrap) is not installed")
+    monkeypatch.setattr(
+        grade, "_self_test", lambda limits, stop=None: "bubblewrap (bwrap) is not installed"
+    )
     nb = small(tmp_path / "pa9_g01.ipynb", "g01", design=False)
     out = tmp_path / "grades.csv"
     assert cli.main(["grade", str(nb), "--out", str(out)]) == 2
