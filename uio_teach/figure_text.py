@@ -53,7 +53,7 @@ __all__ = [
 ]
 
 NARROW_WIDTH = 3.6
-"""Width (inches) of a figure's phone version: 360 px at 100 dpi, a phone's column."""
+"""Width (inches) of a figure's phone version, 360 px at 100 dpi (a phone's column)."""
 NARROW_SCREEN_PX = 600
 """Screens up to this width (CSS px) get the phone version of a figure."""
 _PANEL_HEIGHT = 2.4  # inches per panel of the phone version

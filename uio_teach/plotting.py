@@ -80,12 +80,12 @@ __all__ = [
 ]
 
 COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
-"""The course's colour cycle: the Okabe-Ito palette (blue, vermillion, bluish green, reddish
+"""The course's colour cycle, the Okabe-Ito palette (blue, vermillion, bluish green, reddish
 purple, orange, sky blue, black) without its yellow, which is too light on white. The book's
 ``matplotlibrc`` sets the same cycle, with :data:`LINESTYLES`."""
 LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2)), (0, (1, 1)))
-"""The line style of each colour of :data:`COLORS`: curves stay apart in grey print and for a
-reader who sees two of the colours as one."""
+"""The line style of each colour of :data:`COLORS`, so that curves stay apart in grey print
+and for a reader who sees two of the colours as one."""
 
 UNIT = "model units"
 """The unit of states, inputs and disturbances: the course's models give no physical units."""
