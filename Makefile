@@ -20,7 +20,7 @@ unexport PYTHONDONTWRITEBYTECODE
 JOBS ?= auto
 
 .DEFAULT_GOAL := help
-.PHONY: help venv book book-instructor test lint clean
+.PHONY: help venv book book-instructor pdf pdf-instructor test lint clean
 
 # What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
 # build the book or the wheel, start any other process, or take long (the markers each test
@@ -31,6 +31,9 @@ help:
 	@echo "make book   build the HTML book into _build/html (warnings are errors)"
 	@echo "make book-instructor  the instructor edition (lab solutions, tutors' notes)"
 	@echo "            into _build/instructor/_build/html"
+	@echo "make pdf    the book, with every page and the whole book printed as tagged PDFs"
+	@echo "            into _build/pdf (and linked from the pages); make pdf-instructor:"
+	@echo "            the instructor edition's, into _build/instructor/_build/pdf"
 	@echo "make test   lint, then run every test (package, chapters, book build, browser)"
 	@echo "make check  lint, then the quick tests: no kernel, browser, book, wheel or process"
 	@echo "make venv   create or update $(VENV) from the lock, requirements.txt"
@@ -61,6 +64,22 @@ book-instructor: $(STAMP)
 	UIO_TEACH_EDITION=instructor $(BIN)/jupyter-book build . -W -n --keep-going \
 		--path-output _build/instructor
 	@echo "The instructor edition is in $(CURDIR)/_build/instructor/_build/html/index.html"
+
+# The printed book (_ext/downloads.py, _ext/pdf_print.py): the book built with UIO_TEACH_PDF=1,
+# whose pages then link their PDFs, and once written every page printed as a tagged PDF by
+# Debian's Chromium, as many at a time as there are cores, into _build/pdf (uio-teach.pdf: the
+# whole book) and the site's _pdf/. `make book` afterwards rewrites the pages without the links
+# and takes _pdf/ out of the site: a page links a PDF only when its build printed it.
+pdf: $(STAMP)
+	$(BIN)/python _ext/run_chapters.py
+	UIO_TEACH_PDF=1 $(BIN)/jupyter-book build . -W -n --keep-going
+	@echo "The PDFs are in $(CURDIR)/_build/pdf; the book linking them in $(CURDIR)/_build/html"
+
+pdf-instructor: $(STAMP)
+	$(BIN)/python _ext/run_chapters.py --cache _build/instructor/_build/.jupyter_cache
+	UIO_TEACH_EDITION=instructor UIO_TEACH_PDF=1 $(BIN)/jupyter-book build . -W -n \
+		--keep-going --path-output _build/instructor
+	@echo "The PDFs are in $(CURDIR)/_build/instructor/_build/pdf"
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

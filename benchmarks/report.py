@@ -169,13 +169,48 @@ def read_import(text: str) -> list[list[str]]:
     ]
 
 
+def read_decisions(text: str) -> list[list[str]]:
+    r = _json_line(text)
+    return [
+        [
+            f"existence verdicts on {r['plants']} constructed plants with exactly known zeros "
+            "(right / undecided / wrong; zeros counted right; designs returned / silent leaks)",
+            f"{r['right']} / {r['undecided']} / {r['wrong']}; {r['count right']}; "
+            f"{r['designs']} / {r['silent_leaks']}",
+            f"SLICOT AB08ND agrees on {r['slicot agrees']} zero counts",
+            "",
+        ]
+    ]
+
+
+def read_pdf(text: str) -> list[list[str]]:
+    total = re.search(r"make pdf after make book: ([\d.]+) s \(printing ([\d.]+) s\)", text)
+    printed = re.search(r"printed: (\d+) PDFs, (\d+) pages, ([\d.]+) pages/s", text)
+    one = re.search(r"one PDF at a time \(--jobs 1\): ([\d.]+) s", text)
+    cores = re.search(r"cores: (\d+)", text)
+    if not (total and printed and one and cores):
+        raise ReportError("no 'make pdf after make book', 'printed' and 'one PDF at a time' lines")
+    printing = float(total[2])
+    return [
+        [
+            f"`make pdf` after `make book`: every page and the whole book printed, "
+            f"{printed[1]} tagged PDFs, {printed[2]} pages",
+            f"{float(total[1]):.0f} s (printing {printing:.0f} s, {float(printed[3]):.1f} pages/s)",
+            f"printing one PDF at a time {float(one[1]):.0f} s",
+            f"{float(one[1]) / printing:.1f}x faster on {cores[1]} cores",
+        ]
+    ]
+
+
 # name -> (script and arguments, reader); the summary lists them in this order
 BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "simulate": (["bench_simulate.py"], read_simulate),
     "widgets": (["bench_widgets.py"], read_widgets),
     "book": (["bench_book.py", "--runs", "1"], read_book),
+    "pdf": (["bench_pdf.py"], read_pdf),
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
+    "decisions": (["bench_decisions.py"], read_decisions),
 }
 
 

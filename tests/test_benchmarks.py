@@ -62,3 +62,23 @@ def test_the_table_is_replaced_between_the_markers_only():
     new = report.with_table(text, "| new |")
     assert new == f"before\n{report.BEGIN}\n| new |\n{report.END}\nafter\n"
     assert report.readme_table(new) == "| new |"
+
+
+PDF = """\
+cores: 2
+make pdf after make book: 250.4 s (printing 231.0 s)
+printed: 17 PDFs, 760 pages, 3.29 pages/s
+one PDF at a time (--jobs 1): 402.7 s
+"""
+
+
+def test_the_pdf_reader_takes_time_pages_and_the_one_at_a_time_reference():
+    (row,) = report.read_pdf(PDF)
+    assert row[0].endswith("17 tagged PDFs, 760 pages")
+    assert row[1:] == [
+        "250 s (printing 231 s, 3.3 pages/s)",
+        "printing one PDF at a time 403 s",
+        "1.7x faster on 2 cores",
+    ]
+    with pytest.raises(report.ReportError, match="make pdf after make book"):
+        report.read_pdf("printed: 17 PDFs")

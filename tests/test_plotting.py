@@ -8,7 +8,9 @@ from tolerance import assert_same_run
 
 import uio_teach as ut  # noqa: E402
 from uio_teach import plotting  # noqa: E402
-from uio_teach.experiments import CASE_STUDY, MISSILE, PA9  # noqa: E402
+from uio_teach.worked.case_study import CASE_STUDY  # noqa: E402
+from uio_teach.worked.missile import MISSILE  # noqa: E402
+from uio_teach.worked.pa9 import PA9  # noqa: E402
 
 
 def test_names_and_labels():

@@ -12,6 +12,7 @@ blocked. The explorer pages of the built book (the run's one build, ``built_book
 
 from __future__ import annotations
 
+import functools
 import itertools
 import os
 import threading
@@ -20,19 +21,14 @@ from pathlib import Path
 import pytest
 
 import uio_teach as ut
-from uio_teach.explorers import (
-    ExplorerFigure,
-    case_study_scenario,
-    make_scenario,
-    missile_scenario,
-    pa9_scenario,
-)
+from uio_teach.explorers import ExplorerFigure, make_scenario, scenario_of
 from uio_teach.explorers.static import (
     NARROW_DPI,
     NARROW_FONTSCALE,
     WIDE_FONTSCALE,
     static_explorer,
 )
+from uio_teach.worked import WORKED
 
 CHROMIUM = Path("/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
@@ -46,10 +42,9 @@ def _own():
     return make_scenario(plant, "uio", name="own")
 
 
+# every worked example of the registry, and a plant of one's own
 SCENARIOS = {
-    "pa9": pa9_scenario,
-    "case_study": case_study_scenario,
-    "missile": missile_scenario,
+    **{name: functools.partial(scenario_of, name) for name in WORKED},
     "existence": _own,
 }
 
@@ -199,7 +194,7 @@ def _block_the_network(page) -> None:
 
 def _smallest_text_px(m: dict, narrow: bool) -> float:
     """The smallest text of the shown picture in CSS pixels (its size in points is the figure's)."""
-    scenario = pa9_scenario()  # the same fonts in every explorer
+    scenario = scenario_of("pa9")  # the same fonts in every explorer
     if narrow:
         figure = ExplorerFigure(scenario, dpi=NARROW_DPI, fontscale=NARROW_FONTSCALE, narrow=True)
     else:

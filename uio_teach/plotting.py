@@ -467,7 +467,7 @@ def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     Examples
     --------
     >>> import uio_teach as ut
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> from uio_teach.plotting import new_figure, plot_error
     >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
     >>> ax = new_figure().subplots()
@@ -499,7 +499,7 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
     Examples
     --------
     >>> import uio_teach as ut
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> from uio_teach.plotting import new_figure, plot_residual
     >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
     >>> ax = new_figure().subplots()

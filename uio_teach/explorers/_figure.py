@@ -9,8 +9,8 @@ works is private to this module.
 
 Examples
 --------
->>> from uio_teach.explorers import missile_scenario, render
->>> fig = render(missile_scenario())
+>>> from uio_teach.explorers import scenario_of, render
+>>> fig = render(scenario_of("missile"))
 >>> len(fig.axes) > 4
 True
 """
@@ -209,8 +209,8 @@ class ExplorerFigure:
 
     Examples
     --------
-    >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-    >>> s = pa9_scenario()
+    >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+    >>> s = scenario_of("pa9")
     >>> ef = ExplorerFigure(s)
     >>> ef.update(compute_frame(s))
     >>> line = ef.lines["uio.error"][0]
@@ -334,8 +334,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
-        >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
+        >>> from uio_teach.explorers import ExplorerFigure, scenario_of
+        >>> ExplorerFigure(scenario_of("pa9")).smallest_text_pt()
         7.0
         """
         texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
@@ -602,8 +602,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, case_study_scenario, compute_frame
-        >>> s = case_study_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, scenario_of, compute_frame
+        >>> s = scenario_of("case_study")
         >>> ef = ExplorerFigure(s)
         >>> ef.update(compute_frame(s, s.defaults.replace(poles=(1.05,))))
         >>> "the error grows" in ef.footer.get_text()
@@ -737,8 +737,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-        >>> s = pa9_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+        >>> s = scenario_of("pa9")
         >>> ef = ExplorerFigure(s)
         >>> ef.update(compute_frame(s))
         >>> ef.draw()
@@ -962,8 +962,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-        >>> s = pa9_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+        >>> s = scenario_of("pa9")
         >>> ef = ExplorerFigure(s, dpi=60)
         >>> ef.update(compute_frame(s))
         >>> len(ef.to_png(colors=32)) < len(ef.to_png())
@@ -1000,8 +1000,8 @@ def render(scenario: Scenario, settings: Settings | None = None, *, dpi: float =
 
     Examples
     --------
-    >>> from uio_teach.explorers import missile_scenario, render
-    >>> fig = render(missile_scenario())
+    >>> from uio_teach.explorers import scenario_of, render
+    >>> fig = render(scenario_of("missile"))
     >>> len(fig.axes)
     8
     """
