@@ -783,10 +783,7 @@ def _book_explorers():
     own = ut.Plant([[0, 1], [-0.08, 0.6]], [[-0.5, 1]], E=[[0], [1]], dt=1)
     own_scenario = make_scenario(own, "uio")
     return {
-        "pa9": pa9_scenario,
-        "case_study": case_study_scenario,
-        "missile": missile_scenario,
-        "quadruple_tank": lambda: scenario_of("quadruple_tank"),
+        **{name: functools.partial(scenario_of, name) for name in WORKED},
         "existence": lambda: own_scenario,
     }
 
