@@ -38,6 +38,7 @@ so a symbol or a label is written in one place.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -586,8 +587,6 @@ _SETTLED = 0.02
 
 def _plain(name: str) -> str:
     """A mathtext name in words for a text alternative: ``$\\hat{x}_{2}$`` -> ``x-hat 2``."""
-    import re
-
     text = re.sub(r"\\hat\{(\w+)\}", r"\1-hat", name)
     text = re.sub(r"_\{(\w+)\}", r" \1", text)
     return text.replace("$", "").replace("\\", "").replace("{", "").replace("}", "")
