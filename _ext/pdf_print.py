@@ -466,6 +466,11 @@ FOOTER = (
 )
 
 
+def _running_head(job: Job) -> str:
+    """The book's name at the top of a page's sheets, with its edition when it has one."""
+    return f"{job.book_title} \u2014 {job.subtitle}" if job.subtitle else job.book_title
+
+
 def _page_title(title: str, book: str) -> str:
     """A page's title without the book's name that Sphinx appends (``Page — Book``)."""
     for sep in (" \u2014 ", " - "):
@@ -649,7 +654,7 @@ async def print_page(context, job: Job, page: Page) -> tuple[Path, list[str]]:  
         target = job.out / f"{page.name}.pdf"
         await tab.pdf(
             path=target,
-            header_template=_header(job.book_title, title),
+            header_template=_header(_running_head(job), title),
             footer_template=FOOTER,
             **PDF_OPTIONS,
         )
