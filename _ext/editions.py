@@ -11,8 +11,9 @@ what is rendered differs:
   with cells tagged ``solution``) each solution gives way to the starting code of the student
   notebook (its ``# TODO`` cell), and every code cell after the first solution is shown unrun,
   with a note: its output (a check's verdicts, a figure) was computed from the model solution. A
-  section of notes for the tutors keeps its title and says whom it is for; a page that is one
-  such section (the instructors' page) becomes a stub with no notebook. The pages' MyST sources
+  section of notes for the tutors is left out whole, its heading with it, on every page; a page
+  that is one such section (the instructors' page, which the table of contents lists) becomes a
+  stub with no notebook. The pages' MyST sources
   are not copied into the site, and a lab chapter's notebook link gives the student notebook
   (``# TODO`` cells, as ``uio-teach labs`` writes it). No student page names the other edition.
 * **instructor** (``make book-instructor``, that is ``UIO_TEACH_EDITION=instructor`` in the
@@ -41,10 +42,6 @@ from uio_teach.instructor.lab_registry import LabUsageError
 EDITION_VAR = "UIO_TEACH_EDITION"
 EDITIONS = ("student", "instructor")
 HIDDEN_TAGS = ("solution", "instructor")  # code cells with these tags are not in the student pages
-TUTORS_NOTE = (
-    "This section is for the tutors who run the lab: what the groups should find, how to run "
-    "the lab, the common mistakes."
-)
 STUB_NOTE = (
     "This page is for those who teach the course: how to prepare a term, regenerate the "
     "figures, hand out the lab notebooks and grade the notebooks handed in."
@@ -121,7 +118,10 @@ class StudentEdition(SphinxTransform):
     default_priority = 15
 
     def _attached(self, node: nodes.Node) -> bool:
+        """Still in the page (a removed node keeps its ``parent``, so each link is checked)."""
         while node.parent is not None:
+            if not any(child is node for child in node.parent.children):
+                return False
             node = node.parent
         return node is self.document
 
@@ -154,17 +154,71 @@ class StudentEdition(SphinxTransform):
                 note["classes"].append(UNRUN_CLASS)
                 cell += note
         for section in list(self.document.findall(nodes.section)):
-            if not is_instructor_section(section):
+            if not self._attached(section) or not is_instructor_section(section):
                 continue
+            if isinstance(section.parent, nodes.section):  # a section of a page: dropped whole
+                self._drop(section)
+                continue
+            # the page itself (the instructors' page, in the table of contents): a stub
             title = section.next_node(nodes.title)
             for child in list(section.children):
                 if child is not title:
                     section.remove(child)
-            top = not isinstance(section.parent, nodes.section)
-            text = STUB_NOTE if top else TUTORS_NOTE
-            if top:
-                section["classes"].append(STUB_CLASS)
-            section += nodes.paragraph(text, text)
+            section["classes"].append(STUB_CLASS)
+            section += nodes.paragraph(STUB_NOTE, STUB_NOTE)
+
+    def _drop(self, section: nodes.section) -> None:
+        """Remove a section whole, with the label targets in front of it and its names."""
+        title = section.next_node(nodes.title)
+        text = title.astext() if title is not None else ""
+        parent = section.parent
+        ids = set(section.get("ids", []))
+        names = set(section.get("names", []))
+        k = parent.index(section) - 1
+        while k >= 0:  # its labels: the internal targets right in front of it
+            sib = parent.children[k]
+            if not isinstance(sib, nodes.target) or sib.get("refuri"):
+                break
+            names |= set(sib.get("names", []))
+            ids |= set(sib.get("ids", []))
+            parent.remove(sib)
+            k -= 1
+        parent.remove(section)
+        dropped = _dropped(self.env)
+        for name in names:  # no label of the page leads there any more
+            self.document.nameids.pop(name, None)
+            self.document.nametypes.pop(name, None)
+            dropped[name] = (self.env.docname, text)
+        for i in ids:
+            self.document.ids.pop(i, None)
+
+
+def _dropped(env: Any) -> dict[str, tuple[str, str]]:
+    """The labels of the tutors' sections left out of the student pages: (page, title)."""
+    if not hasattr(env, "uio_teach_dropped"):
+        env.uio_teach_dropped = {}
+    return env.uio_teach_dropped
+
+
+def _purge(app: Sphinx, env: Any, docname: str) -> None:
+    dropped = _dropped(env)
+    for name in [n for n, (doc, _) in dropped.items() if doc == docname]:
+        del dropped[name]
+
+
+def _merge(app: Sphinx, env: Any, docnames: set[str], other: Any) -> None:
+    _dropped(env).update({n: v for n, v in _dropped(other).items() if v[0] in docnames})
+
+
+def _dropped_reference(app: Sphinx, env: Any, node: nodes.Element, contnode: nodes.Node):
+    """A reference to a tutors' section left out: its title as plain text, not a dead link."""
+    if node.get("refdomain") != "std" or node.get("reftype") != "ref":
+        return None
+    found = _dropped(env).get(node.get("reftarget", ""))
+    if found is None:
+        return None
+    text = contnode.astext() if node.get("refexplicit") else found[1]
+    return nodes.inline(text, text)
 
 
 def is_stub(doctree: nodes.Node | None) -> bool:
@@ -193,5 +247,8 @@ def setup(app: Sphinx) -> dict[str, Any]:
         "uio_teach_edition", os.environ.get(EDITION_VAR, "student").strip().lower(), "env"
     )
     app.connect("config-inited", _check_edition)
+    app.connect("env-purge-doc", _purge)
+    app.connect("env-merge-info", _merge)
+    app.connect("missing-reference", _dropped_reference)
     app.add_transform(StudentEdition)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

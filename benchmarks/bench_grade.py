@@ -1,7 +1,18 @@
-"""Benchmark: the time per honest notebook in a mixed class against a class of honest ones only.
+"""Benchmark: grading against its floor, ``jupyter nbconvert --execute``; its start-up; its cost
+per cell; the time per honest notebook in a mixed class against a class of honest ones only.
 
 Run with ``.venv/bin/python benchmarks/bench_grade.py`` (several minutes: every hand-in that runs
-starts a sandbox, a fresh kernel and a checking process). ``uio-teach labs --groups N`` writes one
+starts a sandbox, a fresh kernel and a checking process; ``--parts`` picks some).
+
+* ``startup``: the time from the command's start to the first hand-in's run, in a fresh
+  interpreter (imports, reading the lab chapters' check cells, the hand-ins, the roster; the
+  sandbox's own test runs beside the first hand-ins): goal 5 s.
+* ``nbconvert``: the same honest notebooks graded one at a time and executed one at a time by
+  ``jupyter nbconvert --execute`` (the floor: the kernel and the notebook's own work, no sandbox,
+  no checks); goal: grading within 1.2x of it.
+* ``cells``: an honest notebook with 2000 and with 4000 more tiny cells; the cost of the added
+  cells must double, not quadruple (the notebook is not saved per cell).
+* ``mixed``: ``uio-teach labs --groups N`` writes one
 PA9 variant per group; the honest hand-ins are the solution notebooks of the first ``--honest``
 groups (each with a line of its own), the others a mix of what a real class hands in: files that
 are not notebooks, links to the instructor's files, a folder, a notebook whose tags are a
@@ -30,7 +41,8 @@ from pathlib import Path
 
 import nbformat
 
-from uio_teach.instructor import cli, grade
+from uio_teach.grading import grade
+from uio_teach.instructor import cli
 
 SETUP = "import numpy as np\nimport uio_teach as ut\nfrom uio_teach import checks\n"
 HOSTILE_CELLS = {
@@ -135,12 +147,83 @@ def _rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+STARTUP = """\
+import sys, time
+start = time.perf_counter()
+from uio_teach.grading import grade
+seen = []
+real = grade._grade_one
+def first(*args):
+    if not seen:
+        seen.append(time.perf_counter() - start)
+        print(f"STARTUP {seen[0]:.3f} {time.process_time():.3f}", flush=True)
+    return real(*args)
+grade._grade_one = first
+from uio_teach.instructor import cli
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def _startup(folder: Path, key: Path, out: Path) -> tuple[float, float]:
+    """Seconds from a fresh interpreter's start to the first hand-in's run, wall and CPU time of
+    the process (medians of 3): on a busy machine the wall time is mostly waiting for a core."""
+    import statistics
+    import subprocess
+
+    walls, cpus = [], []
+    for n in range(3):
+        args = [sys.executable, "-c", STARTUP, "grade", str(folder), "--out", str(out) + f"{n}"]
+        args += ["--groups-from", str(key), "-q"]
+        proc = subprocess.run(args, capture_output=True, text=True, timeout=1800)
+        line = next(x for x in proc.stdout.splitlines() if x.startswith("STARTUP"))
+        walls.append(float(line.split()[1]))
+        cpus.append(float(line.split()[2]))
+    return statistics.median(walls), statistics.median(cpus)
+
+
+def _nbconvert(paths: list[Path], work: Path) -> float:
+    """Mean seconds ``jupyter nbconvert --execute`` takes per notebook, one at a time."""
+    import subprocess
+
+    work.mkdir()
+    total = 0.0
+    for path in paths:
+        start = time.perf_counter()
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "jupyter",
+                "nbconvert",
+                "--execute",
+                "--to",
+                "notebook",
+                "--output-dir",
+                str(work),
+                "--ExecutePreprocessor.timeout=600",
+                str(path),
+            ],
+            check=True,
+            capture_output=True,
+            cwd=work,
+        )
+        total += time.perf_counter() - start
+    return total / len(paths)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--honest", type=int, default=10, help="honest hand-ins (default 10)")
     parser.add_argument("--jobs", type=int, default=2, help="hand-ins at a time (default 2)")
     parser.add_argument("--timeout", type=float, default=120, help="--timeout (default 120 s)")
+    parser.add_argument(
+        "--parts",
+        default="startup,nbconvert,cells,mixed",
+        help="what to measure (default: startup,nbconvert,cells,mixed)",
+    )
     args = parser.parse_args(argv)
+    parts = set(args.parts.split(","))
+    failed = False
     with tempfile.TemporaryDirectory(prefix="bench-grade-") as tmp:
         root = Path(tmp)
         labs = root / "labs"
@@ -148,41 +231,87 @@ def main(argv: list[str] | None = None) -> int:
         if cli.main(["labs", "--out", str(labs), "--groups", groups, "--seed", "1", "-q"]) != 0:
             return 1
         key = labs / "answer_key.csv"
-        result = {}
-        for mixed in (False, True):
-            label = "mixed" if mixed else "honest only"
-            folder = root / ("mixed" if mixed else "honest")
-            honest = {os.fspath(p) for p in _class(folder, labs, args.honest, mixed)}
-            out = root / f"grades_{folder.name}.csv"
-            start = time.perf_counter()
-            subs = grade.grade(
-                folder,
-                out,
-                answer_key=key,
-                jobs=args.jobs,
-                timeout=args.timeout,
-                cell_timeout=args.timeout / 2,
-            )
-            wall = time.perf_counter() - start
-            mine = [s for s in subs if s.file in honest]
-            lost = [s.file for s in mine if s.status != "ok" or s.total != len(s.expected)]
-            cheats = [
-                s.file
-                for s in subs
-                if s.file not in honest and s.status == "ok" and s.total == len(s.expected)
-            ]
-            if lost or cheats or len(_rows(out)) != len(subs):
-                print(f"{label}: honest rows lost marks {lost}, others ok in full {cheats}")
-                return 1
-            per_wall = wall / len(mine)
-            per_own = sum(s.seconds for s in mine) / len(mine)
-            result[mixed] = (per_wall, per_own)
+        honest_folder = root / "honest"
+        honest = _class(honest_folder, labs, args.honest, False)
+        if "startup" in parts:
+            wall, cpu = _startup(honest_folder, key, root / "startup.csv")
+            load = os.getloadavg()[0]
             print(
-                f"{label}: {len(subs)} hand-ins ({len(mine)} honest) in {wall:.1f} s: "
-                f"{per_wall:.1f} s of the run per honest notebook, each graded in "
-                f"{per_own:.1f} s on average",
+                f"start-up before the first hand-in: {wall:.2f} s, of which {cpu:.2f} s of CPU "
+                f"(goal 5 s; load {load:.1f} on {os.cpu_count()} CPUs)",
                 flush=True,
             )
+            busy = load > (os.cpu_count() or 1)
+            failed |= (cpu if busy else wall) > 5
+        if "nbconvert" in parts:
+            floor = _nbconvert(honest, root / "nbconvert")
+            subs = grade.grade(honest_folder, root / "one_at_a_time.csv", answer_key=key, jobs=1)
+            mine = sum(s.seconds for s in subs) / len(subs)
+            print(
+                f"grading one at a time: {mine:.1f} s per notebook; jupyter nbconvert --execute "
+                f"{floor:.1f} s: ratio {mine / floor:.2f} (goal 1.2)",
+                flush=True,
+            )
+            failed |= mine / floor > 1.2
+        if "cells" in parts:
+            costs = {}
+            for extra in (0, 2000, 4000):
+                folder = root / f"cells{extra}"
+                folder.mkdir()
+                nb = nbformat.read(honest[0], as_version=4)
+                nb.cells += [nbformat.v4.new_code_cell(f"c{i} = {i}") for i in range(extra)]
+                nbformat.write(nb, folder / honest[0].name)
+                (sub,) = grade.grade(folder, root / f"cells{extra}.csv", answer_key=key)
+                costs[extra] = sub.seconds
+            growth = (costs[4000] - costs[0]) / max(costs[2000] - costs[0], 1e-9)
+            print(
+                f"2000 more cells: +{costs[2000] - costs[0]:.1f} s, 4000 more: "
+                f"+{costs[4000] - costs[0]:.1f} s: {growth:.2f}x for twice the cells "
+                "(linear: 2; saved per cell: 4)",
+                flush=True,
+            )
+            failed |= growth > 3
+        if "mixed" in parts:
+            failed |= _mixed(args, root, labs, key) != 0
+    return 1 if failed else 0
+
+
+def _mixed(args: argparse.Namespace, root: Path, labs: Path, key: Path) -> int:
+    result = {}
+    for mixed in (False, True):
+        label = "mixed" if mixed else "honest only"
+        folder = root / ("mixed_class" if mixed else "honest_class")
+        honest = {os.fspath(p) for p in _class(folder, labs, args.honest, mixed)}
+        out = root / f"grades_{folder.name}.csv"
+        start = time.perf_counter()
+        subs = grade.grade(
+            folder,
+            out,
+            answer_key=key,
+            jobs=args.jobs,
+            timeout=args.timeout,
+            cell_timeout=args.timeout / 2,
+        )
+        wall = time.perf_counter() - start
+        mine = [s for s in subs if s.file in honest]
+        lost = [s.file for s in mine if s.status != "ok" or s.total != len(s.expected)]
+        cheats = [
+            s.file
+            for s in subs
+            if s.file not in honest and s.status == "ok" and s.total == len(s.expected)
+        ]
+        if lost or cheats or len(_rows(out)) != len(subs):
+            print(f"{label}: honest rows lost marks {lost}, others ok in full {cheats}")
+            return 1
+        per_wall = wall / len(mine)
+        per_own = sum(s.seconds for s in mine) / len(mine)
+        result[mixed] = (per_wall, per_own)
+        print(
+            f"{label}: {len(subs)} hand-ins ({len(mine)} honest) in {wall:.1f} s: "
+            f"{per_wall:.1f} s of the run per honest notebook, each graded in "
+            f"{per_own:.1f} s on average",
+            flush=True,
+        )
     wall_ratio = result[True][0] / result[False][0]
     own_ratio = result[True][1] / result[False][1]
     print(

@@ -169,6 +169,20 @@ def read_import(text: str) -> list[list[str]]:
     ]
 
 
+def read_decisions(text: str) -> list[list[str]]:
+    r = _json_line(text)
+    return [
+        [
+            f"existence verdicts on {r['plants']} constructed plants with exactly known zeros "
+            "(right / undecided / wrong; zeros counted right; designs returned / silent leaks)",
+            f"{r['right']} / {r['undecided']} / {r['wrong']}; {r['count right']}; "
+            f"{r['designs']} / {r['silent_leaks']}",
+            f"SLICOT AB08ND agrees on {r['slicot agrees']} zero counts",
+            "",
+        ]
+    ]
+
+
 def read_pdf(text: str) -> list[list[str]]:
     total = re.search(r"make pdf after make book: ([\d.]+) s \(printing ([\d.]+) s\)", text)
     printed = re.search(r"printed: (\d+) PDFs, (\d+) pages, ([\d.]+) pages/s", text)
@@ -196,6 +210,7 @@ BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "pdf": (["bench_pdf.py"], read_pdf),
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
+    "decisions": (["bench_decisions.py"], read_decisions),
 }
 
 

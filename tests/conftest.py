@@ -96,7 +96,7 @@ def needs_of(argv: str | bytes | Sequence[object]) -> set[str]:
     if (
         any("ipykernel" in w for w in words)
         or _module_command(words, "uio_teach", "grade")
-        or _runs_module(words, "uio_teach.instructor.runner")  # the grader's notebook runner
+        or _runs_module(words, "uio_teach.grading.runner")  # the grader's notebook runner
     ):
         needs.add("kernel")
     if (

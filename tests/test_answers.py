@@ -1,9 +1,9 @@
 """Answers out of a kernel as data and back: the checks give the same verdicts on the copies.
 
 The lab chapters' own solution code runs here, in-process; its answers go through JSON
-(:mod:`uio_teach.checks.answers`) and are graded by :mod:`uio_teach.checks.grading` with the
-lab's parameters: every check passes, as it does on the originals, and a wrong value still fails.
-The registry's answer names are read against the chapters' check cells.
+(:mod:`uio_teach.checks.answers`) and are graded by the chapters' own check cells
+(:mod:`uio_teach.grading.lab_checks`) with the lab's parameters: every check passes, as it does on
+the originals, and a wrong value still fails. The grader holds no copy of a check call.
 """
 
 from __future__ import annotations
@@ -19,9 +19,20 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.checks import answers, grading
-from uio_teach.checks.grading import GRADED, Missing, grade_answers, missing_message
+from uio_teach.checks import answers
+from uio_teach.grading import lab_checks
+from uio_teach.grading.lab_checks import (
+    LabChecksError,
+    Missing,
+    course_checks,
+    grade_answers,
+    missing_message,
+    read_lab_checks,
+)
 from uio_teach.instructor.labs import LABS
+
+GRADED = course_checks()
+PACKAGE = Path(lab_checks.__file__).resolve().parents[1]
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```$", re.S | re.M)
@@ -58,81 +69,116 @@ def solved() -> dict[str, dict]:
     return out
 
 
-class _Answer(str):
-    """An answer variable, as the graded call receives it (its name)."""
+def test_the_graders_labs_are_the_registrys():
+    """The grader finds the labs by their chapters (it need not load the labs' parameters); the
+    term's tooling registers them: the two agree, lab by lab and chapter by chapter."""
+    labs = lab_checks.course_labs(BOOK)
+    assert {lab: path.name for lab, path in labs.items()} == {
+        lab: entry.source for lab, entry in LABS.items()
+    }
 
 
-class _Key(dict):
-    """Any entry of the key's parameters: itself, whatever the key."""
-
-    def __getitem__(self, key):
-        return self
-
-
-def _as_passed(node: ast.expr, given: tuple[str, ...]):
-    """What the graded call must receive for one argument of a check cell."""
-    if isinstance(node, ast.Name) and node.id not in given:
-        return _Answer(node.id)
-    return "key"  # PARAMS[...], the plant, x0: the grader's own value
-
-
-def test_the_registry_calls_each_check_as_its_cell_does(monkeypatch):
+def test_the_grader_runs_the_chapters_own_check_cells():
+    """One source per check: the grader's check cells are the chapter's, in its order, with the
+    registry's columns; the answers they read are the names the chapter's solutions define."""
     for lab, graded in GRADED.items():
-        for check, cell in zip(graded, check_cells(lab), strict=True):
-            call = ast.parse(cell).body[0].value
-            seen = []
-
-            def record(*args, _seen=seen, **kwargs):
-                _seen.append((args, kwargs))
-                return checks.CheckResult("recorded")
-
-            monkeypatch.setattr(grading, call.func.attr, record)
-            check.run({n: _Answer(n) for n in check.names}, _Key(), "key")
-            ((args, kwargs),) = seen
-
-            def shown(value):
-                return value if isinstance(value, _Answer) else "key"
-
-            assert [shown(a) for a in args] == [_as_passed(a, check.given) for a in call.args], (
-                check.check_id
-            )
-            assert {k: shown(v) for k, v in kwargs.items()} == {
-                k.arg: _as_passed(k.value, check.given) for k in call.keywords
-            }, check.check_id
-
-
-def test_the_registry_reads_the_answers_each_check_cell_names():
-    for lab, graded in GRADED.items():
-        cells = check_cells(lab)
-        assert [c.check_id.replace(".", "_") for c in graded] == [
-            re.match(r"\s*checks\.(\w+)", c)[1] for c in cells
-        ]
-        for check, cell in zip(graded, cells, strict=True):
-            call = ast.parse(cell).body[0].value
-            used = {
+        assert [c.source.strip() for c in graded.checks] == [c.strip() for c in check_cells(lab)]
+        assert graded.check_ids == LABS[lab].check_ids
+        solution_names: set[str] = set()
+        for source in chapter_cells(lab):
+            tree = ast.parse(source)
+            solution_names |= {
                 n.id
-                for arg in [*call.args, *(k.value for k in call.keywords)]
-                for n in ast.walk(arg)
-                if isinstance(n, ast.Name)
+                for n in ast.walk(tree)
+                if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store)
             }
-            # the answers come from the notebook; the plant (and the missile's x0) from the key
-            assert used - {"PARAMS"} - set(check.given) == set(check.names), check.check_id
-            assert set(check.given) <= used, check.check_id
+        for check in graded.checks:
+            assert check.names, check.check_id
+            assert set(check.names) <= solution_names, check.check_id
+            assert "PARAMS" not in check.names and "plant" not in check.names
+
+
+def test_no_check_call_is_written_twice():
+    """No module of the package calls a lab's check function: the chapters' cells are the one
+    place each call is written."""
+    functions = {c.function for graded in GRADED.values() for c in graded.checks}
+    for path in PACKAGE.rglob("*.py"):
+        if path.parent.name == "checks":
+            continue  # where the check functions are defined
+        called = {
+            getattr(node.func, "attr", getattr(node.func, "id", ""))
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+            if isinstance(node, ast.Call)
+        } & functions
+        assert not called, f"{path.relative_to(PACKAGE)} calls {sorted(called)}"
+
+
+def test_every_check_call_a_group_runs_is_a_tagged_check_cell():
+    """A check call outside the instructor notes that is not tagged would be run by the groups and
+    never by the grader."""
+    for lab in GRADED:
+        text = (BOOK / LABS[lab].source).read_text(encoding="utf-8")
+        text = text.split("## Instructor notes", 1)[0]
+        for body in CELL.findall(text):
+            if "checks." in body:
+                assert body.startswith(":tags: [check]"), (lab, body[:60])
+
+
+def _chapter(tmp_path, lab: str, edit) -> Path:
+    path = tmp_path / LABS[lab].source
+    path.write_text(edit((BOOK / LABS[lab].source).read_text(encoding="utf-8")), "utf-8")
+    return path
+
+
+def test_a_check_cell_changed_in_the_chapter_changes_the_grade(solved, tmp_path):
+    ns = solved["pa9"]
+    params = ns["PARAMS"]
+    names = ["H", "T", "K1", "F", "K2"]
+    good = read_lab_checks(BOOK / LABS["pa9"].source, "pa9")
+    changed = read_lab_checks(
+        _chapter(
+            tmp_path,
+            "pa9",
+            lambda t: t.replace(
+                'plant=plant, poles=PARAMS["poles"])', "plant=plant, poles=[-7, -8, -9])"
+            ),
+        ),
+        "pa9",
+    )
+    design = {n: ns[n] for n in names}
+    assert grade_answers(good, design, params)[0].passed
+    assert not grade_answers(changed, design, params)[0].passed
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda t: t.replace(":tags: [parameters]", ""), "no code cell tagged parameters"),
+        (lambda t: t.replace(":tags: [check]", ""), "no code cell tagged check"),
+        (lambda t: t.replace("checks.pa9_plot(", "checks.missile_plot("), "not a check of lab pa9"),
+        (lambda t: t.replace("checks.pa9_plot(", "checks.pa9_design("), "a second time"),
+        (lambda t: t.replace("checks.pa9_plot(", "print("), "calls no check function"),
+    ],
+)
+def test_a_chapter_the_grader_cannot_use_is_refused_naming_it(tmp_path, edit, message):
+    with pytest.raises(LabChecksError, match=message) as info:
+        read_lab_checks(_chapter(tmp_path, "pa9", edit), "pa9")
+    assert str(info.value).startswith("lab_pa9.md")
 
 
 @pytest.mark.parametrize("lab", list(GRADED))
 def test_every_solution_passes_after_the_round_trip(solved, lab):
     ns = solved[lab]
     params = ns["PARAMS"]
-    names = sorted({n for c in GRADED[lab] for n in c.names})
+    names = list(GRADED[lab].names)
     text = answers.dumps({n: ns[n] for n in names})
     json.loads(text)  # plain JSON, nothing else
     back = answers.loads(text, plant=None)
-    originals = grade_answers(lab, {n: ns[n] for n in names}, params)
-    copies = grade_answers(lab, back, params)
-    assert [r.passed for r in originals] == [True] * len(GRADED[lab])
-    assert [r.check_id for r in copies] == [c.check_id for c in GRADED[lab]]
-    assert [r.passed for r in copies] == [True] * len(GRADED[lab]), [
+    originals = grade_answers(GRADED[lab], {n: ns[n] for n in names}, params)
+    copies = grade_answers(GRADED[lab], back, params)
+    assert [r.passed for r in originals] == [True] * len(GRADED[lab].checks)
+    assert [r.check_id for r in copies] == list(GRADED[lab].check_ids)
+    assert [r.passed for r in copies] == [True] * len(GRADED[lab].checks), [
         r.failures for r in copies if not r.passed
     ]
     assert checks.collected() == []  # the grader keeps no result of its own
@@ -168,13 +214,15 @@ def test_a_wrong_value_still_fails_after_the_round_trip(solved):
     params = dict(ns["PARAMS"], poles=[-4.0, -5.0, -6.0])  # another group's key
     names = ["H", "T", "K1", "F", "K2"]
     back = answers.loads(answers.dumps({n: ns[n] for n in names}))
-    (design,) = [r for r in grade_answers("pa9", back, params) if r.check_id == "pa9.design"]
+    (design,) = [
+        r for r in grade_answers(GRADED["pa9"], back, params) if r.check_id == "pa9.design"
+    ]
     assert not design.passed
     fig, ax = plt.subplots()
     ax.plot([0, 1], [0, 1])
     bad = answers.loads(answers.dumps({"fig": fig, "resp_sine": ns["resp_sine"]}))
     plt.close(fig)
-    plot = grade_answers("pa9", bad, ns["PARAMS"])[2]
+    plot = grade_answers(GRADED["pa9"], bad, ns["PARAMS"])[2]
     assert plot.check_id == "pa9.plot" and not plot.passed
 
 
@@ -252,7 +300,7 @@ def test_malformed_data_is_refused_in_one_line(doc):
 def test_a_missing_answer_names_the_variable_the_cell_and_a_hint():
     params = LABS["pa9"].params().to_params()
     results = grade_answers(
-        "pa9",
+        GRADED["pa9"],
         {"H": Missing("H", 4, "LinAlgError", "Last 2 dimensions of the array must be square")},
         params,
     )

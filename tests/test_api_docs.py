@@ -10,12 +10,17 @@ from numpydoc.docscrape import FunctionDoc
 
 import uio_teach as ut
 
-# The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest.
+# The public modules outside ``ut.__all__``: their ``__all__`` is documented like the rest. Every
+# module of ``uio_teach.worked`` (one per worked example) is one of them, found, not listed.
+WORKED_MODULES = tuple(f"worked.{info.name}" for info in pkgutil.iter_modules(ut.worked.__path__))
 SUBPACKAGE_API = (
     "experiments",
+    "lab_params",
     "worked",
-    "worked.quadruple_tank",
+    *WORKED_MODULES,
     "luenberger",
+    "figure_text",
+    "colour_vision",
     "explorers",
     "explorers.widgets",
     "explorers.static",
@@ -23,7 +28,9 @@ SUBPACKAGE_API = (
     "instructor.config",
     "instructor.figures",
     "instructor.output",
-    "instructor.grade",
+    "grading.grade",
+    "grading.rosters",
+    "grading.merge",
     "instructor.labs",
     "instructor.book",
 )
@@ -92,7 +99,7 @@ SLOW_DOCTESTS = {
 
 # Modules whose docstring examples start a process: the sandbox's probe runs Python (and the
 # package's notebook runner) inside bubblewrap.
-PROCESS_DOCTESTS = {"uio_teach.instructor.sandbox": ("subprocess", "kernel")}
+PROCESS_DOCTESTS = {"uio_teach.grading.sandbox": ("subprocess", "kernel")}
 
 
 def _modules():

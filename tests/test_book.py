@@ -7,7 +7,10 @@ that leaves the local server, and checks that the mathematics is typeset, every 
 output cell shows an error and the console stays clean; each page is opened once per width and
 every check reads that load (``page_facts``), which saves a full-page screenshot in
 ``_build/screenshots/`` when ``UIO_TEACH_SCREENSHOTS`` is set. At 1280 px every display
-equation, every visible code line and every printed output fits its column. The browser tests
+equation, every visible code line and every printed output fits its column. At both widths the
+page meets WCAG 2.1 A and AA as axe-core checks it (every dropdown opened), every picture says
+what it shows, the headings go down one level at a time, every table has header cells and every
+formula carries MathJax's assistive MathML for screen readers. The browser tests
 wait on events and page state (the load event, fonts, images, MathJax), never on a fixed
 duration, and assert nothing about how long anything took.
 """
@@ -271,11 +274,124 @@ def page_facts(browser, book_server: str, page: str, width: int) -> dict:
             SCREENSHOTS.mkdir(parents=True, exist_ok=True)
             name = _screenshot_name(page).removesuffix(".png")
             tab.screenshot(path=str(SCREENSHOTS / f"{name}-{width}px.png"), full_page=True)
-        facts["wide_outputs"] = tab.evaluate(_WIDE_OUTPUTS_JS)  # last: it opens the dropdowns
+        facts["wide_outputs"] = tab.evaluate(_WIDE_OUTPUTS_JS)  # it opens the dropdowns
+        # with every dropdown open, so that what a reader opens is checked too
+        facts["structure"] = tab.evaluate(_STRUCTURE_JS)
+        facts["axe"] = axe_violations(tab)
     finally:
         context.close()
     _FACTS[key] = facts
     return facts
+
+
+# --- WCAG 2.1 AA: axe-core, and what it does not check -----------------------------------------
+
+AXE_TAGS = ["wcag2a", "wcag2aa", "wcag21a", "wcag21aa"]  # WCAG 2.0 and 2.1, levels A and AA
+_AXE: list = []  # axe-core's script, read once per test process
+
+
+def axe_violations(tab) -> list[dict]:
+    """axe-core's WCAG 2.1 A and AA violations on the open page (axe-playwright-python)."""
+    if not _AXE:
+        from axe_playwright_python.sync_playwright import Axe
+
+        _AXE.append(Axe())
+    options = {"runOnly": {"type": "tag", "values": AXE_TAGS}, "resultTypes": ["violations"]}
+    found = _AXE[0].run(tab, options=options).response["violations"]
+    return [
+        {
+            "id": v["id"],
+            "help": v["help"],
+            "count": len(v["nodes"]),
+            "where": [" ".join(map(str, n["target"])) for n in v["nodes"][:4]],
+            "why": (v["nodes"][0].get("failureSummary") or "").replace("\n", " ")[:240],
+        }
+        for v in found
+    ]
+
+
+# The page's structure for a screen reader: its language, its headings in order, its tables'
+# header cells, each formula's assistive MathML, each picture's text alternative, and the
+# course figures whose curves only a hue tells apart (uio_teach.figure_text marks them).
+_STRUCTURE_JS = """
+() => {
+  const main = document.querySelector("main") || document.body;
+  const shown = (el) => el.checkVisibility() || el.closest("details") !== null;
+  const headings = Array.from(main.querySelectorAll("h1, h2, h3, h4, h5, h6"))
+    .filter(shown).map((h) => ({level: +h.tagName[1], text: h.textContent.trim().slice(0, 50)}));
+  const tables = Array.from(main.querySelectorAll("table"))
+    .filter((t) => t.getAttribute("role") !== "presentation" && !t.querySelector("th"))
+    .map((t) => t.textContent.trim().replace(/\\s+/g, " ").slice(0, 60));
+  const formulas = Array.from(main.querySelectorAll("mjx-container"));
+  const pictures = Array.from(main.querySelectorAll("img"))
+    .filter((img) => img.getAttribute("role") !== "presentation"
+      && img.getAttribute("aria-hidden") !== "true")
+    .map((img) => ({src: (img.currentSrc || img.src || "").slice(-60),
+                    alt: img.getAttribute("alt") || ""}));
+  return {
+    lang: document.documentElement.getAttribute("lang") || "",
+    headings, tables,
+    formulas: formulas.length,
+    without_mathml: formulas.filter((c) => !c.querySelector("mjx-assistive-mml")).length,
+    pictures,
+    hue_alone: Array.from(main.querySelectorAll("[data-hue-alone]"))
+      .map((f) => f.getAttribute("data-hue-alone")),
+  };
+}
+"""
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("width", [1280, 390])
+@pytest.mark.parametrize("page", PAGES)
+def test_meets_wcag_21_aa(page: str, width: int, book_server: str, browser) -> None:
+    violations = page_facts(browser, book_server, page, width)["axe"]
+    assert not violations, f"{page} at {width} px, WCAG 2.1 A/AA violations (axe-core):\n" + (
+        "\n".join(
+            f"{v['id']} ({v['count']}): {v['help']}; {v['where']}; {v['why']}" for v in violations
+        )
+    )
+
+
+# A text alternative that is a file name, a path or a word or two says nothing of the picture.
+_NAMELESS = re.compile(r"(\.(png|jpe?g|svg|gif)$)|(^[\w./-]*$)|(^data:)", re.IGNORECASE)
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_every_picture_says_what_it_shows(page: str, book_server: str, browser) -> None:
+    structure = page_facts(browser, book_server, page, 1280)["structure"]
+    silent = [
+        f"{p['src']}: alt={p['alt'][:60]!r}"
+        for p in structure["pictures"]
+        if len(p["alt"].split()) < 6 or _NAMELESS.search(p["alt"].strip())
+    ]
+    assert not silent, f"{page}: pictures without a text alternative that says what they show: " + (
+        "; ".join(silent)
+    )
+    assert not structure["hue_alone"], (
+        f"{page}: curves told apart by hue alone: {structure['hue_alone']}"
+    )
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("page", PAGES)
+def test_structure_for_a_screen_reader(page: str, book_server: str, browser) -> None:
+    structure = page_facts(browser, book_server, page, 1280)["structure"]
+    assert structure["lang"] == "en", f"{page}: the page's language is {structure['lang']!r}"
+    levels = [h["level"] for h in structure["headings"]]
+    assert levels and levels[0] == 1 and levels.count(1) == 1, f"{page}: headings {levels}"
+    jumps = [
+        f"h{a['level']} {a['text']!r} -> h{b['level']} {b['text']!r}"
+        for a, b in zip(structure["headings"], structure["headings"][1:], strict=False)
+        if b["level"] > a["level"] + 1
+    ]
+    assert not jumps, f"{page}: headings that skip a level: {jumps}"
+    assert not structure["tables"], f"{page}: tables without header cells: {structure['tables']}"
+    assert structure["without_mathml"] == 0, (
+        f"{page}: {structure['without_mathml']} of {structure['formulas']} formulas without "
+        "MathJax's assistive MathML"
+    )
 
 
 _ERROR_OUTPUTS = ".output.error, .output.traceback, .output.stderr"

@@ -12,7 +12,7 @@ from tolerance import assert_same_run
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.instructor.lab_params import CaseStudyParams
+from uio_teach.worked.case_study import CaseStudyParams
 
 P = CaseStudyParams().to_params()
 POLE = P["pole"]

@@ -10,7 +10,7 @@ from tolerance import assert_same_run
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.instructor.lab_params import MissileParams
+from uio_teach.worked.missile import MissileParams
 
 matplotlib.use("Agg")
 

@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 import uio_teach as ut
 from uio_teach import checks
-from uio_teach.instructor.lab_params import PA9Params
+from uio_teach.worked.pa9 import PA9Params
 
 P = PA9Params().to_params()
 POLES = P["poles"]

@@ -240,7 +240,9 @@ def _num(value: float) -> str:
 
 
 def _prose_claims() -> list[tuple[str, str]]:
-    from uio_teach.experiments import CASE_STUDY, MISSILE, PA9
+    from uio_teach.worked.case_study import CASE_STUDY
+    from uio_teach.worked.missile import MISSILE
+    from uio_teach.worked.pa9 import PA9
 
     x0_pa9 = PA9.initial_state
     poles_pa9 = ", ".join(_num(p) for p in PA9.poles)
@@ -314,7 +316,7 @@ def _prose_claims() -> list[tuple[str, str]]:
 
 def test_prose_states_the_experiments_numbers() -> None:
     """Every number the text gives for an experiment is the experiment's."""
-    from uio_teach.experiments import PA9
+    from uio_teach.worked.pa9 import PA9
 
     # the known input of PA9 has no parameters: the text describes it as u = [1, 0.5 sin t]
     assert str(PA9.inputs) == "[1 step(t - 0); 0.5 sin(1 t)]"

@@ -8,8 +8,8 @@ import tomllib
 import pytest
 
 from uio_teach import experiments
-from uio_teach.experiments import PA9, PA9Experiment, experiment_params, param
-from uio_teach.explorers import case_study_scenario, pa9_scenario
+from uio_teach.experiments import experiment_params, param
+from uio_teach.explorers import scenario_of
 from uio_teach.instructor import cli
 from uio_teach.instructor.config import (
     ConfigError,
@@ -19,12 +19,11 @@ from uio_teach.instructor.config import (
     default_config_toml,
     load_config,
 )
-from uio_teach.instructor.lab_params import (
-    CaseStudyParams,
-    MissileParams,
-    PA9Params,
-    lab_params_of,
-)
+from uio_teach.instructor.labs import LABS
+from uio_teach.lab_params import lab_params_of
+from uio_teach.worked import pa9
+from uio_teach.worked.case_study import CASE_STUDY
+from uio_teach.worked.pa9 import PA9, PA9Experiment, PA9Params
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,7 +38,7 @@ class PA9WithBias(PA9Experiment):
 @pytest.fixture
 def with_bias(monkeypatch):
     experiment = PA9WithBias(name="pa9", timepts=PA9.timepts)
-    monkeypatch.setattr(experiments, "PA9", experiment)
+    monkeypatch.setattr(pa9, "PA9", experiment)
     return experiment
 
 
@@ -99,7 +98,7 @@ def test_the_config_is_the_declared_fields():
 
 
 def test_the_lab_parameters_are_the_declared_lab_fields():
-    for params in (PA9Params, CaseStudyParams, MissileParams):
+    for params in (lab.params for lab in LABS.values()):
         names = [f.name for f in dataclasses.fields(params)]
         assert names == [n for n, s in experiment_params(params.experiment) if s.lab]
         assert params() == params.from_params(params().to_params())
@@ -107,12 +106,12 @@ def test_the_lab_parameters_are_the_declared_lab_fields():
 
 def test_the_explorers_ranges_are_the_declared_ranges():
     ranges = {n: s.range for n, s in experiment_params(PA9)}
-    scenario = pa9_scenario()
+    scenario = scenario_of("pa9")
     assert scenario.amplitude_limits == ranges["sine_amplitude"]
     assert scenario.disturbance_frequency_limits == ranges["sine_frequency"]
     assert scenario.noise_limits == ranges["noise"]
-    case = {n: s.range for n, s in experiment_params(experiments.CASE_STUDY)}
-    assert case_study_scenario().amplitude_limits == case["u2_amplitude"]
+    case = {n: s.range for n, s in experiment_params(CASE_STUDY)}
+    assert scenario_of("case_study").amplitude_limits == case["u2_amplitude"]
 
 
 def test_a_key_declared_twice_differently_is_refused():

@@ -12,7 +12,7 @@ from tolerance import (
 
 import uio_teach as ut
 from uio_teach.examples import DT_CASE_STUDY_PUBLISHED, MISSILE_PUBLISHED, PA9_PUBLISHED
-from uio_teach.experiments import MISSILE
+from uio_teach.worked.missile import MISSILE
 
 
 def printed(x, decimals):

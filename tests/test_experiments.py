@@ -11,10 +11,14 @@ import pytest
 from tolerance import assert_rounding_close, assert_same_run
 
 import uio_teach as ut
-from uio_teach.experiments import CASE_STUDY, MISSILE, PA9, Experiment
-from uio_teach.explorers import case_study_scenario, missile_scenario, pa9_scenario
+from uio_teach.experiments import Experiment
+from uio_teach.explorers import scenario_of
 from uio_teach.instructor import figures
 from uio_teach.instructor.config import FigureConfig
+from uio_teach.worked import missile
+from uio_teach.worked.case_study import CASE_STUDY
+from uio_teach.worked.missile import MISSILE
+from uio_teach.worked.pa9 import PA9
 
 EXPERIMENTS = {"pa9": PA9, "case-study": CASE_STUDY, "missile": MISSILE}
 
@@ -92,24 +96,22 @@ def test_changing_an_experiment_changes_the_figures_explorers_and_checks():
 import dataclasses
 import numpy as np
 import uio_teach as ut
-from uio_teach import experiments
-experiments.PA9 = dataclasses.replace(experiments.PA9, initial_state=[2.0, 0.0, -1.0])
-from uio_teach.explorers import pa9_scenario
+from uio_teach.worked import pa9
+pa9.PA9 = dataclasses.replace(pa9.PA9, initial_state=[2.0, 0.0, -1.0])
+from uio_teach.explorers import scenario_of
 from uio_teach.instructor.config import FigureConfig
 from uio_teach.instructor.figures import _Runs
-assert pa9_scenario().initial_state.tolist() == [2.0, 0.0, -1.0]
+assert scenario_of("pa9").initial_state.tolist() == [2.0, 0.0, -1.0]
 cfg = FigureConfig()
 assert cfg["pa9.initial_state"] == (2.0, 0.0, -1.0)
-assert _Runs(cfg).pa9["uio_sine"].states[:, 0].tolist() == [2.0, 0.0, -1.0]
-plant = experiments.PA9.plant()
-obs = ut.design_uio(plant, poles=experiments.PA9.poles)
-resp = ut.simulate(plant, obs, experiments.PA9.timepts, d=experiments.PA9.d_sine)
+assert pa9._runs(_Runs(cfg))["uio_sine"].states[:, 0].tolist() == [2.0, 0.0, -1.0]
+plant = pa9.PA9.plant()
+obs = ut.design_uio(plant, poles=pa9.PA9.poles)
+resp = ut.simulate(plant, obs, pa9.PA9.timepts, d=pa9.PA9.d_sine)
 message = " ".join(ut.checks.pa9_simulation(resp).failures)
 assert "initial state" in message, message
-x0 = experiments.PA9.initial_state
-resp = ut.simulate(
-    plant, obs, experiments.PA9.timepts, d=experiments.PA9.d_sine, initial_state=x0
-)
+x0 = pa9.PA9.initial_state
+resp = ut.simulate(plant, obs, pa9.PA9.timepts, d=pa9.PA9.d_sine, initial_state=x0)
 assert ut.checks.pa9_simulation(resp, initial_state=x0).passed
 """
     subprocess.run([sys.executable, "-c", code], check=True)
@@ -126,13 +128,12 @@ def test_figure_defaults_are_the_experiments():
     assert cfg["case_study.steps"] + 1 == CASE_STUDY.timepts.size
     assert cfg["seed"] == CASE_STUDY.seed
     assert [complex(p) for p in cfg["missile.pmo_poles"]] == [complex(p) for p in MISSILE.poles]
-    runs = figures._Runs(cfg)
-    resp = runs.missile["pmo"]["response"]
+    resp = missile._runs(figures._Runs(cfg))["pmo"]["response"]
     assert_same_run(resp.estimates[:, 0], 0.0, resp)
 
 
 def test_scenarios_read_the_experiments():
-    pa9, case, missile = pa9_scenario(), case_study_scenario(), missile_scenario()
+    pa9, case, missile = scenario_of("pa9"), scenario_of("case_study"), scenario_of("missile")
     np.testing.assert_array_equal(pa9.initial_state, PA9.initial_state)
     assert pa9.defaults.poles == PA9.poles
     assert (pa9.defaults.amplitude, pa9.defaults.frequency) == (1.0, 2.0)

@@ -35,10 +35,11 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from uio_teach.instructor import cli, grade, sandbox
-from uio_teach.instructor.gradebook import safe_cell
+from uio_teach.grading import grade, sandbox
+from uio_teach.grading.gradebook import safe_cell
+from uio_teach.grading.sandbox import Limits, sandbox_problem
+from uio_teach.instructor import cli
 from uio_teach.instructor.labs import LABS
-from uio_teach.instructor.sandbox import Limits, sandbox_problem
 
 pytestmark = [pytest.mark.kernel, pytest.mark.filterwarnings("ignore::DeprecationWarning")]
 
@@ -356,12 +357,15 @@ def graded(labs, tmp_path_factory) -> dict:
 
     # copied: group 1's notebook under group 19's name; one code from two groups; a group twice
     subs["renamed"] = small(folder / "pa9_g19.ipynb", "g01")
-    subs["same_a"] = small(folder / "pa9_g20.ipynb", "g20", "shared = 1")
-    subs["same_b"] = small(folder / "pa9_g21.ipynb", "g21", "shared = 1")
+    # a copy disguised: other local names, a comment, blank lines, another layout
+    subs["same_a"] = small(folder / "pa9_g20.ipynb", "g20", "shared = 1\nboth = shared * 2")
+    subs["same_b"] = small(
+        folder / "pa9_g21.ipynb", "g21", "common=1  # ours\n\n\nboth = (common*2)"
+    )
     subs["twice_a"] = small(folder / "pa9_g22.ipynb", "g22", "first = 1")
     subs["twice_b"] = small(folder / "late hand-in.ipynb", "g22", "second = 1")
-    subs["roster"] = small(folder / "notebook (3).ipynb", None, "by_roster = 1")
-    subs["nogroup"] = small(folder / "handin.ipynb", None, "no_group = 1")
+    subs["roster"] = small(folder / "notebook (3).ipynb", None, "by_roster = 24")
+    subs["nogroup"] = small(folder / "handin.ipynb", None, "no_group = 25")
 
     # hostile: probes, a fork bomb, filling /tmp and the folder, a huge figure, a formula name
     sleeper = subprocess.Popen(["sleep", "100000"], start_new_session=True)
@@ -371,7 +375,7 @@ def graded(labs, tmp_path_factory) -> dict:
     subs["forks"] = small(folder / "pa9_g27.ipynb", "g27", FORK_BOMB)
     subs["filler"] = small(folder / "pa9_g28.ipynb", "g28", FILLER, FILL_HOME)
     subs["axes"] = small(folder / "pa9_g29.ipynb", "g29", AXES)
-    subs["formula"] = small(folder / '=HYPERLINK("http:x";"y").ipynb', None, "f = 1")
+    subs["formula"] = small(folder / '=HYPERLINK("http:x";"y").ipynb', None, "f = 26")
     assert len(subs) == 30
 
     roster = folder.parent / "groups.csv"
@@ -585,8 +589,8 @@ def test_the_group_is_the_file_name_and_disagreement_is_checked_by_hand(graded):
 
 @needs_sandbox
 def test_the_same_code_from_two_groups_and_a_group_twice_are_checked_by_hand(graded):
-    for name in ("same_a", "same_b"):
-        assert "same code" in graded["rows"][name]["reason"]
+    for name, other in (("same_a", "g21"), ("same_b", "g20")):
+        assert f"the same code as group {other}" in graded["rows"][name]["reason"]
     for name in ("twice_a", "twice_b"):
         row = graded["rows"][name]
         assert row["group"] == "g22" and "more than once" in row["reason"]
@@ -700,7 +704,7 @@ def test_an_environment_under_tmp_is_still_there_inside(tmp_path, monkeypatch):
         os.chown(work, user, user)
         os.chmod(tmp_path, 0o755)
     code = (
-        f"from uio_teach.instructor.sandbox import drop_privileges; drop_privileges({user!r}); "
+        f"from uio_teach.grading.sandbox import drop_privileges; drop_privileges({user!r}); "
         f"import sys; sys.path.insert(0, {str(env / 'lib')!r}); "
         "import marker_under_tmp; print(marker_under_tmp.VALUE)"
     )
@@ -860,10 +864,10 @@ def test_no_sandbox_grades_the_same_says_so_loudly_and_no_group_is_never_ok(tmp_
 def test_a_failure_of_the_grader_on_one_hand_in_is_that_rows_and_the_run_goes_on(
     tmp_path, monkeypatch, capsys
 ):
-    def broken(nb, lab, params):
+    def broken(nb, checks, params, **kwargs):
         if any("boom" in c.source for c in nb.cells):
             raise KeyError("a bug of the grader")
-        return real(nb, lab, params)
+        return real(nb, checks, params, **kwargs)
 
     real = grade.prepare
     monkeypatch.setattr(grade, "prepare", broken)
@@ -882,9 +886,9 @@ def test_a_failure_of_the_grader_on_one_hand_in_is_that_rows_and_the_run_goes_on
 
 
 def explode_on(stem: str, real):
-    def read(path, roster=None):
+    def read(path, roster=None, **kwargs):
         if Path(path).stem == stem:
             raise MemoryError
-        return real(path, roster)
+        return real(path, roster, **kwargs)
 
     return read

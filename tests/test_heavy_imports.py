@@ -14,7 +14,7 @@ HEAVY = ("control", "cvxpy", "scipy.signal", "matplotlib.pyplot")
 SCRIPT = """
 import sys
 import uio_teach as ut
-plant = ut.experiments.PA9.plant()
+plant = ut.worked.pa9.PA9.plant()
 ut.existence.decoupling(plant)
 print(" ".join(m for m in {heavy!r} if m in sys.modules))
 """
@@ -35,7 +35,7 @@ def test_importing_and_an_existence_check_load_no_heavy_library():
     ("call", "module"),
     [
         ("ut.examples.pa9().as_statespace()", "control"),
-        ("ut.design_luenberger(ut.experiments.PA9.plant(), poles=[-1, -1, -1])", "control"),
+        ("ut.design_luenberger(ut.worked.pa9.PA9.plant(), poles=[-1, -1, -1])", "control"),
         ("ut.lmi_gain([[0.5, 1.0], [0.0, 0.9]], [[1.0, 0.0]], dt=True)", "cvxpy"),
     ],
 )

@@ -18,7 +18,9 @@ import uio_teach as ut
 from uio_teach import checks
 from uio_teach.instructor import cli, labs
 from uio_teach.instructor.config import load_config
-from uio_teach.instructor.lab_params import CaseStudyParams, MissileParams, PA9Params
+from uio_teach.worked.case_study import CaseStudyParams
+from uio_teach.worked.missile import MissileParams
+from uio_teach.worked.pa9 import PA9Params
 
 BOOK = labs.default_book_dir()
 

@@ -17,7 +17,7 @@ PACKAGE = ROOT / "uio_teach"
 TESTS = ROOT / "tests"
 
 # What sits above it: nothing of the algorithm layer may import these.
-ABOVE = {"explorers", "instructor", "checks", "__main__"}
+ABOVE = {"explorers", "instructor", "grading", "checks", "__main__"}
 # The algorithm layer (with the worked examples and plotting): every other top-level module.
 ALGORITHMS = sorted(
     [p.stem for p in PACKAGE.glob("*.py") if p.stem not in ABOVE and p.stem != "__init__"]
@@ -86,6 +86,23 @@ def test_the_layout_check_sees_a_forbidden_import(tmp_path):
     (root / "explorers" / "deep.py").write_text("from ..instructor import cli\n")
     assert "uio_teach.explorers.frames" in _imports(root / "fake.py", root)
     assert "uio_teach.instructor.cli" in _imports(root / "explorers" / "deep.py", root)
+
+
+def test_the_grader_is_a_room_of_its_own():
+    """Only the command line ties the term's tooling to the grader; the grader takes from the
+    term's tooling only where the book is and the output folders, never the figures, the labs'
+    parameters or the variants (nor the algorithms they load, before the first hand-in)."""
+    tied = sorted(
+        path.name
+        for path in (PACKAGE / "instructor").glob("*.py")
+        if any(m.startswith("uio_teach.grading") for m in _imports(path))
+    )
+    assert tied == ["cli.py"]
+    allowed = ("uio_teach.instructor.output", "uio_teach.instructor.book")
+    for path in (PACKAGE / "grading").glob("*.py"):
+        used = {m for m in _imports(path) if m.startswith("uio_teach.instructor")}
+        assert all(m.startswith(allowed) for m in used), f"{path.name} imports {sorted(used)}"
+    assert not (PACKAGE / "checks" / "grading.py").exists()
 
 
 def test_algorithm_layer_is_found():
@@ -391,7 +408,7 @@ def test_each_process_is_classified_by_what_it_starts():
         "kernel",
     }
     assert conftest.needs_of([python, "-m", "uio_teach", "grade", "a.ipynb"]) >= {"kernel"}
-    runner = ["bwrap", "--die-with-parent", python, "-m", "uio_teach.instructor.runner", "--run"]
+    runner = ["bwrap", "--die-with-parent", python, "-m", "uio_teach.grading.runner", "--run"]
     assert conftest.needs_of(runner) >= {"kernel"}
     assert conftest.needs_of(["/venv/bin/jupyter-book", "build", "."]) >= {"book"}
     assert conftest.needs_of([python, "-m", "sphinx", "-b", "html", "src", "out"]) >= {"book"}

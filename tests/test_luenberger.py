@@ -53,7 +53,7 @@ def test_poles_repeated_beyond_the_outputs_stay_and_are_placed():
 def test_a_plant_with_two_equal_modes_takes_a_triple_pole():
     # A has the eigenvalue -2 twice with two eigenvectors (not cyclic): no single output
     # combination w C observes it, a preliminary injection makes A - L0 C cyclic first
-    plant = ut.experiments.PA9.plant()
+    plant = ut.worked.pa9.PA9.plant()
     w, V = np.linalg.eig(plant.A)
     assert np.linalg.matrix_rank(V[:, np.isclose(w, -2)]) == 2
     obs = ut.design_luenberger(plant, poles=[-1, -1, -1])

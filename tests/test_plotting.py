@@ -8,7 +8,9 @@ from tolerance import assert_same_run
 
 import uio_teach as ut  # noqa: E402
 from uio_teach import plotting  # noqa: E402
-from uio_teach.experiments import CASE_STUDY, MISSILE, PA9  # noqa: E402
+from uio_teach.worked.case_study import CASE_STUDY  # noqa: E402
+from uio_teach.worked.missile import MISSILE  # noqa: E402
+from uio_teach.worked.pa9 import PA9  # noqa: E402
 
 
 def test_names_and_labels():
@@ -63,10 +65,12 @@ def test_a_residual_channel_has_the_colour_of_the_state_it_measures():
     for i, line in enumerate(ax_r.lines):
         (j,) = np.flatnonzero(C[i])  # PA9 measures x1 and x3: r1 = e1, r2 = e3
         assert line.get_color() == ax_e.lines[j].get_color()
+        assert line.get_linestyle() == ax_e.lines[j].get_linestyle()
         np.testing.assert_array_equal(line.get_ydata(), resp.error[j])  # drawn as computed
     # a row that mixes states gets a colour no error channel has
     colours = plotting.residual_colors(ut.examples.dt_case_study().C)
-    assert colours[0] not in {f"C{i}" for i in range(3)} and colours[1] == "C0"
+    states = {plotting.channel_style(i)["color"] for i in range(3)}
+    assert colours[0] not in states and colours[1] == plotting.channel_style(0)["color"]
 
 
 def test_rounding_noise_is_drawn_on_zero_and_named():

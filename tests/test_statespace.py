@@ -14,7 +14,9 @@ import pytest
 from tolerance import assert_rounding_close, size_of
 
 import uio_teach as ut
-from uio_teach.experiments import CASE_STUDY, MISSILE, PA9
+from uio_teach.worked.case_study import CASE_STUDY
+from uio_teach.worked.missile import MISSILE
+from uio_teach.worked.pa9 import PA9
 
 
 def _interconnect(plant: ut.Plant, observer) -> ct.StateSpace:

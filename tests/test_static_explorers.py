@@ -12,6 +12,7 @@ blocked. The explorer pages of the built book (the run's one build, ``built_book
 
 from __future__ import annotations
 
+import functools
 import itertools
 import os
 import threading
@@ -20,19 +21,14 @@ from pathlib import Path
 import pytest
 
 import uio_teach as ut
-from uio_teach.explorers import (
-    ExplorerFigure,
-    case_study_scenario,
-    make_scenario,
-    missile_scenario,
-    pa9_scenario,
-)
+from uio_teach.explorers import ExplorerFigure, make_scenario, scenario_of
 from uio_teach.explorers.static import (
     NARROW_DPI,
     NARROW_FONTSCALE,
     WIDE_FONTSCALE,
     static_explorer,
 )
+from uio_teach.worked import WORKED
 
 CHROMIUM = Path("/usr/bin/chromium")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
@@ -46,10 +42,9 @@ def _own():
     return make_scenario(plant, "uio", name="own")
 
 
+# every worked example of the registry, and a plant of one's own
 SCENARIOS = {
-    "pa9": pa9_scenario,
-    "case_study": case_study_scenario,
-    "missile": missile_scenario,
+    **{name: functools.partial(scenario_of, name) for name in WORKED},
     "existence": _own,
 }
 
@@ -199,7 +194,7 @@ def _block_the_network(page) -> None:
 
 def _smallest_text_px(m: dict, narrow: bool) -> float:
     """The smallest text of the shown picture in CSS pixels (its size in points is the figure's)."""
-    scenario = pa9_scenario()  # the same fonts in every explorer
+    scenario = scenario_of("pa9")  # the same fonts in every explorer
     if narrow:
         figure = ExplorerFigure(scenario, dpi=NARROW_DPI, fontscale=NARROW_FONTSCALE, narrow=True)
     else:
@@ -374,3 +369,68 @@ def test_built_explorer_pages_read_on_a_phone(chapter, built_book):
             f"{chapter} explorer {k + 1} at 390 px: column {m['column']:.0f} px, picture "
             f"{m['img']['width']:.0f} x {m['img']['height']:.0f} px"
         )
+
+
+# Each control of the explorer as a keyboard and screen-reader user meets it: its accessible name,
+# whether it has focus, the width of its focus ring, its value as read out, the picture's text
+# alternative and the live region that announces the caption.
+_CONTROLS_JS = """
+(k) => {
+  const root = document.querySelectorAll(".uio-static-explorer")[k];
+  const el = document.activeElement;
+  const label = el.labels && el.labels.length ? el.labels[0].textContent.trim() : "";
+  const ring = getComputedStyle(el);
+  const live = root.querySelector("[aria-live]");
+  return {
+    inside: root.contains(el), tag: el.tagName, name: el.getAttribute("aria-label") || label,
+    ring: ring.outlineStyle !== "none" ? parseFloat(ring.outlineWidth) : 0,
+    valuetext: el.getAttribute("aria-valuetext"),
+    shown: (root.querySelector("output") || {}).value,
+    alt: root.querySelector("img.uio-frame").alt,
+    live: live ? live.getAttribute("aria-live") + ": " + live.textContent : "",
+    group: root.getAttribute("role") + " " + root.getAttribute("aria-label"),
+  };
+}
+"""
+
+
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_controls_work_from_the_keyboard_with_focus_labels_and_announcements(name, tmp_path):
+    """Tab reaches the slider and the disturbance menu; each shows a focus ring and has a name;
+    the arrow keys move the slider, whose value is read out as shown (not as its index), and the
+    picture's text alternative and the announced caption change with it."""
+    path, kinds = _standalone(name, tmp_path)
+    seen = []
+
+    def work(browser) -> None:
+        context = browser.new_context(viewport={"width": 1280, "height": 900})
+        page = context.new_page()
+        _block_the_network(page)
+        page.goto(path.as_uri())
+        page.keyboard.press("Tab")  # from the top of the page to the slider
+        seen.append(page.evaluate(_CONTROLS_JS, 0))
+        page.keyboard.press("End")
+        page.keyboard.press("ArrowLeft")
+        seen.append(page.evaluate(_CONTROLS_JS, 0))
+        if kinds > 1:
+            page.keyboard.press("Tab")  # the disturbance menu
+            page.keyboard.press("ArrowDown")
+            seen.append(page.evaluate(_CONTROLS_JS, 0))
+        context.close()
+
+    _in_chromium(work)
+    first, moved = seen[0], seen[1]
+    assert first["group"].startswith("group ") and "explorer" in first["group"], first
+    for state in seen:
+        assert state["inside"], (name, state)
+        assert state["name"], f"{name}: a control without a name: {state}"
+        assert state["ring"] >= 2, f"{name}: no visible focus on {state['tag']}: {state}"
+        assert state["live"].startswith("polite: ") and len(state["live"]) > 20, state
+    assert first["tag"] == "INPUT" and moved["tag"] == "INPUT", seen
+    assert first["valuetext"] == first["shown"] and moved["valuetext"] == moved["shown"], seen
+    assert moved["shown"] != first["shown"] and moved["alt"] != first["alt"], seen
+    assert moved["live"] != first["live"], seen
+    if kinds > 1:
+        menu = seen[2]
+        assert menu["tag"] == "SELECT" and "disturbance" in menu["name"], menu
+        assert menu["alt"] != moved["alt"] and menu["live"] != moved["live"], menu

@@ -191,6 +191,44 @@ def test_no_page_shows_what_its_source_hides(page: str, built_book: Path) -> Non
     assert not named, f"{page}: names {named}"
 
 
+def _tutor_headings(source: Path) -> list[str]:
+    """The headings of a page's source that open a section for the tutors."""
+    lines = source.read_text(encoding="utf-8").splitlines()
+    blocks = [(s, e) for s, e, name, _ in _fence_blocks(lines) if name == "code-cell"]
+    out = []
+    for k, line in enumerate(lines):
+        m = re.match(r"^(#{2,})\s+(.*)$", line)
+        if m and not any(s <= k <= e for s, e in blocks):
+            if m.group(2).strip().lower().startswith("instructor"):
+                out.append(m.group(2).strip())
+    return out
+
+
+TUTOR_PAGES = [page for page in PAGES if _tutor_headings(SOURCES[page])]
+
+
+def test_the_pages_with_tutors_sections_are_found():
+    """The labs and the API page have sections for the tutors (else the test below tests
+    nothing)."""
+    assert set(LABS) <= set(TUTOR_PAGES) and any(p.endswith("api") for p in TUTOR_PAGES)
+
+
+@pytest.mark.parametrize("page", TUTOR_PAGES)
+def test_tutors_sections_are_left_out_whole_heading_and_all(page: str, built_book: Path) -> None:
+    """No heading of a tutors' section, no stub text in its place, no entry in the page's
+    table of contents, no dead anchor: the section is not on the student page at all."""
+    html = (built_book / f"{page}.html").read_text(encoding="utf-8")
+    headings = [
+        re.sub(r"<[^>]+>", "", h).replace("#", "").strip()
+        for h in re.findall(r"<h[1-6][^>]*>(.*?)</h[1-6]>", html, flags=re.S)
+    ]
+    for title in _tutor_headings(SOURCES[page]):
+        assert not any(h.startswith(title) for h in headings), (page, title, headings)
+        assert f">{title}<" not in html, (page, title)
+    assert "This section is for the tutors" not in html
+    assert not re.search(r'id="[^"]*-instructor"', html), page
+
+
 @pytest.mark.parametrize("page", LABS)
 def test_lab_checks_are_shown_unrun(page: str, built_book: Path) -> None:
     """A lab's check cells have no output (their verdicts would come from the model solution)
@@ -314,7 +352,7 @@ def test_fonts_of_the_chapters_figures() -> None:
 
 def _explorer_text_px(image: dict, width: int) -> float:
     """The smallest text of an explorer picture as shown, in CSS pixels."""
-    from uio_teach.explorers import pa9_scenario
+    from uio_teach.explorers import scenario_of
     from uio_teach.explorers._figure import ExplorerFigure
     from uio_teach.explorers.static import (
         NARROW_DPI,
@@ -325,7 +363,7 @@ def _explorer_text_px(image: dict, width: int) -> float:
 
     narrow = width <= NARROW_PX
     figure = ExplorerFigure(
-        pa9_scenario(),
+        scenario_of("pa9"),
         dpi=NARROW_DPI if narrow else 144,
         fontscale=NARROW_FONTSCALE if narrow else WIDE_FONTSCALE,
         narrow=narrow,

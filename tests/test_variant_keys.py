@@ -12,9 +12,9 @@ import pytest
 import uio_teach as ut
 from uio_teach import checks
 from uio_teach.existence import decoupling
-from uio_teach.instructor.lab_params import MIN_INITIAL_ERROR
 from uio_teach.instructor.lab_registry import LABS
 from uio_teach.instructor.variants import draw_variants
+from uio_teach.lab_params import MIN_INITIAL_ERROR
 from uio_teach.lmi import lmi_gain
 
 GROUPS = 4

@@ -85,7 +85,8 @@ def test_the_registry_is_the_source_of_experiments_labs_observers_and_figures():
     for name, entry in WORKED.items():
         assert EXPERIMENTS[name] is entry.run() and entry.run().lab == name
         if entry.lab:
-            assert LABS[name].source == entry.lab and (BOOK / entry.lab).is_file()
+            assert LABS[name].source == entry.lab.source and (BOOK / entry.lab.source).is_file()
+            assert LABS[name].params is entry.lab.params
         assert OBSERVER_KEYS[entry.poles_key()] == name
     assert list(figures.FIGURES) == [f.name for e in WORKED.values() for f in e.figures]
     assert set(OBSERVER_KEYS) == {e.poles_key() for e in WORKED.values()}

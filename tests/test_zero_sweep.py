@@ -28,14 +28,19 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import warnings
 from collections import Counter, defaultdict
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import uio_teach as ut
 from uio_teach.verify import LEAK_REFUSE, LEAK_RTOL, DecouplingWarning, PlacementAccuracyError
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+import zero_families  # noqa: E402
 
 FAMILIES = (
     "fast unstable",
@@ -117,107 +122,9 @@ def build(family: str, coordinates: str, seed: int) -> tuple[ut.Plant, np.ndarra
     return ut.Plant(A, C, B=B, E=E), np.array(zeros, complex)
 
 
-# exact judgement ------------------------------------------------------------------------------
-class _Exact:
-    """A matrix of floats held exactly as Python integers times ``2**-shift``.
-
-    Every double is a dyadic rational, so sums and products of such matrices are exact in integer
-    arithmetic (the rational arithmetic of :class:`fractions.Fraction`, with the common
-    denominator kept as one power of 2).
-    """
-
-    def __init__(self, ints: np.ndarray, shift: int) -> None:
-        self.ints, self.shift = ints, shift
-
-    @classmethod
-    def of(cls, M: np.ndarray) -> _Exact:
-        M = np.atleast_2d(np.asarray(M, float))
-        ratios = [x.as_integer_ratio() for x in M.ravel().tolist()]
-        shift = max((d.bit_length() - 1 for _, d in ratios), default=0)
-        ints = np.array([n << (shift - (d.bit_length() - 1)) for n, d in ratios], dtype=object)
-        return cls(ints.reshape(M.shape), shift)
-
-    @classmethod
-    def eye(cls, n: int) -> _Exact:
-        return cls(np.array(np.eye(n, dtype=int), dtype=object), 0)
-
-    def _at(self, shift: int) -> np.ndarray:
-        return self.ints * (1 << (shift - self.shift))
-
-    def __matmul__(self, other: _Exact) -> _Exact:
-        return _Exact(np.dot(self.ints, other.ints), self.shift + other.shift)
-
-    def __sub__(self, other: _Exact) -> _Exact:
-        shift = max(self.shift, other.shift)
-        return _Exact(self._at(shift) - other._at(shift), shift)
-
-    def to_float(self) -> np.ndarray:
-        den = 1 << self.shift
-        # int / int is correctly rounded in Python, however large the integers
-        return np.array([int(x) / den for x in self.ints.ravel()], float).reshape(self.ints.shape)
-
-
-def _fr(M: np.ndarray) -> _Exact:
-    return _Exact.of(M)
-
-
-def _mul(X: _Exact, Y: _Exact) -> _Exact:
-    return X @ Y
-
-
-def _sub(X: _Exact, Y: _Exact) -> _Exact:
-    return X - Y
-
-
-def _eye(n: int) -> _Exact:
-    return _Exact.eye(n)
-
-
-def _float(X: _Exact) -> np.ndarray:
-    return X.to_float()
-
-
-def exact_leak(plant: ut.Plant, obs) -> float:
-    """The unknown input's gain to the estimation error over its gain to the state, from the
-    exact residuals of the returned matrices (rational arithmetic)."""
-    real = obs.realization()
-    A, E, C = _fr(plant.A), _fr(plant.E), _fr(plant.C)
-    n = plant.n
-    Dy, F, K, Co = _fr(real.D_y), _fr(real.A), _fr(real.B_y), _fr(real.C)
-    if isinstance(obs, ut.GInverseObserver):
-        theta = _sub(_eye(n), _mul(_fr(obs.Kg), C))  # its state estimates (I - Kg C) x
-    else:
-        theta = _sub(_eye(n), _mul(Dy, C))  # its state estimates (I - H C) x
-    # e = x - xhat = R0 x + Co (theta x - w); (theta x - w)' = F (theta x - w) + R x + R1 d
-    R0 = _float(_sub(_sub(_eye(n), _mul(Dy, C)), _mul(Co, theta)))
-    R = _float(_sub(_sub(_mul(theta, A), _mul(F, theta)), _mul(K, C)))
-    R1 = _float(_mul(theta, E))
-    Af, Ef, Ff, Cof = plant.A, plant.E, real.A, real.C
-    lam = np.concatenate([np.linalg.eigvals(Af), np.linalg.eigvals(Ff)])
-    mags = np.abs(lam)
-    mags = mags[mags > 0]
-    # a finer grid than the package's own check, every resonance, and points next to them
-    res = np.abs(lam.imag)
-    res = res[res > 0]
-    ws = np.concatenate([[0.0], np.geomspace(mags.min(), mags.max(), 31), res, res * 1.01])
-    leak = gain = 0.0
-    for w in np.unique(ws):
-        s = 1j * w
-        if np.any(np.abs(lam - s) <= 1e-6 * max(1.0, w)):
-            # on an undamped pole (the g-inverse observer's modes at 0): the transfer function is
-            # not defined there, and rounding of size eps / |s - lambda| would be judged a leak;
-            # the points beside it measure the gain of the modes around it
-            continue
-        try:
-            X = np.linalg.solve(s * np.eye(n) - Af, Ef)
-            Y = np.linalg.solve(s * np.eye(Ff.shape[0]) - Ff, R @ X + R1)
-        except (np.linalg.LinAlgError, ValueError):
-            continue
-        if not (np.all(np.isfinite(X)) and np.all(np.isfinite(Y))):
-            continue
-        gain = max(gain, float(np.linalg.norm(X, 2)))
-        leak = max(leak, float(np.linalg.norm(R0 @ X + Cof @ Y, 2)))
-    return leak / gain if gain else 0.0
+# exact judgement: the rational-arithmetic judge of the benchmark's families, which evaluates at
+# DC and at every mode's own rate and skips only points on an eigenvalue to round-off
+exact_leak = zero_families.exact_leak
 
 
 def why(call) -> str:

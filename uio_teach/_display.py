@@ -186,19 +186,36 @@ def matrices_text(title: str, items: Iterable[tuple[str, np.ndarray]], digits: i
     return "\n".join(lines)
 
 
-def _html_matrix(M: np.ndarray, digits: int, ref: float = 0.0) -> str:
+_SR_ONLY = (
+    "position:absolute;width:1px;height:1px;overflow:hidden;clip:rect(0 0 0 0);"
+    "white-space:nowrap;border:0;padding:0;margin:-1px"
+)
+"""The style of text for screen readers only: in the page's structure, not on the screen."""
+
+
+def _html_matrix(M: np.ndarray, digits: int, ref: float = 0.0, name: str = "") -> str:
+    """A matrix as an HTML table between brackets; a screen reader hears its name, its size and
+    each entry's row and column (header cells shown to screen readers only)."""
     M = np.asarray(M)
     if M.size == 0:
         return f"<i>empty {M.shape[0]}&times;{M.shape[1]}</i>"
+    rows, cols = M.shape
+    label = html.escape(f"{name}, {rows} by {cols} matrix" if name else f"{rows} by {cols} matrix")
+    head = (
+        f'<tr><td style="{_SR_ONLY}"></td>'
+        + "".join(f'<th scope="col" style="{_SR_ONLY}">column {j + 1}</th>' for j in range(cols))
+        + "</tr>"
+    )
     body = "".join(
-        "<tr>"
+        f'<tr><th scope="row" style="{_SR_ONLY}">row {i + 1}</th>'
         + "".join(f'<td style="text-align:right;padding:0 0.4em">{v:.{digits}g}</td>' for v in row)
         + "</tr>"
-        for row in _clean(M, ref)
+        for i, row in enumerate(_clean(M, ref))
     )
     return (
-        '<table style="display:inline-table;border-left:1px solid;border-right:1px solid;'
-        f'border-collapse:collapse;margin:0.2em">{body}</table>'
+        f'<table aria-label="{label}" style="display:inline-table;border-left:1px solid;'
+        'border-right:1px solid;border-collapse:collapse;margin:0.2em;position:relative">'
+        f"{head}{body}</table>"
     )
 
 
@@ -210,7 +227,7 @@ def matrices_html(title: str, items: Iterable[tuple[str, np.ndarray]], digits: i
     for name, M in items:
         parts.append(
             f'<span style="display:inline-block;margin-right:1em"><i>{html.escape(name)}</i> = '
-            f"{_html_matrix(M, digits, ref)}</span>"
+            f"{_html_matrix(M, digits, ref, name)}</span>"
         )
     parts.append("</div>")
     return "".join(parts)

@@ -33,6 +33,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from . import tolerances as tols
 from .linalg import ObservabilitySplit, left_null, observability_decomposition, sort_poles
 from .plant import Plant
 
@@ -323,6 +324,7 @@ def balanced_pair(
     D: np.ndarray,
     scaling: Scaling | None = None,
     zeros: np.ndarray | None = None,
+    radius: np.ndarray | None = None,
 ) -> BalancedPair:
     """Balance the pair ``(A1, N C)`` (``N D = 0``) and split it into observable parts.
 
@@ -339,6 +341,9 @@ def balanced_pair(
         find other modes, it is run again with a tighter and a looser rank
         threshold and the split that agrees with the zeros is kept, so the
         number of movable poles always agrees with the list of zeros.
+    radius : array_like, optional
+        How far round-off moves each zero (:class:`uio_teach.linalg.ZeroSet`): modes agree
+        with a zero within it (a repeated zero's modes scatter by ``eps**(1/k)``).
 
     Returns
     -------
@@ -361,14 +366,18 @@ def balanced_pair(
     R = Nb * wy[None, :]
     Cn = Nb @ Cb
     split = observability_decomposition(Ab, Cn)
-    if zeros is not None and not modes_agree(split.unobservable_modes * sigma, zeros):
+    if zeros is not None and not modes_agree(split.unobservable_modes * sigma, zeros, radius):
         for rtol in (1e1, 1e5, 1e7, 1e9):
             other = observability_decomposition(Ab, Cn, rtol=rtol)
-            if modes_agree(other.unobservable_modes * sigma, zeros):
+            if modes_agree(other.unobservable_modes * sigma, zeros, radius):
                 split = other._replace(margin=min(other.margin, 1.0))  # flagged: marginal
                 break
         else:
-            split = _split_from_modes(Ab, Cn, np.asarray(zeros, complex) / sigma) or split
+            split = (
+                _split_from_modes(Ab, Cn, np.asarray(zeros, complex) / sigma)
+                or _split_of_size(Ab, Cn, len(zeros))
+                or split
+            )
     return BalancedPair(A=Ab, C=Cn, t=t, R=R, sigma=sigma, split=split)
 
 
@@ -393,17 +402,35 @@ def _split_from_modes(A: np.ndarray, C: np.ndarray, modes: np.ndarray):
     V = np.array(vecs).T
     U, sv, _ = np.linalg.svd(V, full_matrices=True)
     k = len(modes)
-    if V.shape[1] != k or sv.size < k or sv[k - 1] <= 1e-8 * sv[0]:
+    if V.shape[1] != k or sv.size < k or sv[k - 1] <= tols.SPAN_RTOL * sv[0]:
         return None  # repeated modes: their vectors do not span the subspace
     Vu, Vo = U[:, :k], U[:, k:]
     split = ObservabilitySplit(
         Vo=Vo, Vu=Vu, Ao=Vo.T @ A @ Vo, Co=C @ Vo, Au=Vu.T @ A @ Vu, margin=1.0
     )
-    return split if modes_agree(split.unobservable_modes, modes, rtol=1e-6) else None
+    return split if modes_agree(split.unobservable_modes, modes) else None
 
 
-def modes_agree(modes: np.ndarray, zeros: np.ndarray, rtol: float = 1e-5) -> bool:
+def _split_of_size(A: np.ndarray, C: np.ndarray, k: int):
+    """The observability split whose unobservable part has ``k`` states, or None.
+
+    For a repeated or defective zero, whose modes scatter by ``eps**(1/k)``: the staircase is
+    run with rank thresholds from tight to loose and the first split of the right size (the
+    zeros' count, from the pencil's structure) is kept, flagged as marginal.
+    """
+    for rtol in np.geomspace(1.0, 1e12, 13):
+        split = observability_decomposition(A, C, rtol=float(rtol))
+        if split.Au.shape[0] == k:
+            return split._replace(margin=min(split.margin, 1.0))
+    return None
+
+
+def modes_agree(modes: np.ndarray, zeros: np.ndarray, radius: np.ndarray | None = None) -> bool:
     """True when ``modes`` and ``zeros`` are the same values (count and, matched, value).
+
+    Matched one to one, each within ``MODES_RTOL`` (:mod:`uio_teach.tolerances`) of the
+    larger of its size and the largest zero's (a scale of the system's own, so the same in
+    any unit of time), or within twice its ``radius`` (how far round-off moves it).
 
     Examples
     --------
@@ -418,6 +445,15 @@ def modes_agree(modes: np.ndarray, zeros: np.ndarray, rtol: float = 1e-5) -> boo
         return False
     if not modes.size:
         return True
-    cost = np.abs(modes[:, None] - zeros[None, :]) / np.maximum(1.0, np.abs(zeros))[None, :]
+    top = float(np.max(np.abs(zeros)))
+    allow = tols.MODES_RTOL * np.maximum(np.abs(zeros), top)
+    if radius is not None and len(radius) == zeros.size:
+        r = np.asarray(radius, float)
+        allow = np.maximum(allow, 2 * np.where(np.isfinite(r), r, 0.0))
+    if not np.all(np.isfinite(modes)) or not np.all(np.isfinite(zeros)):
+        return False
+    cost = (
+        np.abs(modes[:, None] - zeros[None, :]) / np.maximum(allow, np.finfo(float).tiny)[None, :]
+    )
     rows, cols = linear_sum_assignment(cost)
-    return bool(np.all(cost[rows, cols] <= rtol))
+    return bool(np.all(cost[rows, cols] <= 1.0))

@@ -42,7 +42,7 @@ class UIOTeachWarning(UserWarning):
     Examples
     --------
     >>> from uio_teach.errors import UIOTeachWarning
-    >>> from uio_teach.instructor.grade import UnsandboxedWarning
+    >>> from uio_teach.grading.grade import UnsandboxedWarning
     >>> issubclass(UnsandboxedWarning, UIOTeachWarning)
     True
     """

@@ -11,13 +11,15 @@
   missile autopilot, with matrices as read back from the paper's scrambled
   text; ``Mv``, ``x0`` and the unknown inputs in :data:`MISSILE_PUBLISHED`.
 * :func:`quadruple_tank` -- Johansson (IEEE TCST 8(3), 2000): the
-  quadruple-tank process linearized at the paper's operating points, both
-  pump flows unknown (``E = B``); the paper's parameters, time constants and
-  zeros in :data:`QUADRUPLE_TANK_PUBLISHED`.
+  quadruple-tank process linearized at the steady state of its valves and
+  pump voltages (:func:`tank_operating_point`), both pump flows unknown
+  (``E = B``); the paper's parameters, levels, time constants and zeros in
+  :data:`QUADRUPLE_TANK_PUBLISHED`.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
@@ -40,6 +42,9 @@ __all__ = [
     "MISSILE_PUBLISHED",
     "quadruple_tank",
     "tank_time_constants",
+    "tank_operating_point",
+    "TankOperatingPoint",
+    "TANK_OUTLETS",
     "QUADRUPLE_TANK_PUBLISHED",
 ]
 
@@ -249,12 +254,151 @@ Each holds the tank areas ``A`` and outlet areas ``a`` (cm^2), the sensor gain
 and the printed time constants ``T`` (s) and zeros (1/s)."""
 
 
-def tank_time_constants(setting: str = "P-") -> np.ndarray:
-    """The time constants ``T_i = (A_i / a_i) sqrt(2 h_i0 / g)`` of a setting, in s.
+TANK_OUTLETS = (0.071, 0.0572, 0.071, 0.0572)
+"""The outlet areas ``a_1 .. a_4`` (cm^2) of the course's model.
+
+The paper prints ``a_1 = a_3 = 0.071`` and ``a_2 = a_4 = 0.057`` to two
+significant digits. With ``0.057`` exactly, the steady state of the mass
+balance gives ``T_2 = 90.6`` s at P- (printed 90), ``T_2 = 92.0`` s and
+``T_4 = 56.6`` s at P+ (printed 91 and 56) and the slower P- zero
+``-0.01747`` (printed ``-0.018``). ``a_2 = a_4 = 0.0572``, which the printed
+``0.057`` rounds, reproduces every printed time constant and zero of both
+settings (so does any value from about 0.05715 to 0.05725)."""
+
+
+@dataclass(frozen=True)
+class TankOperatingPoint:
+    """The steady state of the quadruple tank for given valves and pump voltages.
+
+    Attributes
+    ----------
+    gamma : tuple of float
+        The valve splits ``(gamma1, gamma2)``.
+    v0 : tuple of float
+        The pump voltages (V).
+    k : tuple of float
+        The pump gains (cm^3/(V s)).
+    flows : numpy.ndarray
+        The steady outflow of each tank, ``q_i = a_i sqrt(2 g h_i0)`` (cm^3/s).
+    h0 : numpy.ndarray
+        The steady levels (cm).
+    T : numpy.ndarray
+        The time constants ``T_i = (A_i / a_i) sqrt(2 h_i0 / g)`` (s).
+
+    Examples
+    --------
+    >>> from uio_teach import examples
+    >>> op = examples.tank_operating_point("P-")
+    >>> op.h0.round(2).tolist(), op.T.round(1).tolist()
+    ([12.26, 12.69, 1.63, 1.4], [62.4, 90.0, 22.8, 29.9])
+    """
+
+    gamma: tuple[float, float]
+    v0: tuple[float, float]
+    k: tuple[float, float]
+    flows: np.ndarray
+    h0: np.ndarray
+    T: np.ndarray
+
+
+def _positive_pair(name: str, value: Any) -> tuple[float, float]:
+    try:
+        pair = tuple(float(x) for x in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be two numbers (V), got {value!r}") from None
+    if len(pair) != 2 or isinstance(value, str) or not all(math.isfinite(x) for x in pair):
+        raise ValueError(f"{name} must be two finite numbers (V), got {value!r}")
+    if min(pair) <= 0:
+        raise ValueError(
+            f"{name} must be positive: a pump at 0 V leaves its upper tank empty, where the "
+            f"outflow sqrt(2 g h) has no linearization; got {value!r}"
+        )
+    return pair  # type: ignore[return-value]
+
+
+def tank_operating_point(
+    setting: str = "P-",
+    *,
+    gamma1: float | None = None,
+    gamma2: float | None = None,
+    v0: tuple[float, float] | None = None,
+) -> TankOperatingPoint:
+    """The steady state of the nonlinear quadruple tank: levels and time constants.
+
+    The mass balance of each tank (Johansson 2000, eq. (1))::
+
+        A1 dh1/dt = -a1 sqrt(2 g h1) + a3 sqrt(2 g h3) + g1 k1 v1
+        A2 dh2/dt = -a2 sqrt(2 g h2) + a4 sqrt(2 g h4) + g2 k2 v2
+        A3 dh3/dt = -a3 sqrt(2 g h3) + (1 - g2) k2 v2
+        A4 dh4/dt = -a4 sqrt(2 g h4) + (1 - g1) k1 v1
+
+    is at rest when every tank lets out what flows in: ``q3 = (1 - g2) k2 v2``,
+    ``q4 = (1 - g1) k1 v1``, ``q1 = g1 k1 v1 + q3``, ``q2 = g2 k2 v2 + q4``,
+    and ``h_i0 = (q_i / a_i)^2 / (2 g)``. The outlet areas are
+    :data:`TANK_OUTLETS`.
 
     Parameters
     ----------
     setting : {"P-", "P+"}
+        The paper's setting whose pump gains (and, unless given, valves and
+        pump voltages) are used.
+    gamma1, gamma2 : float, optional
+        The valve splits, from 0 (the whole flow to the upper tank) up to but
+        not including 1 (at 1 the upper tank on the other side is empty, and
+        its outflow has no linearization there).
+    v0 : pair of float, optional
+        The pump voltages (V), both positive.
+
+    Returns
+    -------
+    TankOperatingPoint
+
+    Raises
+    ------
+    ValueError
+        An unknown setting, a valve outside ``[0, 1)`` or a pump voltage not
+        positive, said in words.
+
+    Examples
+    --------
+    >>> from uio_teach import examples
+    >>> op = examples.tank_operating_point("P-", gamma1=0.43, gamma2=0.34)
+    >>> op.h0.round(2).tolist()
+    [12.08, 12.93, 4.45, 5.05]
+    """
+    pub = _tank_setting(setting)
+    g1 = _valve("gamma1", pub.gamma[0] if gamma1 is None else gamma1, upper=4)
+    g2 = _valve("gamma2", pub.gamma[1] if gamma2 is None else gamma2, upper=3)
+    v1, v2 = _positive_pair("v0", pub.v0 if v0 is None else v0)
+    k1, k2 = (float(x) for x in pub.k)
+    q3, q4 = (1 - g2) * k2 * v2, (1 - g1) * k1 * v1
+    flows = np.array([g1 * k1 * v1 + q3, g2 * k2 * v2 + q4, q3, q4])
+    a = np.asarray(TANK_OUTLETS)
+    g = float(pub.g)
+    h0 = (flows / a) ** 2 / (2 * g)
+    T = np.asarray(pub.A) / a * np.sqrt(2 * h0 / g)
+    for arr in (flows, h0, T):
+        arr.setflags(write=False)
+    return TankOperatingPoint((g1, g2), (v1, v2), (k1, k2), flows, h0, T)
+
+
+def tank_time_constants(
+    setting: str = "P-",
+    *,
+    gamma1: float | None = None,
+    gamma2: float | None = None,
+    v0: tuple[float, float] | None = None,
+) -> np.ndarray:
+    """The time constants ``T_i = (A_i / a_i) sqrt(2 h_i0 / g)`` at the steady state, in s.
+
+    The levels ``h_i0`` are those of :func:`tank_operating_point` for the
+    setting's pumps and the given (or the setting's) valves and voltages.
+
+    Parameters
+    ----------
+    setting : {"P-", "P+"}
+    gamma1, gamma2, v0 : optional
+        As for :func:`tank_operating_point`.
 
     Returns
     -------
@@ -264,14 +408,13 @@ def tank_time_constants(setting: str = "P-") -> np.ndarray:
     --------
     >>> from uio_teach import examples
     >>> examples.tank_time_constants("P+").round(1).tolist()
-    [63.2, 91.4, 39.0, 56.1]
+    [62.8, 91.3, 38.7, 56.2]
     """
-    pub = _tank_setting(setting)
-    return np.asarray(pub.A) / np.asarray(pub.a) * np.sqrt(2.0 * np.asarray(pub.h0) / pub.g)
+    return tank_operating_point(setting, gamma1=gamma1, gamma2=gamma2, v0=v0).T.copy()
 
 
 def _tank_setting(setting: str) -> Published:
-    if setting not in QUADRUPLE_TANK_PUBLISHED:
+    if not isinstance(setting, str) or setting not in QUADRUPLE_TANK_PUBLISHED:
         raise ValueError(
             f"setting must be one of {', '.join(map(repr, QUADRUPLE_TANK_PUBLISHED))}, "
             f"got {setting!r}"
@@ -279,27 +422,39 @@ def _tank_setting(setting: str) -> Published:
     return QUADRUPLE_TANK_PUBLISHED[setting]
 
 
-def _valve(name: str, value: Any) -> float:
+def _valve(name: str, value: Any, *, upper: int) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} must be a number between 0 and 1, got {value!r}")
+        raise ValueError(f"{name} must be a number from 0 up to (not including) 1, got {value!r}")
     value = float(value)
-    if not 0.0 < value < 1.0:
+    if not 0.0 <= value < 1.0:
+        if value == 1.0:
+            raise ValueError(
+                f"{name} = 1 sends the whole of pump {name[-1]}'s flow to lower tank {name[-1]}: "
+                f"upper tank {upper} is then empty, where its outflow sqrt(2 g h{upper}) has no "
+                f"linearization; take {name} below 1"
+            )
         raise ValueError(
-            f"{name} must lie strictly between 0 and 1 (the share of the pump's flow sent to "
-            f"the lower tank), got {value!r}"
+            f"{name} must lie from 0 up to (not including) 1 (the share of pump {name[-1]}'s "
+            f"flow sent to lower tank {name[-1]}), got {value!r}"
         )
     return value
 
 
 def quadruple_tank(
-    setting: str = "P-", *, gamma1: float | None = None, gamma2: float | None = None
+    setting: str = "P-",
+    *,
+    gamma1: float | None = None,
+    gamma2: float | None = None,
+    v0: tuple[float, float] | None = None,
 ) -> Plant:
     """The quadruple-tank process of Johansson (2000), linearized, both pump flows unknown.
 
-    States are the level deviations ``h_i - h_i0`` (cm) of the four tanks, the
-    outputs the two measured lower levels ``kc (h_1 - h_10)``, ``kc (h_2 - h_20)``
-    (V), the unknown inputs the two pump voltages' deviations (V), entering as
-    the paper's ``B`` (``E = B``; no known input)::
+    Linearized at its own steady state (:func:`tank_operating_point`) for the
+    valves and pump voltages given, or the setting's. States are the level
+    deviations ``h_i - h_i0`` (cm) of the four tanks, the outputs the two
+    measured lower levels ``kc (h_1 - h_10)``, ``kc (h_2 - h_20)`` (V), the
+    unknown inputs the two pump voltages' deviations (V), entering as the
+    paper's ``B`` (``E = B``; no known input)::
 
         A = [[-1/T1, 0, A3/(A1 T3), 0], [0, -1/T2, 0, A4/(A2 T4)],
              [0, 0, -1/T3, 0], [0, 0, 0, -1/T4]]
@@ -308,17 +463,20 @@ def quadruple_tank(
     with ``T_i`` from :func:`tank_time_constants`. The valves split each pump's
     flow between a lower tank (``gamma``) and the upper tank on the other side;
     the invariant zeros solve ``(1 + s T3)(1 + s T4) = (1-g1)(1-g2)/(g1 g2)``,
-    so one crosses into the right half-plane when ``g1 + g2 < 1``.
+    so one crosses into the right half-plane when ``g1 + g2 < 1``. A valve at
+    0 sends nothing to its lower tank: ``C E`` is singular and the rank
+    condition fails.
 
     Parameters
     ----------
     setting : {"P-", "P+"}
-        The operating point (levels, pump gains, valves) of the paper's
-        minimum-phase (``"P-"``, gamma 0.70, 0.60) or non-minimum-phase
-        (``"P+"``, gamma 0.43, 0.34) setting.
+        The paper's minimum-phase (``"P-"``, gamma 0.70, 0.60, 3.00 V) or
+        non-minimum-phase (``"P+"``, gamma 0.43, 0.34, 3.15 V) setting: its
+        pump gains, and its valves and voltages unless given.
     gamma1, gamma2 : float, optional
-        Other valve splits, strictly between 0 and 1; the operating point
-        stays the setting's (the valves change ``E`` only).
+        Other valve splits, from 0 up to (not including) 1.
+    v0 : pair of float, optional
+        Other pump voltages (V), both positive.
 
     Returns
     -------
@@ -327,7 +485,7 @@ def quadruple_tank(
     Raises
     ------
     ValueError
-        An unknown setting, or a valve split outside (0, 1).
+        An unknown setting, a valve outside ``[0, 1)``, a voltage not positive.
 
     Examples
     --------
@@ -338,16 +496,22 @@ def quadruple_tank(
     True
     >>> ut.check_existence(ut.examples.quadruple_tank("P+")).ok
     False
+    >>> ut.examples.quadruple_tank(gamma1=0.43, gamma2=0.34).name
+    'quadruple tank (P- pumps, gamma 0.43, 0.34)'
     """
     pub = _tank_setting(setting)
-    g1 = _valve("gamma1", pub.gamma[0] if gamma1 is None else gamma1)
-    g2 = _valve("gamma2", pub.gamma[1] if gamma2 is None else gamma2)
+    op = tank_operating_point(setting, gamma1=gamma1, gamma2=gamma2, v0=v0)
+    g1, g2 = op.gamma
     A1, A2, A3, A4 = (float(x) for x in pub.A)
-    k1, k2 = (float(x) for x in pub.k)
-    T1, T2, T3, T4 = tank_time_constants(setting)
+    k1, k2 = op.k
+    T1, T2, T3, T4 = op.T
     kc = float(pub.kc)
-    custom = (g1, g2) != tuple(float(x) for x in pub.gamma)
-    name = f"quadruple tank ({setting}" + (f" levels, gamma {g1:g}, {g2:g})" if custom else ")")
+    changed = []
+    if op.gamma != tuple(float(x) for x in pub.gamma):
+        changed.append(f"gamma {g1:g}, {g2:g}")
+    if op.v0 != tuple(float(x) for x in pub.v0):
+        changed.append(f"v0 {op.v0[0]:g}, {op.v0[1]:g} V")
+    name = f"quadruple tank ({setting}" + (f" pumps, {', '.join(changed)})" if changed else ")")
     return Plant(
         [
             [-1 / T1, 0, A3 / (A1 * T3), 0],

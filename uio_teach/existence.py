@@ -7,30 +7,34 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._display import LINE_WIDTH, fit_lines, format_poles
-from .balancing import BalancedPair, Scaling, balanced_pair, balanced_plant, plant_scaling
+from . import tolerances as tols
+from ._display import LINE_WIDTH, fit_lines, format_complex
+from .balancing import (
+    BalancedPair,
+    Scaling,
+    balanced_pair,
+    balanced_plant,
+    modes_agree,
+    plant_scaling,
+)
 from .errors import UIOTeachError
 from .linalg import (
-    DROP_MARGIN,
-    MARGIN,
     ObservabilitySplit,
+    ZeroSet,
     checked_zeros,
-    is_stable,
     left_null,
     one_blas_thread,
     pinv,
     rank_decision,
-    sort_poles,
 )
 from .plant import Plant, check_plant
-from .verify import IDENTITY_RTOL, product_bound, relative_residual
+from .verify import product_bound, relative_residual
 
 __all__ = [
     "Condition",
     "Decoupling",
     "ExistenceReport",
     "UIOExistenceError",
-    "boundary_note",
     "check_existence",
     "decoupling",
     "detectability_conditions",
@@ -62,8 +66,9 @@ class Condition:
     margin: float | None = None
     """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
     rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
-    threshold, that ratio (threshold / dropped value); below ``uio_teach.linalg.MARGIN`` the
-    verdict hangs on round-off and the reason says so. A rank-0 verdict carries it too."""
+    threshold, that ratio (threshold / dropped value); below
+    ``uio_teach.tolerances.RANK_MARGIN`` the verdict hangs on round-off and the reason says
+    so. A rank-0 verdict carries it too."""
     undecided: bool = False
     """True when the verdict cannot be decided at this precision (``holds`` is then ``None``
     and the reason says why)."""
@@ -71,7 +76,7 @@ class Condition:
     @property
     def marginal(self) -> bool:
         """True when the verdict sits within the numerical margin of the rank threshold."""
-        return self.margin is not None and self.margin < MARGIN
+        return self.margin is not None and self.margin < tols.RANK_MARGIN
 
     @property
     def symbol(self) -> str:
@@ -117,6 +122,7 @@ def decoupling(
     Mv: np.ndarray | None = None,
     scaling: Scaling | None = None,
     zeros: np.ndarray | None = None,
+    radius: np.ndarray | None = None,
 ) -> Decoupling:
     """Compute ``M``, ``A1`` and the balanced pair ``(A1, N C)`` (rank condition assumed).
 
@@ -132,6 +138,9 @@ def decoupling(
         The plant's invariant zeros (``check_existence(plant).invariant_zeros``):
         the fixed modes of the pair are made to agree with them (see
         :func:`uio_teach.balancing.balanced_pair`).
+    radius : array_like, optional
+        How far round-off moves each zero (``ZeroSet.radius``): a repeated zero's fixed modes
+        agree with it within that radius.
 
     Returns
     -------
@@ -153,7 +162,7 @@ def decoupling(
         M = M + Mv @ (np.eye(p) - G @ pinv(G))
     A1 = (np.eye(n) - M @ plant.C) @ plant.A
     N = left_null(plant.D)
-    pair = balanced_pair(A1, plant.C, plant.D, scaling, zeros)
+    pair = balanced_pair(A1, plant.C, plant.D, scaling, zeros, radius)
     return Decoupling(M=M, A1=A1, N=N, pair=pair)
 
 
@@ -182,7 +191,10 @@ def projection_gain(plant: Plant, scaling: Scaling | None = None) -> np.ndarray:
         if np.all(np.isfinite(G)):
             M = Eb @ pinv(G)
             bound = product_bound((M, G), Eb)
-            if np.all(np.isfinite(M)) and relative_residual(M @ G - Eb, bound) <= IDENTITY_RTOL:
+            if (
+                np.all(np.isfinite(M))
+                and relative_residual(M @ G - Eb, bound) <= tols.IDENTITY_RTOL
+            ):
                 return M
     s = plant_scaling(plant) if scaling is None else scaling
     bal, _ = balanced_plant(plant, s)
@@ -226,6 +238,13 @@ class ExistenceReport:
     invariant_zeros: np.ndarray
     fixed_modes: np.ndarray
     movable: int = field(default=0)
+    zero_set: ZeroSet | None = None
+    """The zeros with their radii and distances (:func:`uio_teach.linalg.checked_zeros`)."""
+
+    @property
+    def zero_radius(self) -> np.ndarray | None:
+        """How far round-off of the data can move each invariant zero (``None``: not computed)."""
+        return None if self.zero_set is None else self.zero_set.radius
 
     @property
     def ok(self) -> bool:
@@ -299,67 +318,28 @@ class UIOExistenceError(UIOTeachError, ValueError):
         super().__init__(f"cannot design {what} for {report.plant!r}: {reasons}")
 
 
-RANK_RTOL = 100.0
-"""The rank condition's thresholds are ``RANK_RTOL * eps`` (``RANK_RTOL * n * eps`` for the
-product ``C E``) times the size of the balanced data: round-off stays well below them."""
-
-AMPLIFICATION_LIMIT = 1e6
-"""Above this, the report says that any UIO of the plant amplifies round-off: ``H`` with
-``H C E = E`` has ``||H|| ||C|| >= ||E|| ||C|| / ||C E||``-sized entries (a small ``C E``)."""
-
-ZERO_MARGIN = 1e-6
-"""A zero or fixed mode closer than this (relative to ``max(1, ||A||)`` in balanced units) to
-the stability boundary is reported as marginal: round-off of the data could move it across."""
-
-
-def boundary_note(
-    values: np.ndarray, discrete: bool, size: float, radius: np.ndarray | None = None
-) -> str:
-    """A note for values within the numerical margin of the stability boundary.
-
-    Parameters
-    ----------
-    values : array_like of complex
-        Zeros or modes.
-    discrete : bool
-        Judge against the unit circle (True) or the imaginary axis.
-    size : float
-        The size of the plant's balanced ``A``; the margin is
-        ``ZERO_MARGIN * max(1, size)``.
-    radius : array_like, optional
-        For each value, how far round-off of the data can move it
-        (:class:`uio_teach.linalg.ZeroSet`): a value farther from the boundary than ``MARGIN``
-        times that (plus ``ZERO_MARGIN`` of its own size) gets no note.
-
-    Returns
-    -------
-    str
-        Empty when no value is that close.
-
-    Examples
-    --------
-    >>> from uio_teach.existence import boundary_note
-    >>> boundary_note([-1e-9, -1.0], discrete=False, size=1.0)[:28]
-    ' (within the numerical margi'
-    """
-    if not len(values):
-        return ""
+def _listed(values: np.ndarray, radius: np.ndarray | None = None) -> str:
+    """Values on their own scale, a cluster within its radius (a repeated zero) once with ``xk``."""
     values = np.asarray(values, complex)
-    dist = np.abs(np.abs(values) - 1.0) if discrete else np.abs(values.real)
-    close = dist <= ZERO_MARGIN * max(1.0, float(size))
-    if radius is not None and len(radius) == len(values):
-        # a zero far from the boundary compared with how far round-off can move it is clear
-        close &= dist <= MARGIN * np.asarray(radius, float) + ZERO_MARGIN * np.maximum(
-            1.0, np.abs(values)
-        )
-    if not np.any(close):
-        return ""
-    where = "unit circle" if discrete else "imaginary axis"
-    return (
-        f" (within the numerical margin: {format_poles(values[close], braces=True)} lie(s) "
-        f"{float(np.max(dist[close])):.2g} from the {where}, so round-off of the data could "
-        "change this verdict)"
-    )
+    if not values.size:
+        return "none"
+    radius = np.zeros(values.size) if radius is None else np.asarray(radius, float)
+    parts, used = [], np.zeros(values.size, bool)
+    for i in range(values.size):
+        if used[i]:
+            continue
+        reach = max(float(radius[i]), 0.0) if np.isfinite(radius[i]) else 0.0
+        group = ~used & (np.abs(values - values[i]) <= 2 * np.maximum(reach, radius))
+        group[i] = True
+        if np.sum(group) > 1 and not np.all(np.isfinite(radius[group])):
+            group[:] = False
+            group[i] = True
+        used |= group
+        k = int(np.sum(group))
+        centre = complex(np.mean(values[group]))
+        text = format_complex(centre)
+        parts.append(f"{text} (x{k})" if k > 1 else text)
+    return "{" + ", ".join(parts) + "}"
 
 
 def _pair_name(plant: Plant) -> str:
@@ -371,7 +351,7 @@ def _region(discrete: bool) -> str:
 
 
 def _margin_note(margin: float, what: str = "a singular value") -> str:
-    if margin >= MARGIN:
+    if margin >= tols.RANK_MARGIN:
         return ""
     return (
         f" (within the numerical margin: {what} is only {margin:.3g} times "
@@ -406,9 +386,10 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     # data known to double precision; C E is a sum of n products, so its round-off
     # grows with n: the thresholds leave room for it (RANK_RTOL)
     eps = np.finfo(float).eps
-    dE, dD = rank_decision(E, rtol=RANK_RTOL * eps), rank_decision(D, rtol=RANK_RTOL * eps)
+    rtol = tols.RANK_RTOL * eps
+    dE, dD = rank_decision(E, rtol=rtol), rank_decision(D, rtol=rtol)
     dG = rank_decision(
-        np.hstack([C @ E, D]), scale=max(nC * nE, nD), rtol=RANK_RTOL * max(bal.n, 1) * eps
+        np.hstack([C @ E, D]), scale=max(nC * nE, nD), rtol=tols.RANK_RTOL * max(bal.n, 1) * eps
     )
     rE, rD, rG = dE.rank, dD.rank, dG.rank
     margin = min(dE.margin, dD.margin, dG.margin)
@@ -426,7 +407,7 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
             "at once, so it cannot be cancelled"
         )
     note = _margin_note(margin)
-    if below < DROP_MARGIN:
+    if below < tols.DROP_MARGIN:
         note += (
             f" (within the numerical margin: a singular value taken as 0 is only {below:.3g} "
             "times below the rank threshold, so round-off of the data could change this "
@@ -437,166 +418,165 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     return cond, rE
 
 
-def zero_condition(
-    zeros: np.ndarray,
-    discrete: bool,
-    size: float,
-    doubtful: np.ndarray | None = None,
-    residuals: np.ndarray | None = None,
-    radius: np.ndarray | None = None,
-) -> Condition:
-    """The condition "invariant zeros stable" for the given zeros.
+def zero_condition(zs: ZeroSet) -> Condition:
+    """The condition "invariant zeros stable", decided from the zeros and their radii.
 
-    ``doubtful`` lists values that are zeros of plants within round-off of the data but not
-    certainly of this one (:class:`uio_teach.linalg.ZeroSet`), with ``residuals`` the
-    Rosenbrock matrix's smallest singular value there relative to the round-off threshold. When
-    such a value, or a zero within the numerical margin of the stability boundary, would change
-    the verdict, the condition is not decided (``holds=None``) and the reason says why.
+    A zero is on a side of the stability boundary when no perturbation of the data within the
+    backward error of the computation (:class:`uio_teach.linalg.ZeroSet`) moves it across: the
+    verdict is "no" when one zero is certainly outside the stability region, "cannot be
+    decided" when a perturbation within that bound can move a zero across the boundary (or
+    through infinity), and the reason then says the bound and the distance.
+
+    Parameters
+    ----------
+    zs : ZeroSet
+        The zeros, from :func:`uio_teach.linalg.checked_zeros`.
+
+    Returns
+    -------
+    Condition
 
     Examples
     --------
     >>> import numpy as np
-    >>> zero_condition(np.array([-1.0 + 0j]), discrete=False, size=1.0).holds
+    >>> from uio_teach.linalg import checked_zeros
+    >>> zs = checked_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]])
+    >>> zero_condition(zs).holds
     True
     """
-    region = _region(discrete)
-    doubtful = np.zeros(0, complex) if doubtful is None else np.asarray(doubtful, complex)
-    zeros = np.asarray(zeros, complex)
-    undecided = _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius)
-    if undecided:
-        return Condition("invariant zeros stable", None, undecided, margin=1.0, undecided=True)
-    if not len(zeros):
-        return Condition("invariant zeros stable", True, "no invariant zeros")
-    bad = zeros[~is_stable(zeros, discrete)]
-    note = boundary_note(zeros, discrete, size, radius)
-    listed = format_poles(zeros if not len(bad) else bad, braces=True, empty="none")
-    if not len(bad):
+    name = "invariant zeros stable"
+    discrete, region = zs.discrete, _region(zs.discrete)
+    where = "unit circle" if discrete else "imaginary axis"
+    zeros, und, stable = zs.zeros, zs.undecided, zs.stable
+    bound = f"{zs.backward_error:.1g}"
+    bad = ~stable & ~und
+    if np.any(bad):
         return Condition(
-            "invariant zeros stable", True, f"zeros {listed} all lie in {region}" + note
+            name,
+            False,
+            f"invariant zero(s) {_listed(zeros[bad], zs.radius[bad])} outside {region}: they "
+            "are observer poles no gain can move, so the error would not decay"
+            + _clear_note(zs, bad, where),
         )
+    parts = []
+    far = zs.unresolved
+    if np.any(far):
+        parts.append(
+            f"zero(s) {_listed(zeros[far])} lie beyond what double precision resolves: a "
+            f"perturbation of the data within its backward error ({bound} relative) sends them "
+            "through infinity, so they may lie on either side or not exist"
+        )
+    near = und & ~far
+    for z, r, d in zip(zeros[near], zs.radius[near], zs.distance[near], strict=True):
+        parts.append(
+            f"zero {format_complex(z)} lies {d:.2g} from the {where}, and a perturbation of the "
+            f"data within its backward error ({bound} relative) moves it by up to {r:.2g}, "
+            "across"
+        )
+    if zs.lost:
+        parts.append(
+            f"{zs.lost} zero(s) sit at infinity by a rank decision within round-off: a plant "
+            f"within {bound} (relative) of the data has them finite and fast, on either side"
+        )
+    if zs.crossing and not parts:
+        parts.append(
+            f"a plant within the data's backward error ({bound} relative) has an invariant zero "
+            f"on the {where}"
+        )
+    if parts:
+        return Condition(
+            name,
+            None,
+            "cannot be decided at this precision: " + "; ".join(parts),
+            margin=1.0,
+            undecided=True,
+        )
+    if not len(zeros):
+        return Condition(name, True, "no invariant zeros")
     return Condition(
-        "invariant zeros stable",
-        False,
-        f"invariant zero(s) {listed} outside {region}: they are observer poles "
-        "no gain can move, so the error would not decay" + note,
+        name,
+        True,
+        f"zeros {_listed(zeros, zs.radius)} all lie in {region}"
+        + _clear_note(zs, np.ones(zeros.size, bool), where),
     )
 
 
-def _undecided_zeros(zeros, discrete, size, doubtful, residuals, radius=None) -> str:
-    """Why the zero condition cannot be decided at this precision ('' when it can)."""
-    stable = is_stable(zeros, discrete)
-    dist = np.abs(np.abs(zeros) - 1.0) if discrete else np.abs(zeros.real)
-    if radius is not None and len(radius) == len(zeros):
-        # how far round-off of the data can move each zero (its condition number)
-        near = dist <= np.asarray(radius, float)
-    else:
-        near = dist <= ZERO_MARGIN * max(1.0, float(size))
-    if np.all(stable):
-        # the verdict "stable" would change with a doubtful unstable value or a zero on the edge
-        flip = doubtful[~is_stable(doubtful, discrete)] if doubtful.size else doubtful
-        edge = zeros[near]
-    else:
-        # "unstable" is certain when one unstable zero is certain and clear of the boundary
-        if np.any(~stable & ~near):
-            return ""
-        flip, edge = np.zeros(0, complex), zeros[~stable]
-    if not flip.size and not edge.size:
+def _clear_note(zs: ZeroSet, mask: np.ndarray, where: str) -> str:
+    """For the zero closest to the boundary among ``mask``: its distance and its radius.
+
+    Said only when it is close (within ``CLOSE_NOTE_RTOL`` of the system's own rate or of the
+    largest zero): the verdict is decided, and the note shows by how much.
+    """
+    d, r, z = zs.distance[mask], zs.radius[mask], zs.zeros[mask]
+    finite = np.abs(zs.zeros[np.isfinite(zs.zeros)])
+    if not d.size or not finite.size:
         return ""
-    where = "unit circle" if discrete else "imaginary axis"
-    parts = []
-    if flip.size:
-        res = np.asarray(residuals if residuals is not None else [], float)
-        how = (
-            f" (singular to {float(np.min(res)):.2g} times the round-off threshold)"
-            if res.size
-            else ""
-        )
-        parts.append(
-            f"{format_poles(flip, braces=True)} outside {_region(discrete)} is an invariant zero "
-            f"of a plant within round-off of the data{how}, not certainly of this one"
-        )
-    if edge.size:
-        parts.append(
-            f"zero(s) {format_poles(edge, braces=True)} lie within round-off of the {where}"
-        )
-    return "cannot be decided at this precision: " + "; ".join(parts)
-
-
-def _agreeing_modes(fixed: np.ndarray, zeros: np.ndarray, scale: float) -> bool:
-    """True when the fixed modes are the invariant zeros (same count, matched values)."""
-    if len(fixed) != len(zeros):
-        return False
-    if not len(fixed):
-        return True
-    cost = np.abs(fixed[:, None] - zeros[None, :])
-    return bool(np.all(np.min(cost, axis=1) <= 1e-5 * max(1.0, scale)))
+    i = int(np.argmin(d))
+    if not d[i] <= tols.CLOSE_NOTE_RTOL * max(float(np.max(finite)), zs.scale):
+        return ""
+    return (
+        f" (the closest, {format_complex(z[i])}, lies {d[i]:.2g} from the {where}; a "
+        f"perturbation of the data within its backward error moves it by at most {r[i]:.2g})"
+    )
 
 
 def detectability_conditions(
-    plant: Plant,
-    dec: Decoupling,
-    zeros: np.ndarray,
-    size: float,
-    zero_cond: Condition | None = None,
+    plant: Plant, dec: Decoupling, zs: ZeroSet, zero_cond: Condition
 ) -> tuple[list[Condition], np.ndarray, int]:
     """Detectability and observability of the pair the designs use (rank condition holds).
 
-    The fixed modes are the unobservable modes of the balanced pair; in exact
-    arithmetic they are the invariant zeros. When the two computations do not
-    agree, the verdict hangs on round-off and the reasons say so.
+    The fixed modes are the unobservable modes of the balanced pair; in exact arithmetic they
+    are the invariant zeros, so detectability is decided as the zeros' stability is
+    (``zero_cond``), and the number of movable poles is ``n`` minus the number of zeros, counted
+    by the pencil's structure: the report and every design agree on it.
 
     Returns
     -------
     (list of Condition, numpy.ndarray, int)
         The two conditions, the fixed modes and the number of movable poles.
     """
-    discrete, region, pair = plant.is_discrete, _region(plant.is_discrete), _pair_name(plant)
+    pair = _pair_name(plant)
+    zeros = zs.zeros
     fixed, movable = dec.pair.fixed_modes, dec.pair.movable
-    unstable = fixed[~is_stable(fixed, discrete)]
     margin = dec.pair.split.margin
-    note = boundary_note(fixed, discrete, size) + _margin_note(
-        margin, "a singular value of the observability staircase"
-    )
-    if not _agreeing_modes(fixed, zeros, dec.pair.sigma):
-        # in exact arithmetic the fixed modes are the invariant zeros; the zeros are computed
-        # with every decision checked (uio_teach.linalg.checked_zeros), the staircase is not
-        found = format_poles(fixed, braces=True, empty="none")
-        if zero_cond is None:
-            zero_cond = zero_condition(zeros, discrete, size)
-        listed_zeros = format_poles(zeros, braces=True, empty="none")
-        why = (
-            f"the fixed modes are the invariant zeros {listed_zeros}"
-            f" (the observability staircase of {pair} finds {found}: its rank decisions do not "
-            "resolve them)"
+    note = _margin_note(margin, "a singular value of the observability staircase")
+    if not modes_agree(fixed, zeros, zs.radius):
+        # the zeros are counted from the pencil's structure; the staircase of the pair did not
+        # resolve them (a repeated zero, a fast one): the zeros are the fixed modes
+        note = (
+            f" (the observability staircase of {pair} finds "
+            f"{_listed(fixed)}: its rank decisions do not resolve them)"
         )
+        fixed, movable, margin = zeros, plant.n - len(zeros), min(margin, 1.0)
+    near = [int(np.argmin(np.abs(zeros - f))) for f in fixed]
+    listed = _listed(fixed, zs.radius[near] if len(near) else None)
+    if zero_cond.undecided:
         det = Condition(
             f"detectable {pair}",
-            zero_cond.holds,
-            why,
-            margin=min(margin, 1.0),
-            undecided=zero_cond.undecided,
+            None,
+            "cannot be decided at this precision: the fixed modes are the invariant zeros "
+            f"{_listed(zeros, zs.radius)}, whose side of the boundary round-off decides" + note,
+            margin=margin,
+            undecided=True,
         )
-        obs = Condition(f"observable {pair}", not len(zeros), why, required=False, margin=1.0)
-        return [det, obs], zeros, plant.n - len(zeros)
-    listed = format_poles(fixed if not len(unstable) else unstable, braces=True, empty="none")
-    if not len(unstable):
-        reason = (
-            f"unobservable modes {listed} lie in {region}"
-            if len(fixed)
-            else "observable, hence detectable"
+    elif zero_cond.holds:
+        reason = f"unobservable modes {listed} are the invariant zeros, all stable"
+        det = Condition(
+            f"detectable {pair}",
+            True,
+            (reason if len(fixed) else "observable, hence detectable") + note,
+            margin=margin,
         )
-        det = Condition(f"detectable {pair}", True, reason + note, margin=margin)
     else:
         det = Condition(
             f"detectable {pair}",
             False,
-            f"unobservable mode(s) {listed} outside {region}" + note,
+            f"unobservable modes {listed} are the invariant zeros, not all stable" + note,
             margin=margin,
         )
     if len(fixed):
-        all_fixed = format_poles(fixed, braces=True, empty="none")
         reason = (
-            f"{movable} of {plant.n} poles can be placed; {all_fixed} are fixed "
+            f"{movable} of {plant.n} poles can be placed; {listed} are fixed "
             "(they are the invariant zeros)"
         )
     else:
@@ -612,9 +592,10 @@ def conditioning_condition(bal: Plant) -> Condition:
 
     Every UIO has ``H`` with ``H C E = E`` and ``T = I - H C``; the smallest such ``H`` is
     ``E (C E)^+``, so the decoupling multiplies the data's round-off by at least
-    ``||E|| ||C|| / sigma_min(C E)`` (in balanced units). Above ``AMPLIFICATION_LIMIT`` the UIO
-    exists but is ill-conditioned: its matrices hold their identities only to that many
-    rounding errors, and a design's check says how much the result leaks.
+    ``||E|| ||C|| / sigma_min(C E)`` (in balanced units). Above ``AMPLIFICATION_LIMIT``
+    (:mod:`uio_teach.tolerances`) the UIO exists but is ill-conditioned: its matrices hold
+    their identities only to that many rounding errors, and a design's check says how much
+    the result leaks.
 
     Examples
     --------
@@ -631,7 +612,7 @@ def conditioning_condition(bal: Plant) -> Condition:
     smin = float(s[rG - 1]) if rG else 0.0
     top = float(np.linalg.norm(E, 2) * np.linalg.norm(C, 2)) if E.size and C.size else 0.0
     amp = top / smin if smin > 0 else np.inf
-    ok = bool(amp <= AMPLIFICATION_LIMIT)
+    ok = bool(amp <= tols.AMPLIFICATION_LIMIT)
     if ok:
         reason = f"any UIO amplifies round-off by about {amp:.2g} at most"
     else:
@@ -688,35 +669,21 @@ def check_existence(plant: Plant) -> ExistenceReport:
     plant = check_plant(plant)
     discrete = plant.is_discrete
     bal, scaling = balanced_plant(plant, time=True)
-    sigma = scaling.sigma
-    size = sigma * (float(np.linalg.norm(bal.A, 2)) if plant.n else 0.0)
     rank_cond, rE = rank_condition(bal)
     conds = [rank_cond]
-    Bz = np.hstack([bal.E, np.zeros((plant.n, plant.nv))])
-    Dz = np.hstack([np.zeros((plant.p, plant.q)), bal.D])
-    zs = checked_zeros(bal.A, Bz, bal.C, Dz)
-    zeros = sort_poles(zs.zeros * sigma)
-    conds.append(
-        zero_condition(zeros, discrete, size, zs.doubtful * sigma, zs.residuals, zs.radius * sigma)
-    )
+    # the zeros in the plant's own time unit (the states, inputs and outputs balanced)
+    bal0, _ = balanced_plant(plant, scaling)
+    Bz = np.hstack([bal0.E, np.zeros((plant.n, plant.nv))])
+    Dz = np.hstack([np.zeros((plant.p, plant.q)), bal0.D])
+    zs = checked_zeros(bal0.A, Bz, bal0.C, Dz, discrete=discrete)
+    zero_cond = zero_condition(zs)
+    conds.append(zero_cond)
+    zeros = zs.zeros
     fixed = np.zeros(0, complex)
     movable = 0
     if rank_cond.holds:
-        more, fixed, movable = detectability_conditions(
-            plant, decoupling(plant, scaling=scaling, zeros=zeros), zeros, size, conds[-1]
-        )
-        det = more[0]
-        if conds[-1].undecided and not det.undecided:
-            # in exact arithmetic the fixed modes are the invariant zeros: detectability is no
-            # more certain than the zeros' stability
-            more[0] = Condition(
-                det.name,
-                None,
-                "cannot be decided at this precision: it is the stability of the invariant "
-                f"zeros, which round-off decides ({det.reason})",
-                margin=det.margin,
-                undecided=True,
-            )
+        dec = decoupling(plant, scaling=scaling, zeros=zeros, radius=zs.radius)
+        more, fixed, movable = detectability_conditions(plant, dec, zs, zero_cond)
         conds.extend(more)
     else:
         why = "not evaluated: the rank condition fails"
@@ -739,4 +706,5 @@ def check_existence(plant: Plant) -> ExistenceReport:
         invariant_zeros=zeros,
         fixed_modes=fixed,
         movable=movable,
+        zero_set=zs,
     )

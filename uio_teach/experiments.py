@@ -1,50 +1,35 @@
-"""The course's worked experiments, each defined once: the runs behind the figures and explorers.
+"""What every worked experiment shares: the base class, the field declarations, the lab plants.
 
 An experiment is what the book simulates for one plant of :mod:`uio_teach.examples`:
 the time grid, the known input, the unknown inputs, the initial state, the
-observer poles, where the observer starts and the measurement noise. The
-figures of ``uio-teach figures``, the explorers and the lab checks read these
-values from here, so changing one (say the PA9 initial state) changes every
-figure, explorer and lab that uses it.
+observer poles, where the observer starts and the measurement noise. Each
+worked example defines its own in its module of :mod:`uio_teach.worked`
+(``uio_teach.worked.pa9.PA9``, ``uio_teach.worked.case_study.CASE_STUDY``,
+``uio_teach.worked.missile.MISSILE``,
+``uio_teach.worked.quadruple_tank.QUADRUPLE_TANK``); :data:`EXPERIMENTS` holds
+them all, read from :data:`uio_teach.worked.WORKED`. The figures of
+``uio-teach figures``, the explorers and the lab checks read their values from
+there, so changing one (say the PA9 initial state) changes every figure,
+explorer and lab that uses it.
 
-* :data:`PA9` -- Practical Assignment 9: the decoupling UIO with the poles
-  ``-1, -2, -3``, a sinusoidal and a piecewise-constant disturbance;
-* :data:`CASE_STUDY` -- the discrete-time case study: the projection-operator
-  observer (gain from the LMI), the unknown state input ``u2`` and a random
-  staircase ``v``;
-* :data:`MISSILE` -- the missile autopilot of De, Banerjee and Das: the PMO with
-  the poles ``-100, -120``, the paper's unknown inputs ``v1, v2`` and initial
-  state, the observer started at ``q(0) = -M C x(0)`` (so ``xhat(0) = 0``).
-
-A worked example added later keeps its experiment beside its registry entry (the quadruple
-tank's is :data:`uio_teach.worked.quadruple_tank.QUADRUPLE_TANK`); :data:`EXPERIMENTS` holds
-them all, read from :data:`uio_teach.worked.WORKED`.
-
-Each is a frozen dataclass; :meth:`Experiment.simulate` runs an observer on it
-with :func:`uio_teach.simulate`. The numbers an instructor may change are
-fields declared once with :func:`param` (type, unit, help, bounds, range): the
-term config (``uio_teach.instructor.config``), the lab parameters
-(:mod:`uio_teach.instructor.lab_params`) and the explorers' ranges are derived
-from these declarations (:func:`experiment_params`), so a new field is one
-line here. :func:`plant_from_params` gives a lab's plant, the course's or a
-group's own.
+Each is a frozen dataclass derived from :class:`Experiment`;
+:meth:`Experiment.simulate` runs an observer on it with
+:func:`uio_teach.simulate`. The numbers an instructor may change are fields
+declared once with :func:`param` (type, unit, help, bounds, range): the term
+config (``uio_teach.instructor.config``), the lab parameters
+(:mod:`uio_teach.lab_params`) and the explorers' controls are derived from
+these declarations (:func:`experiment_params`), so a new field is one line.
+:func:`plant_from_params` gives a lab's plant, the course's or a group's own.
 
 Examples
 --------
->>> import uio_teach as ut
->>> from uio_teach.experiments import PA9
->>> PA9.initial_state.tolist(), PA9.poles
+>>> from uio_teach.experiments import EXPERIMENTS
+>>> EXPERIMENTS["pa9"].initial_state.tolist(), EXPERIMENTS["pa9"].poles
 ([1.0, -1.0, 0.5], (-1.0, -2.0, -3.0))
->>> observer = ut.design_uio(PA9.plant(), poles=PA9.poles)
->>> sine = PA9.simulate(observer, d=PA9.d_sine)
->>> steps = PA9.simulate(observer, d=PA9.d_piecewise)
->>> bool(abs(sine.error - steps.error).max() < 1e-8)   # the UIO ignores d
-True
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
 from types import MappingProxyType
@@ -52,7 +37,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from . import examples, signals
 from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
@@ -60,12 +44,6 @@ from .worked import WORKED
 
 __all__ = [
     "Experiment",
-    "PA9Experiment",
-    "CaseStudyExperiment",
-    "MissileExperiment",
-    "PA9",
-    "CASE_STUDY",
-    "MISSILE",
     "EXPERIMENTS",
     "Param",
     "param",
@@ -86,7 +64,7 @@ class Param:
     """What the course knows about one field of an experiment: the one declaration of it.
 
     The term config (``uio_teach.instructor.config``), the lab parameters
-    (:mod:`uio_teach.instructor.lab_params`) and the explorers
+    (:mod:`uio_teach.lab_params`) and the explorers
     (``uio_teach.explorers.scenarios``) read their keys, types, bounds,
     help texts and ranges from these declarations, attached to the fields of
     the experiment dataclasses with :func:`param`; adding a field to an
@@ -135,7 +113,8 @@ class Param:
 
     Examples
     --------
-    >>> from uio_teach.experiments import PA9, experiment_params
+    >>> from uio_teach.experiments import experiment_params
+    >>> from uio_teach.worked.pa9 import PA9
     >>> spec = dict(experiment_params(PA9))["sine_frequency"]
     >>> spec.key, spec.unit, spec.config_key("pa9")
     ('sine.frequency', 'rad/s', 'pa9.sine.frequency')
@@ -214,7 +193,8 @@ def param(default: Any, kind: str, doc: str, **options: Any) -> Any:
     Examples
     --------
     >>> import dataclasses
-    >>> from uio_teach.experiments import PA9Experiment, param
+    >>> from uio_teach.experiments import param
+    >>> from uio_teach.worked.pa9 import PA9Experiment
     >>> @dataclasses.dataclass(frozen=True)
     ... class Heavier(PA9Experiment):
     ...     gain: float = param(2.0, "float", "a gain of the known input", positive=True)
@@ -251,7 +231,8 @@ def experiment_params(experiment: Any) -> tuple[tuple[str, Param], ...]:
 
     Examples
     --------
-    >>> from uio_teach.experiments import MISSILE, experiment_params
+    >>> from uio_teach.experiments import experiment_params
+    >>> from uio_teach.worked.missile import MISSILE
     >>> [name for name, spec in experiment_params(MISSILE) if spec.lab]
     ['poles', 'duration', 'samples', 'style', 'matrices', 'noise_sigma', 'noise_seed', 'tol']
     """
@@ -353,7 +334,7 @@ class Experiment:
 
     Examples
     --------
-    >>> from uio_teach.experiments import MISSILE
+    >>> from uio_teach.worked.missile import MISSILE
     >>> MISSILE.name, MISSILE.duration, MISSILE.timepts.size
     ('missile', 0.5, 10001)
     """
@@ -405,7 +386,7 @@ class Experiment:
 
         Examples
         --------
-        >>> from uio_teach.experiments import PA9
+        >>> from uio_teach.worked.pa9 import PA9
         >>> PA9.plant().name
         'PA9'
         >>> PA9.with_values(matrices={"E": [[1], [0], [0]]}).plant().E.ravel().tolist()
@@ -431,7 +412,7 @@ class Experiment:
 
         Examples
         --------
-        >>> from uio_teach.experiments import PA9
+        >>> from uio_teach.worked.pa9 import PA9
         >>> PA9.grid(samples=5).tolist()
         [0.0, 2.5, 5.0, 7.5, 10.0]
         """
@@ -456,7 +437,7 @@ class Experiment:
 
         Examples
         --------
-        >>> from uio_teach.experiments import PA9
+        >>> from uio_teach.worked.pa9 import PA9
         >>> run = PA9.with_values(duration=5.0, samples=11, sine_amplitude=2.0)
         >>> run.timepts[-1], run.timepts.size, run.sine_amplitude, PA9.duration
         (np.float64(5.0), 11, 2.0, 10.0)
@@ -486,7 +467,7 @@ class Experiment:
 
         Examples
         --------
-        >>> from uio_teach.experiments import PA9
+        >>> from uio_teach.worked.pa9 import PA9
         >>> PA9.measurement_disturbance() is None
         True
         """
@@ -506,7 +487,7 @@ class Experiment:
 
         Examples
         --------
-        >>> from uio_teach.experiments import PA9
+        >>> from uio_teach.worked.pa9 import PA9
         >>> PA9.observer_state(None) is None
         True
         """
@@ -535,7 +516,7 @@ class Experiment:
         Examples
         --------
         >>> import uio_teach as ut
-        >>> from uio_teach.experiments import CASE_STUDY
+        >>> from uio_teach.worked.case_study import CASE_STUDY
         >>> pmo = ut.design_pmo(CASE_STUDY.plant(), method="lmi")
         >>> CASE_STUDY.simulate(pmo).error.shape
         (3, 41)
@@ -558,399 +539,6 @@ class Experiment:
         kwargs.update(changes)
         timepts = kwargs.pop("timepts")
         return simulate(self.plant(), observer, timepts, **kwargs)
-
-
-@dataclass(frozen=True)
-class PA9Experiment(Experiment):
-    """Practical Assignment 9: the decoupling UIO, a sinusoidal and a piecewise-constant ``d``.
-
-    Attributes
-    ----------
-    sine_amplitude : float
-        Amplitude of the sinusoidal disturbance ``d(t) = amplitude sin(frequency t)``.
-    sine_frequency : float
-        Its angular frequency (rad/s).
-    switch_times : tuple of float
-        The piecewise-constant disturbance: the times it switches (0 before the first).
-    switch_values : tuple of float
-        The level held from each switching time.
-
-    Examples
-    --------
-    >>> from uio_teach.experiments import PA9
-    >>> PA9.d_sine, PA9.d_piecewise
-    (1 sin(2 t), piecewise constant (1 from t=0, -1.5 from t=2, 2 from t=5, 0 from t=7.5))
-    >>> PA9.inputs
-    [1 step(t - 0); 0.5 sin(1 t)]
-    """
-
-    lab: ClassVar[str] = "pa9"
-    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
-        {
-            "": "Practical Assignment 9: the decoupling observer and its lab",
-            "sine": "the sinusoidal disturbance",
-            "piecewise": "the piecewise-constant disturbance (0 before the first switching time)",
-        }
-    )
-
-    initial_state: np.ndarray = param(
-        (1.0, -1.0, 0.5), "floats", "plant state x(0)", length=3, maximum=MAX_VALUE
-    )
-    poles: tuple[complex, ...] | None = param(
-        (-1.0, -2.0, -3.0), "poles", "UIO poles (also the Luenberger poles)"
-    )
-    noise: float | None = param(
-        0.0,
-        "float",
-        "standard deviation of the measurement noise (0: none)",
-        minimum=0.0,
-        maximum=MAX_VALUE,
-        omit_default=True,
-        range=(0.0, 0.2),
-        control="noise",
-    )
-    seed: int | None = param(
-        4, "int", SEED_DOC, config="seed", minimum=0, maximum=MAX_SEED, omit_default=True
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
-    )
-    sine_amplitude: float = param(
-        1.0,
-        "float",
-        "d(t) = amplitude sin(frequency t)",
-        key="sine.amplitude",
-        maximum=MAX_VALUE,
-        range=(0.0, 5.0),
-        control="amplitude",
-    )
-    sine_frequency: float = param(
-        2.0,
-        "float",
-        "angular frequency, below the time grid's Nyquist frequency",
-        unit="rad/s",
-        key="sine.frequency",
-        positive=True,
-        range=(0.1, 10.0),
-        control="frequency",
-    )
-    switch_times: tuple[float, ...] = param(
-        (0.0, 2.0, 5.0, 7.5),
-        "floats",
-        "switching times, increasing, within the duration",
-        unit="s",
-        key="piecewise.times",
-        minimum=0.0,
-    )
-    switch_values: tuple[float, ...] = param(
-        (1.0, -1.5, 2.0, 0.0),
-        "floats",
-        "the level held from each switching time",
-        key="piecewise.values",
-        maximum=MAX_VALUE,
-    )
-
-    @property
-    def inputs(self) -> Callable:
-        """The known input ``u = [1, 0.5 sin t]``."""
-        return signals.stack(signals.step(1.0), signals.sinusoid(0.5, 1.0))
-
-    @property
-    def d_sine(self) -> signals.Signal:
-        """The sinusoidal disturbance."""
-        return signals.sinusoid(self.sine_amplitude, self.sine_frequency)
-
-    @property
-    def d_piecewise(self) -> signals.Signal:
-        """The piecewise-constant disturbance."""
-        return signals.piecewise_constant(self.switch_times, self.switch_values)
-
-    @property
-    def unknown_inputs(self) -> Mapping[str, Callable]:
-        """``{"sine": d_sine, "piecewise": d_piecewise}``."""
-        return MappingProxyType({"sine": self.d_sine, "piecewise": self.d_piecewise})
-
-
-@dataclass(frozen=True)
-class CaseStudyExperiment(Experiment):
-    """The discrete-time case study: PMO from the LMI, unknown input ``u2``, random staircase ``v``.
-
-    Attributes
-    ----------
-    u2_amplitude : float
-        Amplitude of the unknown state input ``u2[k] = amplitude sin(frequency k)``.
-    u2_frequency : float
-        Its angular frequency (rad per step).
-    v_amplitude : float
-        The measurement disturbance ``v`` holds levels drawn uniformly in
-        ``[-v_amplitude, v_amplitude]``.
-    v_hold : int
-        Steps each level of ``v`` is held.
-
-    Examples
-    --------
-    >>> from uio_teach.experiments import CASE_STUDY
-    >>> CASE_STUDY.timepts[-1], CASE_STUDY.poles, CASE_STUDY.u2
-    (np.float64(40.0), None, 2 sin(0.6 t))
-    """
-
-    lab: ClassVar[str] = "case_study"
-    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
-        {
-            "": "the discrete-time case study (projection-operator observer)",
-            "u2": "the unknown state input",
-            "v": "the measurement disturbance",
-        }
-    )
-
-    initial_state: np.ndarray = param(
-        (1.0, -2.0, 3.0), "floats", "plant state x[0]", length=3, maximum=MAX_VALUE
-    )
-    poles: tuple[complex, ...] | None = param(
-        None,
-        "poles",
-        "the one movable pole, e.g. [0.2]; absent: the LMI gain of the case study",
-        discrete=True,
-        optional=True,
-        lab=False,
-    )
-    seed: int | None = param(
-        4, "int", SEED_DOC, config="seed", key="v.seed", minimum=0, maximum=MAX_SEED
-    )
-    duration: float = param(
-        None,
-        "int",
-        "number of steps k = 0 ... steps",
-        key="steps",
-        init=False,
-        minimum=2,
-        maximum=MAX_STEPS,
-    )
-    pole: float = param(
-        0.3,
-        "float",
-        "where the lab's exercise moves the one movable pole (inside the unit circle)",
-        config=False,
-        minimum=-1.0,
-        maximum=1.0,
-    )
-    u2_amplitude: float = param(
-        2.0,
-        "float",
-        "u2[k] = amplitude sin(frequency k)",
-        key="u2.amplitude",
-        maximum=MAX_VALUE,
-        range=(0.0, 5.0),
-        control="amplitude",
-    )
-    u2_frequency: float = param(
-        0.6,
-        "float",
-        "angular frequency, at most pi",
-        unit="rad per step",
-        key="u2.frequency",
-        positive=True,
-        maximum=math.pi,
-        range=(0.05, 3.0),
-        control="frequency",
-    )
-    v_amplitude: float = param(
-        1.0,
-        "float",
-        "v: a random staircase, levels uniform in [-amplitude, amplitude]",
-        key="v.amplitude",
-        minimum=0.0,
-        maximum=MAX_VALUE,
-    )
-    v_hold: int = param(
-        5, "int", "steps each level of v is held", key="v.hold", minimum=1, maximum=MAX_STEPS
-    )
-
-    def grid(self, samples: int | None = None, duration: float | None = None) -> np.ndarray:
-        """The steps ``k = 0 ... duration`` (``samples``, if given, must be ``duration + 1``).
-
-        Parameters
-        ----------
-        samples : int, optional
-            Number of steps plus one.
-        duration : int, optional
-            The last step (default: ``duration``).
-
-        Returns
-        -------
-        numpy.ndarray
-
-        Examples
-        --------
-        >>> from uio_teach.experiments import CASE_STUDY
-        >>> CASE_STUDY.grid(duration=3).tolist()
-        [0.0, 1.0, 2.0, 3.0]
-        """
-        if duration is None and samples is None:
-            return self.timepts
-        last = int(duration) if duration is not None else int(samples) - 1
-        if samples is not None and int(samples) != last + 1:
-            raise ValueError(f"samples must be the steps plus one ({last + 1}), got {samples}")
-        return np.arange(last + 1, dtype=float)
-
-    @property
-    def u2(self) -> signals.Signal:
-        """The unknown state input ``u2`` (the plant's ``d``)."""
-        return signals.sinusoid(self.u2_amplitude, self.u2_frequency)
-
-    @property
-    def unknown_inputs(self) -> Mapping[str, Callable]:
-        """``{"u2": u2}``."""
-        return MappingProxyType({"u2": self.u2})
-
-    def measurement_disturbance(
-        self, seed: int | None = None, timepts: np.ndarray | None = None
-    ) -> signals.Signal:
-        """The random staircase ``v``: a new level every ``v_hold`` steps.
-
-        Parameters
-        ----------
-        seed : int, optional
-            Seed of ``numpy.random.default_rng`` (default: ``seed``).
-        timepts : numpy.ndarray, optional
-            The steps it must cover (default: ``timepts``).
-
-        Returns
-        -------
-        Signal
-
-        Examples
-        --------
-        >>> from uio_teach.experiments import CASE_STUDY
-        >>> v = CASE_STUDY.measurement_disturbance()
-        >>> bool(v(0.0) == v(4.0) != v(5.0))
-        True
-        """
-        t = self.timepts if timepts is None else np.asarray(timepts, dtype=float)
-        rng = np.random.default_rng(self.seed if seed is None else seed)
-        switch = np.arange(0, t[-1] + 1, self.v_hold)
-        levels = rng.uniform(-self.v_amplitude, self.v_amplitude, switch.size)
-        return signals.piecewise_constant(switch, levels)
-
-
-@dataclass(frozen=True)
-class MissileExperiment(Experiment):
-    """The missile autopilot: the paper's ``x0`` and ``v1, v2``, the PMO started at ``xhat(0) = 0``.
-
-    The unknown inputs are the paper's damped sinusoids
-    ``v_i(t) = amplitude exp(-rate t) cos/sin(frequency t)``, one tuple
-    ``(amplitude, rate, frequency, "cos" or "sin")`` each in ``v_parameters``.
-
-    Attributes
-    ----------
-    v_parameters : tuple of tuple
-        ``v1`` and ``v2`` as ``(amplitude, rate, frequency, kind)``.
-
-    Examples
-    --------
-    >>> from uio_teach.experiments import MISSILE
-    >>> MISSILE.poles, MISSILE.v
-    ((-100.0, -120.0), [10 exp(-2 t) cos(10 t); 50 exp(-5 t) sin(100 t)])
-    """
-
-    lab: ClassVar[str] = "missile"
-    tables: ClassVar[Mapping[str, str]] = MappingProxyType(
-        {
-            "": "the missile autopilot of De, Banerjee and Das (2014)",
-            "noise": "the measurement noise of the lab's last exercise",
-        }
-    )
-
-    initial_state: np.ndarray = field(default=tuple(examples.MISSILE_PUBLISHED.x0))
-    poles: tuple[complex, ...] | None = param(
-        (-100.0, -120.0),
-        "poles",
-        "PMO poles (the paper's are not given; see chapter 5)",
-        key="pmo_poles",
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
-    )
-    v_parameters: tuple[tuple[float, float, float, str], ...] = examples.MISSILE_INPUTS
-    noise_sigma: float = param(
-        0.01,
-        "float",
-        "standard deviation of the measurement noise",
-        key="noise.sigma",
-        positive=True,
-        maximum=MAX_VALUE,
-    )
-    noise_seed: int = param(
-        7, "int", "seed of that noise", key="noise.seed", minimum=0, maximum=MAX_SEED
-    )
-    tol: float = param(
-        0.02,
-        "float",
-        "the band of the catch times, relative to each signal's peak",
-        config=False,
-        positive=True,
-        maximum=1.0,
-    )
-
-    @property
-    def v(self) -> Callable:
-        """The unknown inputs ``[v1; v2]`` as one vector signal."""
-        return signals.stack(*(signals.damped_sinusoid(*p) for p in self.v_parameters))
-
-    @property
-    def unknown_inputs(self) -> Mapping[str, Callable]:
-        """``{"v": v}``."""
-        return MappingProxyType({"v": self.v})
-
-    def observer_state(self, observer: Any) -> np.ndarray:
-        """``q(0) = -M C x(0)``: the estimate ``xhat(0) = q(0) + M y(0)`` starts at zero.
-
-        Parameters
-        ----------
-        observer : Observer
-            An observer with a matrix ``M`` (a PMO).
-
-        Returns
-        -------
-        numpy.ndarray
-
-        Examples
-        --------
-        >>> import uio_teach as ut
-        >>> from uio_teach.experiments import MISSILE
-        >>> plant = MISSILE.plant()
-        >>> pmo = ut.design_pmo(plant, poles=MISSILE.poles)
-        >>> q0 = MISSILE.observer_state(pmo)
-        >>> bool(abs(q0 + pmo.M @ plant.C @ MISSILE.initial_state).max() == 0)
-        True
-        """
-        C = self.plant().C
-        return -observer.M @ C @ self.initial_state
-
-
-PA9 = PA9Experiment(name="pa9", timepts=np.linspace(0.0, 10.0, 2001))
-"""The run of Practical Assignment 9.
-
-10 s on 2001 points, ``x(0) = [1, -1, 0.5]``, poles -1, -2, -3.
-"""
-
-CASE_STUDY = CaseStudyExperiment(name="case-study", timepts=np.arange(41.0))
-"""The run of the case study.
-
-Steps ``k = 0 ... 40``, ``x[0] = [1, -2, 3]``, the LMI gain, seed 4.
-"""
-
-MISSILE = MissileExperiment(name="missile", timepts=np.linspace(0.0, 0.5, 10_001))
-"""The run of the missile autopilot.
-
-0.5 s on 10001 points, the paper's ``x0``, PMO poles -100, -120.
-"""
 
 
 class _FromRegistry(Mapping):
@@ -980,13 +568,13 @@ class _FromRegistry(Mapping):
 EXPERIMENTS: Mapping[str, Experiment] = _FromRegistry("experiments")
 """The experiment of every worked example, by name.
 
-The names are the tables of the term config; the values ``PA9``, ``CASE_STUDY``, ``MISSILE``
-and the later worked examples' (a view of :data:`uio_teach.worked.WORKED`)."""
+The names are the tables of the term config; the values the experiments of the worked
+examples' modules (a view of :data:`uio_teach.worked.WORKED`)."""
 
 
 LAB_PLANTS: Mapping[str, Callable[[], Plant]] = _FromRegistry("lab plants")
-"""The course's plant of each lab (``"pa9"``, ``"case_study"``, ``"missile"``), as a factory
-(the worked examples of :data:`uio_teach.worked.WORKED` that have a lab)."""
+"""The course's plant of each lab, as a factory (the worked examples of
+:data:`uio_teach.worked.WORKED` that have a lab)."""
 
 _PLANT_MATRICES = ("A", "B", "C", "D", "E")
 

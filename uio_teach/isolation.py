@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from . import tolerances as tols
 from ._display import call_repr, fit_lines, format_poles
 from .detection import Threshold, detect, observer_residual, residual_threshold
 from .existence import ExistenceReport, check_existence
@@ -452,7 +453,9 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
                 [
                     c
                     for c in cand
-                    if np.all(np.abs(report.fixed_modes - c) > 1e-6 * max(1.0, abs(c)))
+                    if np.all(
+                        np.abs(report.fixed_modes - c) > tols.FIXED_POLE_RTOL * max(1.0, abs(c))
+                    )
                 ],
                 dtype=complex,
             )

@@ -40,6 +40,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg as sla
 
+from . import tolerances as tols
+
 __all__ = [
     "MARGIN",
     "DROP_MARGIN",
@@ -53,8 +55,6 @@ __all__ = [
     "invariant_zeros",
     "checked_zeros",
     "ZeroSet",
-    "ZERO_RTOL",
-    "ZERO_DOUBT",
     "is_stable",
     "ObservabilitySplit",
     "sort_poles",
@@ -62,13 +62,11 @@ __all__ = [
 ]
 
 
-MARGIN = 1e4
-"""A kept singular value below ``MARGIN`` times the rank threshold makes the verdict marginal."""
+MARGIN = tols.RANK_MARGIN
+"""``uio_teach.tolerances.RANK_MARGIN``, for the names of this module's documentation."""
 
-DROP_MARGIN = 10.0
-"""A dropped singular value above ``1 / DROP_MARGIN`` of the rank threshold makes a rank-deficient
-verdict marginal (round-off sits well below the threshold when ``rtol`` covers the data's
-precision, e.g. ``100 n eps`` for a product over ``n`` terms)."""
+DROP_MARGIN = tols.DROP_MARGIN
+"""``uio_teach.tolerances.DROP_MARGIN``."""
 
 
 class RankDecision(NamedTuple):
@@ -156,7 +154,8 @@ def rank_decision(
     r = int(np.sum(s > tol))
     margin = float(s[r - 1] / tol) if r and tol > 0 else np.inf
     below = float(tol / s[r]) if r < s.size and s[r] > 0 else np.inf
-    return RankDecision(r, tol, margin, bool(margin < MARGIN or below < DROP_MARGIN), below)
+    marginal = bool(margin < tols.RANK_MARGIN or below < tols.DROP_MARGIN)
+    return RankDecision(r, tol, margin, marginal, below)
 
 
 def rank(M: np.ndarray, *, scale: float | None = None) -> int:
@@ -292,7 +291,7 @@ class ObservabilitySplit(NamedTuple):
 
 
 def observability_decomposition(
-    A: np.ndarray, C: np.ndarray, *, rtol: float = 1e3
+    A: np.ndarray, C: np.ndarray, *, rtol: float | None = None
 ) -> ObservabilitySplit:
     """Split ``(A, C)`` into its observable and unobservable parts.
 
@@ -304,9 +303,10 @@ def observability_decomposition(
     ----------
     A : array_like, shape (n, n)
     C : array_like, shape (p, n)
-    rtol : float
+    rtol : float, optional
         A singular value of a staircase step counts as zero below
-        ``rtol * max(shape) * eps`` times the data's size.
+        ``rtol * max(shape) * eps`` times the data's size; default
+        ``uio_teach.tolerances.STAIRCASE_RTOL``.
 
     Returns
     -------
@@ -323,6 +323,7 @@ def observability_decomposition(
     A = np.asarray(A, float)
     C = np.atleast_2d(np.asarray(C, float))
     n = A.shape[0]
+    rtol = tols.STAIRCASE_RTOL if rtol is None else float(rtol)
     # Staircase: W spans the current candidate unobservable subspace (start: ker C).
     margins = [np.inf]
     W = _null(C, margins=margins, rtol=rtol) if C.shape[0] else np.eye(n)
@@ -347,7 +348,7 @@ def observability_decomposition(
 
 
 def _null(
-    M: np.ndarray, ref: float | None = None, margins: list | None = None, rtol: float = 1e3
+    M: np.ndarray, ref: float | None = None, margins: list | None = None, rtol: float | None = None
 ) -> np.ndarray:
     """Orthonormal basis of the right null space of ``M`` (columns).
 
@@ -360,6 +361,7 @@ def _null(
         return np.eye(n)
     _, s, Vt = np.linalg.svd(M, full_matrices=True)
     scale = ref if ref is not None else (s[0] if s.size else 0.0)
+    rtol = tols.STAIRCASE_RTOL if rtol is None else rtol
     tol = max(M.shape) * rtol * np.finfo(float).eps * max(scale, np.finfo(float).tiny)
     k = int(np.sum(s > tol))
     if margins is not None and k and tol > 0:
@@ -396,23 +398,40 @@ def sort_poles(z: np.ndarray) -> np.ndarray:
     >>> sort_poles([-1 + 2j, -3, -1 - 2j]).tolist()
     [(-3+0j), (-1-2j), (-1+2j)]
     """
+    z = _real_cleaned(z)
+    return z[_order(z)]
+
+
+def _real_cleaned(z) -> np.ndarray:
+    """``z`` with imaginary parts that are round-off of a real value (``REAL_RTOL``) set to 0."""
     z = np.asarray(z, complex)
-    # clean tiny imaginary parts of real values
-    z = np.where(np.abs(z.imag) <= 1e-10 * np.maximum(1.0, np.abs(z)), z.real + 0j, z)
-    # sort on rounded keys so that a conjugate pair whose real parts differ by round-off
-    # always comes out in the same order (negative imaginary part first)
-    scale = max(1.0, float(np.max(np.abs(z)))) if z.size else 1.0
-    key_re = np.round(z.real / scale, 9)
-    return z[np.lexsort((z.imag, key_re))]
+    with np.errstate(invalid="ignore"):
+        real = np.abs(z.imag) <= tols.REAL_RTOL * np.abs(z)
+    return np.where(real, z.real + 0j, z)
+
+
+def _order(z: np.ndarray) -> np.ndarray:
+    """Indices sorting ``z`` by real part, then imaginary part.
+
+    Sorted on rounded keys relative to the largest finite value, so that a conjugate pair whose
+    real parts differ by round-off always comes out in the same order (negative imaginary part
+    first), whatever the unit.
+    """
+    finite = np.abs(z[np.isfinite(z)])
+    scale = float(np.max(finite)) if finite.size and np.max(finite) > 0 else 1.0
+    with np.errstate(invalid="ignore"):
+        key_re = np.round(z.real / scale, 9)
+    return np.lexsort((z.imag, key_re))
 
 
 _sort = sort_poles  # former private name
 
 
-def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.ndarray:
+def is_stable(values: np.ndarray, discrete: bool, margin: float | None = None) -> np.ndarray:
     """Elementwise: inside the stability region (open left half-plane or unit disk).
 
-    A value within ``margin`` (relative) of the boundary counts as *not* stable.
+    A value within ``margin`` of the boundary, relative to its own size, counts as *not*
+    stable: ``Re z < -margin |z|`` (the same in any unit of time) or ``|z| < 1 - margin``.
 
     Parameters
     ----------
@@ -420,34 +439,38 @@ def is_stable(values: np.ndarray, discrete: bool, margin: float = 1e-9) -> np.nd
         Poles or zeros.
     discrete : bool
         Judge against the unit disk (True) or the left half-plane (False).
-    margin : float
-        Relative distance from the boundary still counted as unstable.
+    margin : float, optional
+        Relative distance from the boundary still counted as unstable; default
+        ``uio_teach.tolerances.STABILITY_MARGIN``.
 
     Examples
     --------
     >>> from uio_teach.linalg import is_stable
-    >>> is_stable([-1.0, 0.0, 0.5], discrete=False).tolist()
-    [True, False, False]
+    >>> is_stable([-1.0, 0.0, 0.5, -1e-12], discrete=False).tolist()
+    [True, False, False, True]
     >>> is_stable([-1.0, 0.0, 0.5], discrete=True).tolist()
     [False, True, True]
     """
     z = np.asarray(values, complex)
+    margin = tols.STABILITY_MARGIN if margin is None else float(margin)
     if discrete:
         return np.abs(z) < 1.0 - margin
-    return z.real < -margin * np.maximum(1.0, np.abs(z))
+    return z.real < -margin * np.abs(z)
 
 
 def invariant_zeros(
     A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray | None = None
 ) -> np.ndarray:
-    """Invariant zeros of ``(A, B, C, D)``, square or not.
+    """Invariant zeros of ``(A, B, C, D)``, square or not, with multiplicity.
 
     The zeros are the finite values ``s`` at which the Rosenbrock matrix
     ``[[s I - A, -B], [C, D]]`` loses rank below its normal rank. The system
     is first reduced with the orthogonal staircase of Emami-Naeini and Van
     Dooren (1982), applied to the system and to its dual, until the
-    feedthrough is square and invertible; the zeros are then the finite
-    generalized eigenvalues of a regular pencil.
+    feedthrough is square and invertible; the zeros are then the generalized
+    eigenvalues of the regular pencil that remains, as many as its size (the
+    count comes from the pencil's structure, a fast zero is never dropped).
+    :func:`checked_zeros` says in addition how far round-off can move each.
 
     Parameters
     ----------
@@ -476,43 +499,15 @@ def invariant_zeros(
     >>> invariant_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]])
     array([-1.5+0.j])
     """
-    A = np.atleast_2d(np.asarray(A, float))
-    n = A.shape[0]
-    B = np.asarray(B, float).reshape(n, -1)
-    C = np.asarray(C, float).reshape(-1, n)
-    D = np.zeros((C.shape[0], B.shape[1])) if D is None else np.asarray(D, float)
-    D = D.reshape(C.shape[0], B.shape[1])
-    # Scale first (see the module's tolerance policy): a diagonal similarity balances A,
-    # then input and output scalings bring ||B|| and ||C|| to ||A||. The zeros do not change,
-    # and no block is judged against another block's size.
-    A, B, C, D = _scaled_system(A, B, C, D)
-    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
-    A1, B1, C1, D1 = _reduce(A, B, C, D, scale)
-    A2, B2, C2, D2 = _reduce(A1.T, C1.T, B1.T, D1.T, scale)
-    A2, B2, C2, D2 = A2.T, C2.T, B2.T, D2.T
-    nr, mr = A2.shape[0], B2.shape[1]
-    if nr == 0:
-        return np.zeros(0, complex)
-    if D2.shape[0] != D2.shape[1]:  # normal-rank deficient: fall back on what remains
-        return np.zeros(0, complex)
-    if mr == 0:
-        return sort_poles(np.linalg.eigvals(A2))
-    # compress the columns of [C D] onto D: [C D] W = [0 Df]
-    CD = np.hstack([C2, D2])
-    Q, _ = np.linalg.qr(CD.T[:, ::-1], mode="complete")
-    W = Q[:, ::-1]  # last mr columns span the row space of [C D]
-    AB = np.hstack([A2, B2]) @ W
-    IB = np.hstack([np.eye(nr), np.zeros((nr, mr))]) @ W
-    Af, Ef = AB[:, :nr], IB[:, :nr]
-    w = sla.eigvals(Af, Ef)
-    w = w[np.isfinite(w) & (np.abs(w) < 1e12 * scale)]
-    return sort_poles(w)
+    return checked_zeros(A, B, C, D).zeros
 
 
-def _reduce(A, B, C, D, scale):
-    """One Emami-Naeini/Van Dooren reduction until ``D`` has full row rank."""
+def _reduce(A, B, C, D, tol, drops):
+    """One Emami-Naeini/Van Dooren reduction until ``D`` has full row rank.
+
+    Every singular value taken as 0 is appended to ``drops`` (the largest per decision).
+    """
     A, B, C, D = (np.array(X, dtype=float) for X in (A, B, C, D))
-    tol = max(A.shape[0] + C.shape[0], 1) * 1e3 * np.finfo(float).eps * scale
     while True:
         n, m, p = A.shape[0], B.shape[1], C.shape[0]
         if p == 0:
@@ -521,6 +516,7 @@ def _reduce(A, B, C, D, scale):
         if m:
             U, s, _ = np.linalg.svd(D, full_matrices=True)
             rho = int(np.sum(s > tol))
+            drops.extend(s[rho : rho + 1])
         else:
             U, rho = np.eye(p), 0
         U = U[:, ::-1].T  # rows: null part first, range part last
@@ -533,6 +529,7 @@ def _reduce(A, B, C, D, scale):
         # compress the columns of C1: C1 V = [0, Cbar] with Cbar of full column rank mu
         _, s, Vt = np.linalg.svd(C1, full_matrices=True)
         mu = int(np.sum(s > tol))
+        drops.extend(s[mu : mu + 1])
         if mu == 0:  # those outputs are identically zero: drop them
             C, D = C2, Dplus
             continue
@@ -547,161 +544,186 @@ def _reduce(A, B, C, D, scale):
         D = np.vstack([B2, Dplus])
 
 
-ZERO_RTOL = 10.0
-"""A candidate ``z`` is an invariant zero when the smallest singular value of the scaled
-Rosenbrock matrix at ``z`` is at most ``ZERO_RTOL * (n + p) * eps`` of its size (the backward
-error of a double-precision computation); between that and ``ZERO_DOUBT`` times more it is a zero
-of a plant within round-off of the data, but not certainly of this one."""
-
-ZERO_DOUBT = 1e3
-"""How far above the zero threshold a candidate still counts as doubtful (see ``ZERO_RTOL``)."""
-
-
 class ZeroSet(NamedTuple):
     """Invariant zeros with the evidence for each (:func:`checked_zeros`).
 
     Attributes
     ----------
     zeros : numpy.ndarray of complex
-        The zeros: values at which the scaled Rosenbrock matrix is singular to round-off, found by
-        a random square-down of the outputs and confirmed on the full (non-square) matrix and by
-        the orthogonal staircase or a second square-down.
-    doubtful : numpy.ndarray of complex
-        Values at which the Rosenbrock matrix is singular to within ``ZERO_DOUBT`` times the
-        round-off threshold, or that one method finds and the other does not: zeros of plants
-        within round-off of the data, on which no verdict should rest.
-    residuals : numpy.ndarray of float
-        For each doubtful value, the smallest singular value of the scaled Rosenbrock matrix
-        divided by its threshold.
-    threshold : float
-        The relative singular value below which a value is a zero.
+        The zeros, as many as the pencil's structure says (a repeated zero by its multiplicity),
+        none dropped however fast.
     radius : numpy.ndarray of float
-        For each zero, how far round-off of the data (``threshold`` relative to the scaled
-        system) can move it, from its condition number ``||u|| ||v|| / |u_x^H v_x|`` (``u``,
-        ``v`` the left and right singular vectors of the Rosenbrock matrix at the zero).
+        For each zero, how far a perturbation of the data within ``backward_error`` can move
+        it (measured along its way to the stability boundary; a defective cluster's true
+        radius, ``eps**(1/k)``-like, not a first-order estimate); ``inf`` when it is beyond
+        what double precision resolves.
+    distance : numpy.ndarray of float
+        For each zero, its distance to the stability boundary (the imaginary axis or the unit
+        circle).
+    unresolved : numpy.ndarray of bool
+        For each zero: so fast that a perturbation within ``backward_error`` can send it
+        through infinity (it may be on either side, or not exist).
+    backward_error : float
+        The relative size (in balanced units) of the perturbation of the data the computed
+        zeros are exact for: ``ZERO_RTOL (n + p) eps``.
+    lost : int
+        Zeros the structure puts at infinity by a rank decision within ``DROP_MARGIN`` of its
+        threshold: a plant within round-off of the data has them, finite and fast, on either
+        side of the boundary.
+    crossing : bool
+        A plant within ``backward_error`` of the data has a zero on the stability boundary.
+    discrete : bool
+        Which boundary: the unit circle (True) or the imaginary axis.
+    scale : float
+        The system's own rate, the spectral radius of ``A`` in continuous time (1 in discrete
+        time): the zeros' sizes are judged against it.
 
     Examples
     --------
     >>> import numpy as np
     >>> from uio_teach.linalg import checked_zeros
     >>> zs = checked_zeros(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]])
-    >>> zs.zeros, zs.doubtful.size
-    (array([-1.5+0.j]), 0)
+    >>> zs.zeros, zs.decided
+    (array([-1.5+0.j]), True)
     """
 
     zeros: np.ndarray
-    doubtful: np.ndarray
-    residuals: np.ndarray
-    threshold: float
-    radius: np.ndarray = np.zeros(0)
+    radius: np.ndarray
+    distance: np.ndarray
+    unresolved: np.ndarray
+    backward_error: float
+    lost: int = 0
+    crossing: bool = False
+    discrete: bool = False
+    scale: float = 1.0
+
+    @property
+    def undecided(self) -> np.ndarray:
+        """For each zero: round-off of the data can move it across the boundary (or infinity)."""
+        return self.unresolved | (self.radius >= self.distance)
+
+    @property
+    def decided(self) -> bool:
+        """True when no perturbation within the backward error changes which side any zero is on."""
+        return not (self.lost or self.crossing or np.any(self.undecided))
+
+    @property
+    def stable(self) -> np.ndarray:
+        """For each zero, whether it lies inside the stability region (its computed value)."""
+        return is_stable(self.zeros, self.discrete, margin=0.0)
 
 
-def _scaled_system(A, B, C, D):
-    """Balance ``A`` (diagonal similarity) and scale ``B``, ``C`` to its size; zeros unchanged."""
+def _normalized_system(A, B, C, D, discrete):
+    """Balance ``A`` (diagonal similarity), divide the time unit out, scale inputs and outputs.
+
+    Returns the scaled ``(A, B, C, D)`` and the factor ``t`` the zeros are to be multiplied by:
+    ``||A|| = 1`` in continuous time (the zeros of a plant whose time is measured in other
+    units are the same numbers in units of its own rate), ``||B|| = ||C|| = 1``.
+    """
     n = A.shape[0]
     if n:
         _, (bal, _) = sla.matrix_balance(A, permute=False, separate=True)
         A = A / bal[:, None] * bal[None, :]
         B = B / bal[:, None]
         C = C * bal[None, :]
-    alpha = max(float(np.linalg.norm(A, 2)), 1.0) if n else 1.0
+    t = float(np.linalg.norm(A, 2)) if n and not discrete else 0.0
+    t = t if t > 0 and np.isfinite(t) else 1.0
+    A, B = A / t, B / t
     nb = float(np.linalg.norm(B, 2)) if B.size else 0.0
     nc = float(np.linalg.norm(C, 2)) if C.size else 0.0
-    beta = alpha / nb if nb > 0 else 1.0
-    gamma = alpha / nc if nc > 0 else 1.0
-    return A, B * beta, C * gamma, D * (beta * gamma)
+    beta = 1.0 / nb if nb > 0 else 1.0
+    gamma = 1.0 / nc if nc > 0 else 1.0
+    return A, B * beta, C * gamma, D * (beta * gamma / t), t
 
 
-def _rosenbrock_residual(A, B, C, D, size, z) -> float:
-    """Smallest singular value of ``[[z I - A, -B], [C, D]]`` relative to its size.
+def _pseudo(Af: np.ndarray, Ef: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Smallest perturbation ``||(dA, dE)||`` that makes each ``w`` an eigenvalue of the pencil.
 
-    For ``|z|`` beyond the system's size the state columns are divided by ``|z| / size`` (the
-    pencil in homogeneous form): without it every Rosenbrock matrix at a large ``z`` is nearly
-    singular (its smallest singular value falls like ``1 / |z|^2``), a zero or not.
+    ``sigma_min(Af - w Ef) / sqrt(1 + |w|^2)`` (for ``Af``, ``Ef`` of norm about 1).
     """
-    n = A.shape[0]
-    alpha = size / max(abs(z), size)
-    R = np.block(
-        [[(z * np.eye(n) - A) * alpha, -B], [(C * alpha).astype(complex), D.astype(complex)]]
-    )
-    if not np.all(np.isfinite(R)):
-        return 0.0
-    s = np.linalg.svd(R, compute_uv=False)
-    return float(s[-1]) / size
-
-
-def _zero_condition(A, B, C, D, W, z) -> float:
-    """Condition number ``||u|| ||v|| / |u_x^H v_x|`` of ``z`` as a zero of the square-down ``W``.
-
-    ``u``, ``v``: left and right singular vectors of the smallest singular value of the square
-    Rosenbrock matrix; a perturbation ``delta`` of the pencil moves ``z`` by about
-    ``kappa * ||delta||``.
-    """
-    n = A.shape[0]
-    # in homogeneous form, as in _rosenbrock_residual: the state columns scaled by alpha
-    size = max(1.0, float(np.linalg.norm(np.block([[A, B], [W @ C, W @ D]]), 2)))
-    alpha = size / max(abs(z), size)
-    R = np.block(
-        [
-            [(z * np.eye(n) - A) * alpha, -B],
-            [(W @ C * alpha).astype(complex), (W @ D).astype(complex)],
-        ]
-    )
-    if not np.all(np.isfinite(R)):
-        return np.inf
-    U, _, Vh = np.linalg.svd(R)
-    k = abs(np.vdot(U[:n, -1], Vh[-1, :n].conj()))
-    return 1.0 / k if k > 0 else np.inf
-
-
-def _square_down_zeros(A, B, C, D, W, limit) -> np.ndarray:
-    """Finite generalized eigenvalues of the Rosenbrock pencil of ``(A, B, W C, W D)``."""
-    n, m = B.shape
-    M = np.block([[A, B], [W @ C, W @ D]])
-    N = np.zeros_like(M)
-    N[:n, :n] = np.eye(n)
+    w = np.atleast_1d(np.asarray(w, complex))
+    M = Af[None, :, :] - w[:, None, None] * Ef[None, :, :]
     with np.errstate(all="ignore"):
-        w = sla.eigvals(M, N)
-    return w[np.isfinite(w) & (np.abs(w) < limit)]
+        s = np.linalg.svd(M, compute_uv=False)[:, -1]
+    return s / np.sqrt(1.0 + np.abs(w) ** 2)
 
 
-def _match(values: np.ndarray, pool: np.ndarray, rtol: float, floor: float) -> np.ndarray:
-    """For each value, whether a distinct element of ``pool`` lies within ``rtol`` of it."""
-    pool = list(pool)
-    found = np.zeros(len(values), bool)
-    for i, z in enumerate(values):
-        if not pool:
-            break
-        d = [abs(z - x) / max(abs(z), floor) for x in pool]
-        j = int(np.argmin(d))
-        if d[j] <= rtol:
-            found[i] = True
-            pool.pop(j)
-    return found
+def _nearest_boundary(z: np.ndarray, discrete: bool) -> np.ndarray:
+    if discrete:
+        ang = np.where(z == 0, 0.0, np.angle(z))
+        return np.exp(1j * ang)
+    return 1j * z.imag
+
+
+def _radius_toward(fun, z, b, eps_pert, discrete) -> float:
+    """How far a perturbation of the pencil of size ``eps_pert`` moves ``z``, towards ``b``.
+
+    The extent, along the ray from ``z`` through the nearest boundary point ``b`` (and beyond
+    it), of the part of the pseudospectrum ``{w: fun(w) <= eps_pert}`` that holds ``z``:
+    ``kappa eps_pert`` for a simple zero, about ``eps_pert**(1/k)`` for a defective cluster of
+    ``k``, and never confused with another zero's part farther along the way.
+    """
+    d = abs(b - z)
+    if d > 0:
+        u = (b - z) / d
+    elif discrete:
+        u = z / abs(z) if z != 0 else 1.0
+    else:
+        u = 1.0
+    lengths = np.geomspace(1e-30, 1e6, 73) * max(abs(z), 1.0)
+    out = fun(z + lengths * u) > eps_pert
+    if not np.any(out):
+        return np.inf
+    k = int(np.argmax(out))
+    hi = lengths[k]
+    lo = lengths[k - 1] if k else 0.0
+    for _ in range(30):
+        mid = np.sqrt(lo * hi) if lo > 0 else hi / 2
+        if fun(np.array([z + mid * u]))[0] <= eps_pert:
+            lo = mid
+        else:
+            hi = mid
+    return float(hi)
+
+
+def _boundary_samples(z: np.ndarray, discrete: bool) -> np.ndarray:
+    """Points of the stability boundary (one half: the data are real) near the zeros and beyond."""
+    if discrete:
+        ang = np.concatenate([np.linspace(0.0, np.pi, 181), np.abs(np.angle(z))])
+        return np.exp(1j * ang)
+    mags = np.abs(z[np.isfinite(z)])
+    near = np.concatenate([[0.0], np.abs(z.imag), np.outer(mags, [0.5, 1.0, 2.0]).ravel()])
+    return 1j * np.concatenate([np.geomspace(1e-4, 1e4, 81), near])
 
 
 def checked_zeros(
-    A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray | None = None
+    A: np.ndarray,
+    B: np.ndarray,
+    C: np.ndarray,
+    D: np.ndarray | None = None,
+    *,
+    discrete: bool = False,
 ) -> ZeroSet:
-    """Invariant zeros of ``(A, B, C, D)`` with every decision checked, fast zeros included.
+    """Invariant zeros of ``(A, B, C, D)``, each with how far round-off of the data can move it.
 
-    Two independent methods on a scaled system (``A`` balanced, ``||B|| = ||C|| = ||A||``, input
-    columns compressed to full rank): the orthogonal staircase of :func:`invariant_zeros`, and
-    the generalized eigenvalues of the square Rosenbrock pencils of random square-downs
-    ``(A, B, W C, W D)`` (every zero of the system is a zero of each square-down). Each candidate
-    ``z`` is then judged on the full Rosenbrock matrix: it is a zero when that matrix is
-    singular at ``z`` to round-off (its smallest singular value at most ``ZERO_RTOL (n + p) eps``
-    of its size) and a second square-down finds it too; a candidate within ``ZERO_DOUBT`` of that
-    threshold, or found by one method and refuted by the other, is listed as doubtful.
-
-    A zero a million times faster than the poles (a small ``C B`` next to ``B``) is found: the
-    pencil of a square-down is regular and well scaled, and the Rosenbrock matrix's singular
-    value is judged relative to ``|z|``.
+    The system is scaled first (``A`` balanced, its norm divided out in continuous time so
+    that the units of time do not matter, ``||B|| = ||C|| = 1``, dependent input columns
+    dropped), then reduced by the orthogonal staircase of :func:`invariant_zeros` with rank
+    decisions at the backward error ``delta = ZERO_RTOL (n + p) eps``: the zeros are the
+    eigenvalues of the regular pencil ``(Af, Ef)`` that remains, as many as its size, a
+    repeated zero by its multiplicity. Round-off is then measured in the pencil's
+    pseudospectrum: a value ``w`` is a zero of a plant within ``delta`` when
+    ``sigma_min(Af - w Ef) <= delta sqrt(1 + |w|^2)``. Each zero's radius is how far that set
+    reaches from it towards the stability boundary (a defective cluster's true radius, not a
+    first-order estimate), and the set is sampled along the boundary: when it touches it, a
+    plant within round-off has a zero on the boundary and the verdict cannot be decided.
 
     Parameters
     ----------
     A, B, C, D : array_like
         The system (``D`` zero when omitted).
+    discrete : bool
+        The stability boundary is the unit circle (True) or the imaginary axis.
 
     Returns
     -------
@@ -715,8 +737,8 @@ def checked_zeros(
     >>> from uio_teach.linalg import checked_zeros
     >>> A = np.array([[-1.0, 0.0], [1.0, -2.0]]); B = np.array([[1.0], [-1.002]])
     >>> zs = checked_zeros(A, B, [[1.0, 1.0]])
-    >>> zs.zeros.real.round(6), zs.doubtful.size
-    (array([999.]), 0)
+    >>> zs.zeros.real.round(6), zs.decided
+    (array([999.]), True)
     """
     A = np.atleast_2d(np.asarray(A, float))
     n = A.shape[0]
@@ -724,53 +746,165 @@ def checked_zeros(
     C = np.asarray(C, float).reshape(-1, n)
     p = C.shape[0]
     D = np.zeros((p, B.shape[1])) if D is None else np.asarray(D, float).reshape(p, B.shape[1])
-    eps = np.finfo(float).eps
-    empty = np.zeros(0, complex)
-    staircase = invariant_zeros(A, B, C, D)
-    A, B, C, D = _scaled_system(A, B, C, D)
+    eps = tols.EPS
+    delta = tols.ZERO_RTOL * (n + p) * eps
+    empty = ZeroSet(np.zeros(0, complex), np.zeros(0), np.zeros(0), np.zeros(0, bool), delta)
+    empty = empty._replace(discrete=bool(discrete))
+    if n == 0:
+        return empty
+    with np.errstate(all="ignore"):
+        A, B, C, D, t = _normalized_system(A, B, C, D, discrete)
+    if not all(np.all(np.isfinite(X)) for X in (A, B, C, D)):
+        return empty._replace(lost=n)
     # independent input columns only (a repeated unknown input adds no zero)
     BD = np.vstack([B, D])
     if BD.size:
         _, s, Vt = np.linalg.svd(BD, full_matrices=False)
-        r = int(np.sum(s > max(BD.shape) * eps * 100 * s[0])) if s.size and s[0] > 0 else 0
+        r = int(np.sum(s > delta * s[0])) if s.size and s[0] > 0 else 0
         B, D = (BD @ Vt[:r].T)[:n], (BD @ Vt[:r].T)[n:]
-    m = B.shape[1]
-    size = max(1.0, float(np.linalg.norm(np.block([[A, B], [C, D]]), 2)))
-    tau = ZERO_RTOL * (n + p) * eps
-    if n == 0 or m == 0 or p < m:
-        return ZeroSet(staircase, empty, np.zeros(0), tau)
-    rng = np.random.default_rng(0)
-    # normal rank: a Rosenbrock matrix singular at random points has no isolated zeros
-    probe = size * (rng.standard_normal(2) + 1j * rng.standard_normal(2))
-    if min(_rosenbrock_residual(A, B, C, D, size, s) for s in probe) <= tau * ZERO_DOUBT:
-        return ZeroSet(staircase, empty, np.zeros(0), tau)
-    # beyond |z| ~ size / tau the homogeneous pencil's state columns are round-off: no test tells
-    # a zero from an infinite one
-    resolve = size / (tau * ZERO_DOUBT)
-    limit = size / eps
-
-    def square_down() -> tuple[np.ndarray, np.ndarray]:
-        W = np.linalg.qr(rng.standard_normal((p, m)))[0].T if p > m else np.eye(p)
-        return _square_down_zeros(A, B, C, D, W, limit), W
-
-    (first, W1), second = square_down(), (square_down()[0] if p > m else None)
-    # the staircase's zeros join the candidates when the square-down did not find them
-    extra = staircase[~_match(staircase, first, 1e-6, size * 1e-8)]
-    cand = np.concatenate([first, extra])
-    rho = np.array([_rosenbrock_residual(A, B, C, D, size, z) for z in cand]) / tau
-    # a zero of the system is a zero of every square-down
-    again = (
-        _match(cand, second, 1e-6, size * 1e-8) if second is not None else np.ones(len(cand), bool)
+    scale = float(np.linalg.norm(np.block([[A, B], [C, D]]), 2))
+    thr = delta * scale
+    drops: list[float] = []
+    A1, B1, C1, D1 = _reduce(A, B, C, D, thr, drops)
+    A2, B2, C2, D2 = _reduce(A1.T, C1.T, B1.T, D1.T, thr, drops)
+    A2, B2, C2, D2 = A2.T, C2.T, B2.T, D2.T
+    nr = A2.shape[0]
+    # a rank decision close to its threshold: a zero may sit at infinity or be finite and fast
+    lost = int(sum(1 for s in drops if s > thr / tols.DROP_MARGIN))
+    z, radius, unresolved = np.zeros(0, complex), np.zeros(0), np.zeros(0, bool)
+    crossing = False
+    pencil = None
+    if nr and D2.shape[0] == D2.shape[1]:  # else: no finite zeros, or normal-rank deficient
+        pencil = _regular_pencil(A2, B2, C2, D2)
+        z, radius, unresolved, crossing = _pencil_zeros(*pencil, delta, discrete)
+    if B.shape[1] < p:
+        # more outputs than inputs: a zero is not generic, and one that the structure of the
+        # data has only to round-off is lost by the staircase's exact rank decisions; a plant
+        # within the backward error has it, so it counts (and the designs find it fixed)
+        more, r_more = _round_off_zeros(A, B, C, D, scale, delta, discrete, pencil)
+        z = np.concatenate([z, more])
+        radius = np.concatenate([radius, r_more])
+        unresolved = np.concatenate([unresolved, np.zeros(more.size, bool)])
+    b = _nearest_boundary(np.where(np.isfinite(z), z, 0.0), discrete)
+    distance = np.where(np.isfinite(z), np.abs(z - b), np.inf)
+    order = _order(z)
+    return ZeroSet(
+        zeros=(z * t)[order],
+        radius=(radius * t)[order],
+        distance=(distance * t)[order],
+        unresolved=unresolved[order],
+        backward_error=delta,
+        lost=lost,
+        crossing=crossing,
+        discrete=bool(discrete),
+        scale=1.0 if discrete else t * float(np.max(np.abs(np.linalg.eigvals(A)))),
     )
-    fast = np.abs(cand) > resolve
-    confirmed = (rho <= 1.0) & again & ~fast
-    doubtful = ~confirmed & (((rho <= ZERO_DOUBT) & ~fast) | (fast & again & (p > m)))
-    zc = cand[confirmed]
-    kappa = np.array([_zero_condition(A, B, C, D, W1, z) for z in zc])
-    rc = 10 * tau * np.maximum(np.abs(zc), size) * kappa
-    zeros = sort_poles(zc)
-    near = [int(np.argmin(np.abs(zc - z))) for z in zeros]
-    return ZeroSet(zeros, sort_poles(cand[doubtful]), rho[doubtful], tau, rc[near])
+
+
+def _regular_pencil(A2, B2, C2, D2) -> tuple[np.ndarray, np.ndarray]:
+    """The regular pencil ``(Af, Ef)`` of a reduced system with ``D`` square and invertible."""
+    nr, mr = A2.shape[0], B2.shape[1]
+    if mr == 0:
+        Af, Ef = A2, np.eye(nr)
+    else:
+        # compress the columns of [C D] onto D: [C D] W = [0 Df]
+        CD = np.hstack([C2, D2])
+        Q, _ = np.linalg.qr(CD.T[:, ::-1], mode="complete")
+        W = Q[:, ::-1]  # last mr columns span the row space of [C D]
+        Af = (np.hstack([A2, B2]) @ W)[:, :nr]
+        Ef = (np.hstack([np.eye(nr), np.zeros((nr, mr))]) @ W)[:, :nr]
+    size = float(np.hypot(np.linalg.norm(Af, 2), np.linalg.norm(Ef, 2)))
+    return Af / size, Ef / size
+
+
+def _pencil_zeros(Af, Ef, delta, discrete):
+    """Eigenvalues of the pencil, their radii, whether each is resolved, and boundary crossing."""
+    nr = Af.shape[0]
+    ab, vl, vr = sla.eig(Af, Ef, left=True, right=True, homogeneous_eigvals=True)
+    alpha, beta = ab
+    with np.errstate(all="ignore"):
+        z = np.where(beta != 0, alpha / np.where(beta != 0, beta, 1.0), np.inf)
+        # first-order chordal radius of each eigenvalue (Stewart and Sun): kappa delta
+        num = np.linalg.norm(vl, axis=0) * np.linalg.norm(vr, axis=0)
+        den = np.hypot(
+            np.abs(np.sum(vl.conj() * (Af @ vr), axis=0)),
+            np.abs(np.sum(vl.conj() * (Ef @ vr), axis=0)),
+        )
+        chord = np.where(den > 0, num / den, np.inf) * delta
+        to_inf = np.abs(beta) / np.hypot(np.abs(alpha), np.abs(beta))
+    unresolved = ~np.isfinite(z) | (to_inf <= chord)
+    # real data: a zero with an imaginary part of round-off is real
+    z = np.where(np.isfinite(z), _real_cleaned(z), z)
+    b = _nearest_boundary(np.where(np.isfinite(z), z, 0.0), discrete)
+    radius = np.full(nr, np.inf)
+
+    def fun(w):
+        return _pseudo(Af, Ef, w)
+
+    for i in np.flatnonzero(~unresolved):
+        radius[i] = _radius_toward(fun, z[i], b[i], delta, discrete)
+    samples = _boundary_samples(z[~unresolved], discrete)
+    crossing = bool(np.min(fun(samples)) <= delta) if samples.size else False
+    return z, radius, unresolved, crossing
+
+
+def _rosenbrock_residual(A, B, C, D, scale, w) -> np.ndarray:
+    """Smallest singular value of ``[[w I - A, -B], [C, D]]`` relative to ``scale``, per ``w``.
+
+    For ``|w|`` beyond 1 (the normalized system's size) the state columns are divided by ``|w|``
+    (the pencil in homogeneous form): without it every Rosenbrock matrix at a large ``w`` is
+    nearly singular, a zero or not.
+    """
+    n, m = B.shape
+    w = np.atleast_1d(np.asarray(w, complex))
+    a = 1.0 / np.maximum(np.abs(w), 1.0)
+    top = (w[:, None, None] * np.eye(n) - A) * a[:, None, None]
+    left = np.concatenate([top, np.broadcast_to(C, (w.size, *C.shape)) * a[:, None, None]], 1)
+    right = np.broadcast_to(np.vstack([-B, D]), (w.size, n + C.shape[0], m))
+    R = np.concatenate([left, right], 2)
+    with np.errstate(all="ignore"):
+        s = np.linalg.svd(R, compute_uv=False)[:, n + m - 1]
+    return np.where(np.isfinite(s), s / scale, 0.0)
+
+
+def _round_off_zeros(A, B, C, D, scale, delta, discrete, pencil):
+    """Zeros of a tall system that hold to round-off only, with their radii.
+
+    Candidates: the zeros of a random square-down ``(A, B, W C, W D)`` (every zero of the
+    system is one of each square-down's); kept when the full Rosenbrock matrix is singular
+    there within the backward error, in a neighbourhood that does not reach infinity, and the
+    staircase's pencil does not already hold them.
+    """
+    n, m = B.shape
+    p = C.shape[0]
+    rng = np.random.default_rng(0)
+    W = np.linalg.qr(rng.standard_normal((p, m)))[0].T
+    M = np.block([[A, B], [W @ C, W @ D]])
+    N = np.zeros_like(M)
+    N[:n, :n] = np.eye(n)
+    with np.errstate(all="ignore"):
+        cand = sla.eigvals(M, N)
+    cand = _real_cleaned(cand[np.isfinite(cand)])
+    if not cand.size:
+        return np.zeros(0, complex), np.zeros(0)
+
+    def fun(w):
+        return _rosenbrock_residual(A, B, C, D, scale, w)
+
+    keep = fun(cand) <= delta
+    if pencil is not None and np.any(keep):
+        keep &= _pseudo(*pencil, cand) > delta
+    found, radius = [], []
+    for z in cand[keep]:
+        # a value whose singular neighbourhood reaches infinity is the system's infinite zeros
+        # seen through round-off (a small C B), not a finite zero
+        if np.isinf(_radius_toward(fun, z, 2 * z if z != 0 else 1.0, delta, discrete)):
+            continue
+        found.append(z)
+        radius.append(
+            _radius_toward(fun, z, _nearest_boundary(np.array([z]), discrete)[0], delta, discrete)
+        )
+    return np.array(found, complex), np.array(radius, float)
 
 
 _BLAS: Any = None

@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.linalg as sla
 
+from . import tolerances as tols
 from ._display import format_complex
 from ._validation import as_matrix
 from .balancing import BalancedPair, balanced_pair
@@ -25,9 +26,9 @@ __all__ = [
     "lmi_gain",
 ]
 
-#: Relative margin of a certified gain: every pole at least this far inside the boundary
-#: (the margin of ``uio_teach.linalg.is_stable``, so a certified observer is ``is_stable``).
-STRICT_MARGIN = 1e-9
+#: Relative margin of a certified gain (``uio_teach.tolerances.STABILITY_MARGIN``): every pole
+#: at least this far inside the boundary, so a certified observer is ``is_stable``.
+STRICT_MARGIN = tols.STABILITY_MARGIN
 
 
 class LMIError(UIOTeachError, ValueError):
@@ -297,8 +298,8 @@ def _meets_each(z: np.ndarray, discrete: bool, decay: float | None) -> np.ndarra
     """Elementwise: the pole meets the bound (strictly stable when no decay is asked)."""
     z = np.asarray(z, complex)
     if decay is None:
-        return is_stable(z, discrete, margin=STRICT_MARGIN)
-    tol = 1e-6 * max(1.0, decay)
+        return is_stable(z, discrete)
+    tol = tols.DECAY_RTOL * max(1.0, decay)
     if discrete:
         return np.abs(z) <= decay + tol
     return z.real <= -decay + tol * np.maximum(1.0, np.abs(z))

@@ -28,6 +28,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from . import tolerances as tols
 from .linalg import observability_decomposition, sort_poles
 from .plant import Plant
 
@@ -75,7 +76,7 @@ def luenberger_poles(plant: Plant, observer_poles: Sequence[complex]) -> np.ndar
         if target:
             dist = [abs(p - f) for p in target]
             i = int(np.argmin(dist))
-            if dist[i] <= 1e-6 * max(1.0, abs(f)):
+            if dist[i] <= tols.FIXED_POLE_RTOL * max(1.0, abs(f)):
                 target.pop(i)
 
     def speed(p: complex) -> float:

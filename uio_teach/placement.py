@@ -8,11 +8,12 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
+from . import tolerances as tols
 from ._display import format_complex, format_poles
 from ._validation import as_matrix, as_poles
 from .balancing import BalancedPair
 from .linalg import ObservabilitySplit, observability_decomposition
-from .verify import POLE_RTOL, PlacementAccuracyError, check_poles
+from .verify import PlacementAccuracyError, check_poles
 
 __all__ = ["place_observer_poles", "place_pair_poles", "requested_poles", "strip_fixed"]
 
@@ -110,7 +111,7 @@ def place_observer_poles(
         return np.zeros((n, C.shape[0]))
     L = _gain(split, poles)
     target = np.concatenate([poles, fixed])
-    if _error(A, C, L, target) > POLE_RTOL:
+    if _error(A, C, L, target) > tols.POLE_RTOL:
         # a badly scaled plant: place on the balanced pair (T^-1 A T, C T), L = T L_b
         t = _balance(A)
         if np.any(t != 1.0):
@@ -169,7 +170,7 @@ def strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     for f in fixed:
         dist = [abs(p - f) for p in rest]
         i = int(np.argmin(dist))
-        if dist[i] > 1e-6 * max(1.0, abs(f)):
+        if dist[i] > tols.FIXED_POLE_RTOL * max(1.0, abs(f)):
             return poles  # not a superset: let the count check complain
         rest.pop(i)
     return np.array(rest)
@@ -380,7 +381,7 @@ def place_pair_poles(
         )
         raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     for z in fixed:
-        close = np.abs(poles - z) <= 1e-6 * max(1.0, abs(z))
+        close = np.abs(poles - z) <= tols.FIXED_POLE_RTOL * max(1.0, abs(z))
         if np.any(close):
             raise ValueError(
                 f"poles: {format_complex(poles[close][0])} is requested on the fixed mode "
@@ -418,6 +419,6 @@ def _place_given(
             Lo = _gain(split, poles)
         except (PlacementAccuracyError, ValueError, np.linalg.LinAlgError):
             return None
-        if not np.all(np.isfinite(Lo)) or _error(A1, NC, Lo, target) > POLE_RTOL:
+        if not np.all(np.isfinite(Lo)) or _error(A1, NC, Lo, target) > tols.POLE_RTOL:
             return None
         return Lo @ N

@@ -20,9 +20,14 @@ Conventions that make the figures say only true things:
 * units: the course's models (PA9, the case study, the missile paper) give no physical
   units, so state, input and disturbance axes say "(model units)"; the time axis says
   "time (s)" for continuous time and "step k" for a discrete-time plant counted in steps;
-* colours: channel ``i`` of the error is ``C{i}``; a residual channel that measures one
+* colours and line styles: the course's cycle (:data:`COLORS`, the Okabe-Ito palette, safe for
+  readers with any of the three dichromacies) and a line style per channel
+  (:data:`LINESTYLES`), so that no two curves of a panel differ by hue alone; channel ``i``
+  of the error is drawn in :func:`channel_style` ``(i)``; a residual channel that measures one
   state (a row of ``C`` with one nonzero entry, e.g. ``r2 = e3`` in PA9) takes that
-  state's colour, the others colours no state uses;
+  state's colour and style, the others those no state uses;
+* words: every figure is described (:func:`uio_teach.figure_text.describe`) from the numbers
+  it draws, what is plotted and what the reader should see;
 * rounding: a panel whose curves are zero up to rounding (``1e-12`` next to signals of
   size 1) is not blown up to fill the axes: its range is at least a thousandth of the
   signals' size, so the curves lie on zero, and the panel says "zero to rounding".
@@ -37,6 +42,8 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .figure_text import describe, description
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -63,8 +70,22 @@ __all__ = [
     "residual_colors",
     "covered_curves",
     "legend_beside",
+    "channel_style",
+    "residual_channels",
+    "describe",
+    "description",
+    "COLORS",
+    "LINESTYLES",
     "UNIT",
 ]
+
+COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
+"""The course's colour cycle: the Okabe-Ito palette (blue, vermillion, bluish green, reddish
+purple, orange, sky blue, black) without its yellow, which is too light on white. The book's
+``matplotlibrc`` sets the same cycle, with :data:`LINESTYLES`."""
+LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2)), (0, (1, 1)))
+"""The line style of each colour of :data:`COLORS`: curves stay apart in grey print and for a
+reader who sees two of the colours as one."""
 
 UNIT = "model units"
 """The unit of states, inputs and disturbances: the course's models give no physical units."""
@@ -135,12 +156,67 @@ def with_unit(label: str, unit: str = UNIT) -> str:
     return f"{label} ({unit})"
 
 
-def residual_colors(C: np.ndarray) -> list[str]:
-    """The colour of each residual channel: that of the state its row of ``C`` measures.
+def channel_style(i: int) -> dict[str, Any]:
+    """The colour and line style of channel ``i`` (from 0): ``color`` and ``linestyle``.
+
+    Parameters
+    ----------
+    i : int
+        The channel; the cycle repeats after ``len(COLORS)`` channels.
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``Axes.plot``.
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import channel_style
+    >>> channel_style(0), channel_style(1)["linestyle"]
+    ({'color': '#0072B2', 'linestyle': '-'}, '--')
+    """
+    k = int(i) % len(COLORS)
+    return {"color": COLORS[k], "linestyle": LINESTYLES[k]}
+
+
+def residual_channels(C: np.ndarray) -> list[int]:
+    """The style channel of each residual: that of the state its row of ``C`` measures.
 
     Row ``i`` of ``C`` with a single nonzero entry, in column ``j``, makes
-    ``r_i`` a multiple of ``e_j`` (without noise), so it gets the colour
-    ``C{j}`` of ``e_j``; other rows get colours after those of the states.
+    ``r_i`` a multiple of ``e_j`` (without noise), so it is drawn like ``e_j``
+    (:func:`channel_style` ``(j)``); other rows get the channels after those of the states.
+
+    Parameters
+    ----------
+    C : array_like
+        The output matrix, ``p x n``.
+
+    Returns
+    -------
+    list of int
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import residual_channels
+    >>> residual_channels([[1, 0, 0], [0, 0, 1]])  # PA9: r1 = e1, r2 = e3
+    [0, 2]
+    >>> residual_channels([[0, 2, 1], [1, 0, 0]])  # the case study: r1 mixes e2 and e3
+    [3, 0]
+    """
+    C = np.atleast_2d(np.asarray(C, dtype=float))
+    channels, spare = [], C.shape[1]
+    for row in C:
+        nonzero = np.flatnonzero(row)
+        if nonzero.size == 1:
+            channels.append(int(nonzero[0]))
+        else:
+            channels.append(spare)
+            spare += 1
+    return channels
+
+
+def residual_colors(C: np.ndarray) -> list[str]:
+    """The colour of each residual channel: that of the state its row of ``C`` measures.
 
     Parameters
     ----------
@@ -150,26 +226,15 @@ def residual_colors(C: np.ndarray) -> list[str]:
     Returns
     -------
     list of str
+        :func:`channel_style` colours of :func:`residual_channels`.
 
     Examples
     --------
-    >>> from uio_teach.plotting import residual_colors
-    >>> residual_colors([[1, 0, 0], [0, 0, 1]])  # PA9: r1 = e1, r2 = e3
-    ['C0', 'C2']
-    >>> residual_colors([[0, 2, 1], [1, 0, 0]])  # the case study: r1 mixes e2 and e3
-    ['C3', 'C0']
+    >>> from uio_teach.plotting import COLORS, residual_colors
+    >>> residual_colors([[1, 0, 0], [0, 0, 1]]) == [COLORS[0], COLORS[2]]
+    True
     """
-    C = np.atleast_2d(np.asarray(C, dtype=float))
-    n = C.shape[1]
-    colours, spare = [], n
-    for row in C:
-        nonzero = np.flatnonzero(row)
-        if nonzero.size == 1:
-            colours.append(f"C{int(nonzero[0])}")
-        else:
-            colours.append(f"C{spare}")
-            spare += 1
-    return colours
+    return [channel_style(j)["color"] for j in residual_channels(C)]
 
 
 def zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
@@ -347,7 +412,7 @@ def plot_channels(
     discrete: bool = False,
     **kwargs: Any,
 ) -> None:
-    """One line per row of ``values``, coloured ``C0, C1, ...`` and named :func:`symbol`.
+    """One line per row of ``values``, drawn in :func:`channel_style` and named :func:`symbol`.
 
     Parameters
     ----------
@@ -362,8 +427,9 @@ def plot_channels(
     discrete : bool, optional
         Draw steps (a discrete-time signal).
     **kwargs
-        Further line properties; ``colors`` (a list, one per row) replaces
-        the colours ``C0, C1, ...``.
+        Further line properties; ``channels`` (a list of int, one per row) draws row ``i``
+        in ``channel_style(channels[i])``, ``colors`` (a list, one per row) replaces the
+        colours only.
 
     Examples
     --------
@@ -375,9 +441,12 @@ def plot_channels(
     ['$r_{1}$', '$r_{2}$']
     """
     colors = kwargs.pop("colors", None)
+    channels = kwargs.pop("channels", None)
     for i, row in enumerate(np.atleast_2d(values)):
-        color = colors[i] if colors is not None else f"C{i}"
-        _line(ax, t, row, discrete, label=symbol(letter, i), color=color, **kwargs)
+        look = channel_style(channels[i] if channels is not None else i)
+        if colors is not None:
+            look["color"] = colors[i]
+        _line(ax, t, row, discrete, label=symbol(letter, i), **{**look, **kwargs})
 
 
 def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
@@ -398,7 +467,7 @@ def plot_error(ax: Axes, response: UIOResponse, *, legend: bool = True) -> None:
     Examples
     --------
     >>> import uio_teach as ut
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> from uio_teach.plotting import new_figure, plot_error
     >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
     >>> ax = new_figure().subplots()
@@ -430,7 +499,7 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
     Examples
     --------
     >>> import uio_teach as ut
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> from uio_teach.plotting import new_figure, plot_residual
     >>> resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
     >>> ax = new_figure().subplots()
@@ -444,7 +513,7 @@ def plot_residual(ax: Axes, response: UIOResponse, *, legend: bool = True) -> No
         response.residual,
         "r",
         discrete=response.plant.is_discrete,
-        colors=residual_colors(response.plant.C),
+        channels=residual_channels(response.plant.C),
     )
     finish_panel(ax, axis_label("residual"), legend)
     zero_to_rounding(ax, response.residual, _size(response.outputs))
@@ -498,13 +567,126 @@ def _actual_and_estimate(
     letter: str,
     i: int,
 ) -> None:
-    """One panel: a signal (coloured) and its estimate (black, dashed), labelled."""
+    """One panel: a signal (solid, coloured) and its estimate (black, dashed), labelled."""
     name = symbol(letter, i)
     if actual is not None:
-        _line(ax, t, actual, discrete, label=name, color=f"C{i}")
+        _line(ax, t, actual, discrete, label=name, color=channel_style(i)["color"])
     hat = symbol(letter, i, hat=True)
     _line(ax, t, estimate, discrete, label=hat, color="k", linestyle="--", linewidth=1.0)
     finish_panel(ax, with_unit(name))
+
+
+# --- the figures in words ----------------------------------------------------------------------
+
+_SETTLED = 0.02
+"""A signal has settled on zero once it stays below this fraction of its peak."""
+
+
+def _plain(name: str) -> str:
+    """A mathtext name in words for a text alternative: ``$\\hat{x}_{2}$`` -> ``x-hat 2``."""
+    import re
+
+    text = re.sub(r"\\hat\{(\w+)\}", r"\1-hat", name)
+    text = re.sub(r"_\{(\w+)\}", r" \1", text)
+    return text.replace("$", "").replace("\\", "").replace("{", "").replace("}", "")
+
+
+def _when(t: float, dt: float | bool | None) -> str:
+    return f"step {t:g}" if time_label(dt) == "step k" else f"t = {t:.3g} s"
+
+
+def _settles(t: np.ndarray, values: np.ndarray, scale: float, dt: float | bool | None) -> str:
+    """How the rows of ``values`` end: zero to rounding, settled on zero (and from when), or not."""
+    values = np.atleast_2d(np.asarray(values, dtype=float))
+    finite = np.where(np.isfinite(values), np.abs(values), np.inf)
+    worst = finite.max(axis=0) if values.size else np.zeros(0)
+    peak = float(worst[np.isfinite(worst)].max()) if np.isfinite(worst).any() else np.inf
+    if not np.isfinite(peak):
+        return "grows without bound (the simulation overflowed)"
+    if peak <= _ROUNDING * max(scale, 1e-300):
+        return "is zero to rounding throughout"
+    above = np.flatnonzero(worst > _SETTLED * peak)
+    last = int(above[-1]) if above.size else -1
+    if last + 1 >= worst.size or worst.size - last < max(2, worst.size // 20):
+        share = float(worst[-max(1, worst.size // 10) :].max()) / peak
+        return f"does not settle on zero: at the end it is still {share:.0%} of its peak"
+    return f"decays to zero (below {_SETTLED:.0%} of its peak from {_when(t[last + 1], dt)} on)"
+
+
+def _describe_response(fig: Figure, response: UIOResponse, title: str) -> None:
+    plant = response.plant
+    t = np.asarray(response.time, dtype=float)
+    n = plant.n
+    states = ", ".join(f"x{i + 1}" for i in range(n))
+    error = _settles(t, response.error, _size(response.states), plant.dt)
+    residual = _settles(t, response.residual, _size(response.outputs), plant.dt)
+    alt = (
+        f"{title}: against time, each state ({states}) drawn solid with its estimate dashed "
+        f"in black, then the estimation error e = x - x-hat and the output residual r = y - C "
+        f"x-hat, one curve per channel. The error {error}; the residual {residual}."
+    )
+    ranges = ", ".join(
+        f"x{i + 1} from {np.nanmin(response.states[i]):.3g} to {np.nanmax(response.states[i]):.3g}"
+        for i in range(n)
+    )
+    details = [f"State panels, each with its estimate: {ranges} (model units)."]
+    details.append(
+        "Error panel: "
+        + "; ".join(
+            f"e{i + 1} ({_look(i)}) "
+            + _settles(t, response.error[i], _size(response.states), plant.dt)
+            for i in range(n)
+        )
+        + "."
+    )
+    channels = residual_channels(plant.C)
+    details.append(
+        "Residual panel: "
+        + "; ".join(
+            f"r{i + 1} ({_look(j)}) "
+            + _settles(t, response.residual[i], _size(response.outputs), plant.dt)
+            for i, j in enumerate(channels)
+        )
+        + "."
+    )
+    describe(fig, alt, " ".join(details))
+
+
+_COLOUR_NAMES = ("blue", "vermillion", "bluish green", "reddish purple", "orange", "sky blue",
+                 "black")  # fmt: skip
+_STYLE_NAMES = ("solid", "dashed", "dash-dotted", "dotted", "dash-dot-dot", "long-dashed",
+                "densely dotted")  # fmt: skip
+
+
+def _look(i: int) -> str:
+    """Channel ``i``'s colour and line style in words: ``"blue, solid"``."""
+    k = int(i) % len(COLORS)
+    return f"{_COLOUR_NAMES[k]}, {_STYLE_NAMES[k]}"
+
+
+def _describe_input_estimate(fig: Figure, estimate: InputEstimate, title: str, letter: str) -> None:
+    q = estimate.estimates.shape[0]
+    t = np.asarray(estimate.time, dtype=float)
+    dt = estimate.dt
+    parts = []
+    for i in range(q):
+        name = f"{letter}{i + 1}"
+        if estimate.actual is None:
+            peak = _size(estimate.estimates[i])
+            parts.append(f"the reconstruction of {name} reaches {peak:.3g} at most")
+            continue
+        gap = np.asarray(estimate.estimates[i], dtype=float) - estimate.actual[i]
+        scale = _size(estimate.actual[i])
+        parts.append(
+            f"the gap between {name} and its reconstruction " + _settles(t, gap, scale, dt)
+        )
+    inputs = ", ".join(f"{letter}{i + 1}" for i in range(q))
+    said = "; ".join(parts)
+    alt = (
+        f"{title}: against time, each unknown input ({inputs}) drawn solid with its "
+        f"reconstruction dashed in black. {said[:1].upper()}{said[1:]}."
+    )
+    describe(fig, alt, "")
 
 
 def plot_response(
@@ -572,6 +754,7 @@ def plot_response(
         name = plant.name or "plant"
         title = f"{response.observer.family} on {name}"
     fig.suptitle(title)
+    _describe_response(fig, response, _plain(title))
     return fig
 
 
@@ -628,11 +811,12 @@ def plot_input_estimate(
         title = f"unknown input reconstruction ({estimate.method}"
         title += f", tau = {estimate.tau:g})" if estimate.tau is not None else ")"
     fig.suptitle(title)
+    _describe_input_estimate(fig, estimate, _plain(title), symbol)
     return fig
 
 
 # The bank's figure: the members' colours (black is the alarm level), the smallest font size.
-_MEMBER_COLORS = ("C0", "C1", "C2", "C4", "C9", "C6", "C8", "C5")
+_MEMBER_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 BANK_FONT_SIZE = FONT_SIZE + 1
 """Font size (points) of every text of :func:`plot_bank_alarms`: about 9 px or more when the
 figure is shown at the width of the book's column."""
@@ -652,7 +836,7 @@ def plot_bank_alarms(
 
     Every panel shows one run (a fault, or none) and all the members of all the banks:
     ``J / threshold`` on a logarithmic axis, so a curve above 1 (the black dashed line)
-    is an alarm. The members keep one colour in every panel; the members of the second
+    is an alarm. The members keep one colour and marker in every panel; the members of the second
     bank are dashed. One legend, above the panels, names them all; the grey band is the
     start before monitoring begins.
 
@@ -717,6 +901,7 @@ def plot_bank_alarms(
     axes = np.atleast_1d(fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False))
     size = BANK_FONT_SIZE
     handles: dict[str, Any] = {}
+    peaks: dict[str, dict[str, float]] = {name: {} for name in names}
     for k, name in enumerate(names):
         ax = axes.flat[k]
         colour = 0
@@ -734,9 +919,13 @@ def plot_bank_alarms(
                     J / th.value,
                     lw=1.4,
                     ls="-" if b == 0 else "--",
-                    color=_MEMBER_COLORS[colour % len(_MEMBER_COLORS)],
+                    color=COLORS[colour % len(COLORS)],
+                    marker=_MEMBER_MARKERS[colour % len(_MEMBER_MARKERS)],
+                    markevery=(colour * max(1, t.size // 64), max(1, t.size // 8)),
+                    markersize=5,
                     label=label,
                 )
+                peaks[name][label] = float(np.nanmax((J / th.value)[t >= th.start]))
                 handles.setdefault(label, line)
                 colour += 1
                 start = th.start
@@ -767,7 +956,40 @@ def plot_bank_alarms(
         fontsize=size,
         frameon=False,
     )
+    _describe_bank(fig, peaks, fault_time)
     return fig
+
+
+def _describe_bank(
+    fig: Figure, peaks: dict[str, dict[str, float]], fault_time: float | None
+) -> None:
+    """The bank's figure in words: which members raise an alarm in which run."""
+    runs = []
+    isolates = True
+    for name, members in peaks.items():
+        loud = [m.removeprefix("blind to ") for m, p in members.items() if p > 1.0]
+        quiet = [m.removeprefix("blind to ") for m, p in members.items() if p <= 1.0]
+        what = "no fault" if name == "no fault" else f"fault: {name}"
+        runs.append(
+            f"Run {what}: "
+            + (f"alarms from the members blind to {', '.join(loud)}" if loud else "no alarm")
+            + (f"; the members blind to {', '.join(quiet)} stay below 1." if quiet and loud
+               else ".")
+        )  # fmt: skip
+        isolates &= quiet == [name] if name != "no fault" else not loud
+    start = f" The faults start at t = {fault_time:g} s." if fault_time is not None else ""
+    summary = (
+        " In every fault run all members raise an alarm except the one blind to that fault, "
+        "which isolates it; with no fault none does."
+        if isolates
+        else " Which members raise an alarm in each run is described below."
+    )
+    alt = (
+        "Alarms of the bank of UIOs, one panel per run: each member's evaluation function over "
+        "its threshold (J / threshold, logarithmic axis) against time; a curve above the "
+        "dashed black line at 1 is an alarm." + start + summary
+    )
+    describe(fig, alt, " ".join(runs))
 
 
 def covered_curves(fig: Figure) -> list[tuple[str, str]]:

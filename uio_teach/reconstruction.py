@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from . import tolerances as tols
 from ._validation import as_real_array, as_real_number, as_time
 from .linalg import pinv, rank
 from .plant import Plant
@@ -157,7 +158,10 @@ def _lowpass(t: np.ndarray, x: np.ndarray, tau: float, y0: np.ndarray) -> np.nda
     h = (t[-1] - t[0]) / (t.size - 1)
     y = np.empty_like(x)
     y[:, 0] = y0
-    if np.max(np.abs(steps - h)) <= 1e-9 * h + 64 * np.finfo(float).eps * np.abs(t).max():
+    if (
+        np.max(np.abs(steps - h))
+        <= tols.TIME_GRID_RTOL * h + 64 * np.finfo(float).eps * np.abs(t).max()
+    ):
         lam, b0, b1 = _lowpass_coefficients(h, tau)
         zi = (b0 * x[:, 0] + lam * y0)[:, None]
         y[:, 1:] = lfilter([b1, b0], [1.0, -lam], x[:, 1:], axis=1, zi=zi)[0]

@@ -56,6 +56,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg as sla
 
+from . import tolerances as tols
 from ._display import format_complex
 from ._validation import as_seed, as_time
 from .errors import UIOTeachError
@@ -259,7 +260,7 @@ def check_timepts(timepts: Any) -> np.ndarray:
 def _uniform_step(t: np.ndarray) -> float | None:
     """The step of a uniform grid (``None`` if the spacing varies beyond rounding)."""
     h = (t[-1] - t[0]) / (t.size - 1)
-    tol = 1e-9 * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
+    tol = tols.TIME_GRID_RTOL * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
     steps = np.diff(t)
     if max(steps.max() - h, h - steps.min()) <= tol:
         return float(h)
@@ -275,7 +276,7 @@ def _check_discrete_grid(plant: Plant, t: np.ndarray) -> float:
             f"timepts must lie on the sampling grid of the discrete plant ({period}): "
             f"got a non-uniform spacing (steps from {steps.min():g} to {steps.max():g})"
         )
-    if plant.dt is not True and abs(h - plant.dt) > 1e-9 * plant.dt:
+    if plant.dt is not True and abs(h - plant.dt) > tols.TIME_GRID_RTOL * plant.dt:
         raise ValueError(
             f"timepts must lie on the sampling grid of the discrete plant: their spacing "
             f"must equal dt = {plant.dt:g}, got {h:g} (e.g. timepts = np.arange(N) * dt)"

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
+from . import tolerances as tols
 from ._display import format_complex
 from .errors import UIOTeachError, UIOTeachWarning
 
@@ -54,10 +55,11 @@ __all__ = [
     "check_decoupling",
 ]
 
-POLE_RTOL = 1e-6
-WARN_RTOL = 1e-3
-IDENTITY_RTOL = 1e-8
-_EPS = np.finfo(float).eps
+POLE_RTOL = tols.POLE_RTOL
+WARN_RTOL = tols.WARN_RTOL
+IDENTITY_RTOL = tols.IDENTITY_RTOL
+_EPS = tols.EPS
+_TINY = float(np.finfo(float).tiny)
 
 
 def _fmt(values) -> str:
@@ -142,7 +144,7 @@ def check_poles(
     err = np.abs(obtained - req)
     size = np.maximum(1.0, np.abs(req))
     round_off = n * _EPS * normF * np.where(np.isfinite(kap), kap, 1e300)
-    tight = err <= POLE_RTOL * size
+    tight = err <= tols.POLE_RTOL * size
     # a pole requested m times forms a Jordan block: a perturbation delta of F moves it by about
     # (delta ||F||^(m-1))^(1/m), far more than kappa (computed from nearby eigenvectors) says;
     # the gain of such a design (Ackermann's formula) is itself accurate to about 100 n eps ||F||
@@ -153,11 +155,11 @@ def check_poles(
         holder = (100 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m) / 10
     round_off = np.where(m > 1, np.maximum(round_off, holder), round_off)
     explained = err <= 10 * round_off
-    for i in np.flatnonzero(~tight & ~explained & (err <= WARN_RTOL * size)):
+    for i in np.flatnonzero(~tight & ~explained & (err <= tols.WARN_RTOL * size)):
         # backward check: is the requested value an eigenvalue of a matrix close to F?
         smin = np.linalg.svd(F - req[i] * np.eye(n), compute_uv=False)[-1]
         explained[i] = smin <= 10 * n * _EPS * max(normF, abs(req[i]))
-    ok = tight | (explained & (err <= WARN_RTOL * size))
+    ok = tight | (explained & (err <= tols.WARN_RTOL * size))
     if np.all(ok):
         return obtained
     bad = ~ok
@@ -171,7 +173,7 @@ def check_poles(
         "conditioned: spread the poles apart, choose them closer to the plant's own, or "
         "scale the plant's states"
     )
-    if worst > WARN_RTOL:
+    if worst > tols.WARN_RTOL:
         raise PlacementAccuracyError(text)
     warnings.warn(text, PlacementAccuracyWarning, stacklevel=stacklevel)
     return obtained
@@ -278,11 +280,11 @@ def check_identity(name: str, residual, scale, *, what: str = "the observer") ->
         rel = res / scale if scale > 0 else (0.0 if res == 0 else np.inf)
     else:
         rel = relative_residual(R, scale)
-    if not rel <= IDENTITY_RTOL:
+    if not rel <= tols.IDENTITY_RTOL:
         raise PlacementAccuracyError(
             f"{what}: the identity {name} holds only to {rel:.2g} relative to its factors "
-            f"(tolerance {IDENTITY_RTOL:g}); the decoupling is lost to round-off, the data are "
-            "too badly conditioned (scale the plant's states or outputs)"
+            f"(tolerance {tols.IDENTITY_RTOL:g}); the decoupling is lost to round-off, the data "
+            "are too badly conditioned (scale the plant's states or outputs)"
         )
     return rel
 
@@ -327,7 +329,7 @@ def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
         cost = np.abs(z[:, None] - w[None, :])
         rows, cols = linear_sum_assignment(cost)
         err = cost[rows, cols] / np.maximum(1.0, np.abs(z[rows]))
-        bad = err > WARN_RTOL
+        bad = err > tols.WARN_RTOL
         missing, nearest = z[rows[bad]], w[cols[bad]]
     if missing.size:
         raise PlacementAccuracyError(
@@ -337,12 +339,11 @@ def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
         )
 
 
-LEAK_RTOL = 1e-6
-"""A design is returned without a word when the unknown input's gain to the estimation error is
-certainly below ``LEAK_RTOL`` times its gain to the state (round-off of the check included)."""
+LEAK_RTOL = tols.LEAK_RTOL
+"""``uio_teach.tolerances.LEAK_RTOL``."""
 
-LEAK_REFUSE = 1e-3
-"""A design whose computed leak exceeds this fraction of the state's response is refused."""
+LEAK_REFUSE = tols.LEAK_REFUSE
+"""``uio_teach.tolerances.LEAK_REFUSE``."""
 
 
 class DecouplingWarning(UIOTeachWarning):
@@ -406,6 +407,7 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
         return DecouplingLeak(0.0, 0.0, 0.0)
     if not all(np.all(np.isfinite(X)) for X in (A, E, C, F, K, Co, Dy, M)):
         return DecouplingLeak(np.inf, np.inf, np.inf)
+    A, E, C, F, K, Co, Dy, M = _balanced(A, E, C, F, K, Co, Dy, M)
     ext = np.longdouble
     # the rounding of the residuals' own computation: sqrt(n) times the working precision times
     # the size of their terms (rounding errors of a sum add up like a random walk)
@@ -426,23 +428,17 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
         if not (np.isfinite(Rb) and np.isfinite(R1b) and np.isfinite(R0b)):
             return DecouplingLeak(np.inf, np.inf, np.inf)
         lam = np.concatenate([np.linalg.eigvals(A), np.linalg.eigvals(F)])
-    if discrete:
-        ang = np.abs(np.angle(lam[np.isfinite(lam)]))
-        points = np.exp(1j * np.unique(np.concatenate([np.linspace(0.0, np.pi, 13), ang])))
-    else:
-        mags = np.abs(lam[np.isfinite(lam)])
-        mags = mags[mags > 0]
-        lo, hi = (float(mags.min()), float(mags.max())) if mags.size else (1.0, 1.0)
-        # a grid over the plant's and the observer's frequencies, and each resonance
-        grid = np.geomspace(lo, hi, 12) if hi > lo else np.array([lo])
-        res = np.abs(lam.imag[np.isfinite(lam)])
-        points = 1j * np.unique(np.concatenate([[0.0], grid, res[res > 0]]))
+    points = _test_points(lam[np.isfinite(lam)], discrete)
     leak = bound = gain = 0.0
     eye = np.eye(n)
-    lam_f = lam[np.isfinite(lam)]
+    lam_A, lam_F = np.linalg.eigvals(A), np.linalg.eigvals(F)
+    # a test point on an eigenvalue to round-off (an undamped mode, a pole at the origin): the
+    # transfer function is not defined there, and its neighbours carry its gain
+    near_A = 100 * n * _EPS * max(float(np.linalg.norm(A, 2)), _TINY)
+    near_F = 100 * n * _EPS * max(float(np.linalg.norm(F, 2)), _TINY)
     for z in points:
-        if np.any(np.abs(lam_f - z) <= 1e-6 * max(1.0, abs(z))):
-            continue  # on a pole of the plant or the observer (an undamped mode): no gain there
+        if np.any(np.abs(lam_A - z) <= near_A) or np.any(np.abs(lam_F - z) <= near_F):
+            continue
         try:
             X = np.linalg.solve(z * eye - A, E)
             Y = Co @ np.linalg.inv(z * np.eye(F.shape[0]) - F)
@@ -458,6 +454,60 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
     if gain == 0:
         return DecouplingLeak(0.0, 0.0, 0.0)
     return DecouplingLeak(leak / gain, bound / gain, bound / gain / _EPS)
+
+
+def _balanced(A, E, C, F, K, Co, Dy, M):
+    """Everything in the plant's balanced units (powers of 2, exact): the leak and its bound are
+    then the same whatever units the states, inputs and outputs are measured in."""
+    from .balancing import plant_scaling  # deferred: balancing imports the algorithms above
+    from .plant import Plant
+
+    n = A.shape[0]
+    try:
+        sc = plant_scaling(Plant(A, C, E=E))
+    except (ValueError, FloatingPointError):  # pragma: no cover - data checked before
+        return A, E, C, F, K, Co, Dy, M
+    t, wy, wd = sc.t, sc.wy, sc.wd
+    if F.shape != (n, n):  # pragma: no cover - every observer here estimates theta x
+        return A, E, C, F, K, Co, Dy, M
+    with np.errstate(all="ignore"):
+        out = (
+            A / t[:, None] * t[None, :],
+            E / t[:, None] * wd[None, :],
+            wy[:, None] * C * t[None, :],
+            F / t[:, None] * t[None, :],
+            K / t[:, None] / wy[None, :],
+            Co / t[:, None] * t[None, :],
+            Dy / t[:, None] / wy[None, :],
+            M / t[:, None] / wy[None, :],
+        )
+    return out if all(np.all(np.isfinite(X)) for X in out) else (A, E, C, F, K, Co, Dy, M)
+
+
+def _test_points(lam: np.ndarray, discrete: bool) -> np.ndarray:
+    """Where the leak is evaluated: DC, every mode at its own rate, and a grid between.
+
+    Continuous time: ``s = j w`` at ``w = 0``, at each mode's magnitude (a slow fixed mode
+    ``1e-9`` from the origin sets a band at ``1e-9``, evaluated there, not skipped), a tenth and
+    ten times it, at each resonance, and on a logarithmic grid over all of them. Discrete
+    time: ``z = e^(j w)`` with ``w`` the same for each mode's distance from ``z = 1`` (its rate),
+    its angle, and a grid over ``[0, pi]``.
+    """
+    if discrete:
+        rate = np.abs(1.0 - lam)
+        ang = np.abs(np.angle(lam))
+    else:
+        rate = np.abs(lam)
+        ang = np.abs(lam.imag)
+    rate = rate[(rate > 0) & np.isfinite(rate)]
+    own = np.concatenate([rate, rate / 10, rate * 10, ang[ang > 0]])
+    if rate.size:
+        lo, hi = float(rate.min()) / 10, float(rate.max()) * 10
+        own = np.concatenate([own, np.geomspace(lo, hi, 25)])
+    if discrete:
+        w = np.concatenate([[0.0], np.linspace(0.0, np.pi, 13), own[own <= np.pi]])
+        return np.exp(1j * np.unique(w))
+    return 1j * np.unique(np.concatenate([[0.0], own]))
 
 
 def check_decoupling(
@@ -491,7 +541,8 @@ def check_decoupling(
     Raises
     ------
     DecouplingError
-        The stored matrices leak more than ``LEAK_REFUSE`` of the state's response.
+        The stored matrices may leak more than ``LEAK_REFUSE`` of the state's response (the
+        bound, round-off of the check included, not only the computed value).
 
     Warns
     -----
@@ -508,16 +559,17 @@ def check_decoupling(
     True
     """
     res = decoupling_leak(A, E, C, F, K, Co, Dy, M, discrete)
-    if res.bound <= LEAK_RTOL:
+    if res.bound <= tols.LEAK_RTOL:
         return res
     why = f"the realization amplifies round-off by {res.amplification:.2g}" + (
         f" ({cause})" if cause else ""
     )
-    if not res.leak <= LEAK_REFUSE:
+    if not res.bound <= tols.LEAK_REFUSE:
         raise DecouplingError(
-            f"{what} does not decouple: the unknown input reaches the estimation error with "
-            f"{res.leak:.2g} of its gain on the state (judged on the returned matrices); "
-            f"{why}. The design is refused"
+            f"{what} does not decouple: the unknown input may reach the estimation error with "
+            f"up to {res.bound:.2g} of its gain on the state ({res.leak:.2g} computed, judged on "
+            f"the returned matrices at every frequency, DC included); {why}. The design is "
+            "refused"
         )
     warnings.warn(
         f"{what} decouples only approximately: the unknown input may reach the estimation error "

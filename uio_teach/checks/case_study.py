@@ -32,8 +32,8 @@ import numpy as np
 from .. import examples
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence, decoupling
-from ..experiments import CASE_STUDY
 from ..linalg import left_null
+from ..worked.case_study import CASE_STUDY
 from .common import (
     CheckResult,
     check_plant_of,
@@ -417,7 +417,7 @@ def case_study_simulation(
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import CASE_STUDY as CS
+    >>> from uio_teach.worked.case_study import CASE_STUDY as CS
     >>> pmo = ut.design_pmo(CS.plant(), method="lmi")
     >>> checks.case_study_simulation(CS.simulate(pmo)).passed
     True
@@ -564,7 +564,7 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import CASE_STUDY as CS
+    >>> from uio_teach.worked.case_study import CASE_STUDY as CS
     >>> plant = CS.plant()
     >>> run = CS.simulate(ut.design_pmo(plant, method="lmi"))
     >>> N = ut.linalg.left_null(plant.D)
@@ -653,7 +653,7 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
     >>> import uio_teach as ut
     >>> from matplotlib.figure import Figure
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import CASE_STUDY as CS
+    >>> from uio_teach.worked.case_study import CASE_STUDY as CS
     >>> plant = CS.plant()
     >>> run = CS.simulate(ut.design_pmo(plant, method="lmi"))
     >>> fig = Figure()

@@ -597,7 +597,7 @@ def rerun_without_unknown_inputs(resp: Any, *, keep_v: bool = False) -> tuple[fl
     --------
     >>> import uio_teach as ut
     >>> from uio_teach.checks.common import rerun_without_unknown_inputs
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> run = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles), d=PA9.d_sine)
     >>> rerun_without_unknown_inputs(run)[1]
     True
@@ -640,7 +640,7 @@ def check_plant_of(result: CheckResult, resp: Any, plant: Any) -> bool:
     --------
     >>> import uio_teach as ut
     >>> from uio_teach.checks.common import CheckResult, check_plant_of
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> run = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles))
     >>> check_plant_of(CheckResult("demo"), run, ut.examples.pa9())
     True

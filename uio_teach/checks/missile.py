@@ -34,9 +34,9 @@ import numpy as np
 
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence
-from ..experiments import MISSILE
 from ..reconstruction import catch_time, reconstruct_input
 from ..simulation import simulate
+from ..worked.missile import MISSILE
 from .common import (
     CheckResult,
     as_poles,
@@ -402,7 +402,7 @@ def missile_reconstruction(
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import MISSILE
+    >>> from uio_teach.worked.missile import MISSILE
     >>> plant = MISSILE.plant()
     >>> pmo = ut.design_pmo(plant, poles=MISSILE.poles)
     >>> run = MISSILE.simulate(pmo, observer_state=None)  # z(0) = 0
@@ -668,14 +668,15 @@ def missile_noise(
         )
     h = float(resp.time[1] - resp.time[0])
     CE = resp.plant.C @ resp.plant.E
-    rho = np.linalg.norm(np.linalg.pinv(CE), axis=1)
-    predicted = float(sigma) / (math.sqrt(2) * h) * rho
+    beta = np.linalg.norm(np.linalg.pinv(CE), axis=1)  # row i of (CE)^+, as the exercise
+    predicted = float(sigma) / (math.sqrt(2) * h) * beta
     ratio = got / predicted
     near = bool(np.all(np.abs(ratio - 1) <= 0.25))
     result.add(
         None,
         f"your RMS errors are {'within' if near else 'not within'} 25 % of the prediction "
-        "σ ρ_i / (√2 h): the differentiator amplifies the noise by 1/h.",
+        f"σ β_i / (√2 h) = {predicted[0]:.3g}, {predicted[1]:.3g} (β_i the length of row i of "
+        "(CE)^+): the differentiator amplifies the noise by 1/h.",
     )
     return result
 
@@ -709,7 +710,7 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import MISSILE
+    >>> from uio_teach.worked.missile import MISSILE
     >>> plant = MISSILE.plant()
     >>> run = MISSILE.simulate(ut.design_pmo(plant, poles=MISSILE.poles))
     >>> vhat = ut.reconstruct_input(plant, run)

@@ -450,7 +450,7 @@ def pa9_piecewise_plot(fig: Any, response: Any = None, *, plant: Any = None) -> 
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> run = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles), d=PA9.d_piecewise)
     >>> checks.pa9_piecewise_plot(None, run).passed
     False

@@ -7,7 +7,7 @@ Examples
 --------
 >>> import uio_teach as ut
 >>> from uio_teach.checks import pa9_simulation
->>> from uio_teach.experiments import PA9
+>>> from uio_teach.worked.pa9 import PA9
 >>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
 >>> pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
 True
@@ -210,7 +210,7 @@ def pa9_simulation(
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> plant = PA9.plant()
     >>> obs = ut.design_uio(plant, poles=PA9.poles)
     >>> checks.pa9_simulation(PA9.simulate(obs, d=PA9.d_sine)).passed
@@ -314,7 +314,7 @@ def pa9_piecewise(
     --------
     >>> import uio_teach as ut
     >>> from uio_teach import checks
-    >>> from uio_teach.experiments import PA9
+    >>> from uio_teach.worked.pa9 import PA9
     >>> obs = ut.design_uio(PA9.plant(), poles=PA9.poles)
     >>> sin = PA9.simulate(obs, d=PA9.d_sine)
     >>> pw = PA9.simulate(obs, d=PA9.d_piecewise)

@@ -5,8 +5,8 @@ same poles, for one plant, and let a student move the poles and the disturbance:
 
 * :mod:`~uio_teach.explorers.model` -- what is explored (:class:`Scenario`) and the values
   of the controls (:class:`Settings`, :class:`Channel`, :func:`disturbance_signals`);
-* :mod:`~uio_teach.explorers.scenarios` -- the course's worked experiments
-  (:func:`pa9_scenario`, :func:`case_study_scenario`, :func:`missile_scenario`) and
+* :mod:`~uio_teach.explorers.scenarios` -- the worked examples' scenarios
+  (:func:`scenario_of`, from the registry :data:`uio_teach.worked.WORKED`) and
   :func:`make_scenario` for any plant;
 * :mod:`~uio_teach.explorers.frames` -- :func:`compute_frame`: design, simulate and
   prepare one picture (:class:`Frame`), never raising for a value a student can set;
@@ -24,8 +24,8 @@ The Luenberger observer's poles follow :func:`uio_teach.luenberger.luenberger_po
 
 Examples
 --------
->>> from uio_teach.explorers import compute_frame, pa9_scenario
->>> scenario = pa9_scenario()
+>>> from uio_teach.explorers import compute_frame, scenario_of
+>>> scenario = scenario_of("pa9")
 >>> frame = compute_frame(scenario, scenario.defaults.replace(poles=(-2.0, -3.0, -4.0)))
 >>> frame.poles.real.round(6).tolist()
 [-4.0, -3.0, -2.0]
@@ -51,13 +51,7 @@ from .model import (
     expand_poles,
 )
 from .modes import excited_modes
-from .scenarios import (
-    case_study_scenario,
-    make_scenario,
-    missile_scenario,
-    pa9_scenario,
-    scenario_of,
-)
+from .scenarios import make_scenario, scenario_of
 
 __all__ = [
     "DISTURBANCES",
@@ -69,9 +63,6 @@ __all__ = [
     "Scenario",
     "Frame",
     "ExplorerFigure",
-    "pa9_scenario",
-    "case_study_scenario",
-    "missile_scenario",
     "make_scenario",
     "scenario_of",
     "expand_poles",

@@ -9,8 +9,8 @@ works is private to this module.
 
 Examples
 --------
->>> from uio_teach.explorers import missile_scenario, render
->>> fig = render(missile_scenario())
+>>> from uio_teach.explorers import scenario_of, render
+>>> fig = render(scenario_of("missile"))
 >>> len(fig.axes) > 4
 True
 """
@@ -33,7 +33,7 @@ from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter
 from matplotlib.transforms import Bbox, IdentityTransform, TransformedBbox
 from PIL import Image
 
-from ..plotting import axis_label, symbol, time_label
+from ..plotting import COLORS, axis_label, channel_style, symbol, time_label
 from .frames import Frame, compute_frame, finite_max
 from .messages import ROUNDING
 from .model import Scenario, Settings
@@ -209,8 +209,8 @@ class ExplorerFigure:
 
     Examples
     --------
-    >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-    >>> s = pa9_scenario()
+    >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+    >>> s = scenario_of("pa9")
     >>> ef = ExplorerFigure(s)
     >>> ef.update(compute_frame(s))
     >>> line = ef.lines["uio.error"][0]
@@ -255,7 +255,7 @@ class ExplorerFigure:
         self.title = self.fig.suptitle("", fontsize=10 * k, y=top, va="top")
         # the observers' messages go under the panels (the footer), in space kept for them
         self.footer = self.fig.text(
-            0.01, 0.005, "", fontsize=_FOOTER_PT * k, ha="left", va="bottom", color="C3"
+            0.01, 0.005, "", fontsize=_FOOTER_PT * k, ha="left", va="bottom", color="#9E3A00"
         )
         width_pt = self.fig.get_figwidth() * 72 * 0.97
         self._wrap = max(30, int(width_pt / (0.56 * _FOOTER_PT * k)))
@@ -334,8 +334,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, pa9_scenario
-        >>> ExplorerFigure(pa9_scenario()).smallest_text_pt()
+        >>> from uio_teach.explorers import ExplorerFigure, scenario_of
+        >>> ExplorerFigure(scenario_of("pa9")).smallest_text_pt()
         7.0
         """
         texts = [t for t in self.fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
@@ -414,7 +414,7 @@ class ExplorerFigure:
                         for i in range(plant.q)
                     ]  # fmt: skip
                 self.lines[f"{who}.{r}"] = [
-                    ax.plot([], [], color=f"C{i}", lw=1.1, label=labels[r](i), **style)[0]
+                    ax.plot([], [], **channel_style(i), lw=1.1, label=labels[r](i), **style)[0]
                     for i in range(counts[r])
                 ]
                 ax.grid(True, alpha=0.3)
@@ -465,8 +465,8 @@ class ExplorerFigure:
             ax.plot([], [], color=c, lw=1.3, ls=ls, label=lab if shown else f"_{lab}")[0]
             for c, ls, lab, shown in (
                 ("k", "-.", "certified", self.lmi),
-                ("C3", "--", "slowest moved", moved),
-                ("C2", ":", "slowest fixed", bool(sc.fixed_poles.size)),
+                (COLORS[3], (0, (6, 2)), "slowest moved", moved),
+                (COLORS[2], (0, (1, 2)), "slowest fixed", bool(sc.fixed_poles.size)),
             )
         ]
 
@@ -491,14 +491,14 @@ class ExplorerFigure:
         pz.axhline(0.0, color="0.8", lw=0.6)
         zeros = sc.invariant_zeros
         (self._zeros,) = pz.plot(
-            zeros.real, zeros.imag, "o", ms=9, mfc="none", mec="C2", mew=1.5,
+            zeros.real, zeros.imag, "o", ms=9, mfc="none", mec=COLORS[2], mew=1.5,
             label="fixed" if zeros.size else "_fixed",
         )  # fmt: skip
         self.lines["poles"] = pz.plot(
-            [], [], "x", ms=8, mew=1.8, color="C3", label=sc.observer_name
+            [], [], "x", ms=8, mew=1.8, color=COLORS[3], label=sc.observer_name
         )
         self.lines["luenberger poles"] = pz.plot(
-            [], [], "+", ms=9, mew=1.2, color="C0", label="Luenberger"
+            [], [], "+", ms=9, mew=1.2, color=COLORS[0], label="Luenberger"
         )
         pz.legend(
             loc="lower center",
@@ -521,13 +521,13 @@ class ExplorerFigure:
         if self.narrow:  # beside the pole map: the label on the free right edge, not over the map
             sig.yaxis.set_label_position("right")
         self.lines["d"] = [
-            sig.plot([], [], color=f"C{i}", lw=1.0, label=symbol(sc.input_symbol, i), **style)[0]
+            sig.plot([], [], **channel_style(i), lw=1.0, label=symbol(sc.input_symbol, i), **style)[
+                0
+            ]
             for i in range(plant.q)
         ]
         self.lines["v"] = [
-            sig.plot(
-                [], [], color=f"C{i + plant.q}", lw=1.0, ls="--", label=symbol("v", i), **style
-            )[0]
+            sig.plot([], [], **channel_style(i + plant.q), lw=1.0, label=symbol("v", i), **style)[0]
             for i in range(plant.nv)
         ]
         if plant.q + plant.nv:
@@ -602,8 +602,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, case_study_scenario, compute_frame
-        >>> s = case_study_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, scenario_of, compute_frame
+        >>> s = scenario_of("case_study")
         >>> ef = ExplorerFigure(s)
         >>> ef.update(compute_frame(s, s.defaults.replace(poles=(1.05,))))
         >>> "the error grows" in ef.footer.get_text()
@@ -737,8 +737,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-        >>> s = pa9_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+        >>> s = scenario_of("pa9")
         >>> ef = ExplorerFigure(s)
         >>> ef.update(compute_frame(s))
         >>> ef.draw()
@@ -962,8 +962,8 @@ class ExplorerFigure:
 
         Examples
         --------
-        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, pa9_scenario
-        >>> s = pa9_scenario()
+        >>> from uio_teach.explorers import ExplorerFigure, compute_frame, scenario_of
+        >>> s = scenario_of("pa9")
         >>> ef = ExplorerFigure(s, dpi=60)
         >>> ef.update(compute_frame(s))
         >>> len(ef.to_png(colors=32)) < len(ef.to_png())
@@ -1000,8 +1000,8 @@ def render(scenario: Scenario, settings: Settings | None = None, *, dpi: float =
 
     Examples
     --------
-    >>> from uio_teach.explorers import missile_scenario, render
-    >>> fig = render(missile_scenario())
+    >>> from uio_teach.explorers import scenario_of, render
+    >>> fig = render(scenario_of("missile"))
     >>> len(fig.axes)
     8
     """

@@ -10,8 +10,8 @@ infeasible LMI becomes a message.
 
 Examples
 --------
->>> from uio_teach.explorers import compute_frame, pa9_scenario
->>> scenario = pa9_scenario()
+>>> from uio_teach.explorers import compute_frame, scenario_of
+>>> scenario = scenario_of("pa9")
 >>> frame = compute_frame(scenario, scenario.defaults.replace(poles=(-2.0, -3.0, -4.0)))
 >>> frame.poles.real.round(6).tolist()
 [-4.0, -3.0, -2.0]
@@ -142,8 +142,8 @@ class Frame:
 
     Examples
     --------
-    >>> from uio_teach.explorers import compute_frame, pa9_scenario
-    >>> s = pa9_scenario()
+    >>> from uio_teach.explorers import compute_frame, scenario_of
+    >>> s = scenario_of("pa9")
     >>> frame = compute_frame(s, s.defaults.replace(poles=(0.5, -2.0, -3.0)))
     >>> print(frame.observer_message.replace("; ", ";\n"))
     this pole makes the UIO unstable: the error grows (pole 0.5 in the right half-plane;
@@ -389,8 +389,8 @@ def compute_frame(scenario: Scenario, settings: Settings | None = None) -> Frame
     An LMI bound below the fixed poles' radius has no solution: a message, no
     exception.
 
-    >>> from uio_teach.explorers import case_study_scenario, compute_frame
-    >>> s = case_study_scenario()
+    >>> from uio_teach.explorers import scenario_of, compute_frame
+    >>> s = scenario_of("case_study")
     >>> frame = compute_frame(s, s.defaults.replace(mode="lmi", decay=0.4))
     >>> frame.observer is None, "cannot move" in frame.observer_message
     (True, True)

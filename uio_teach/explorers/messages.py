@@ -145,8 +145,14 @@ class ErrorVerdict:
             return True
         return not self.zero and self.peak > (1 + TOLERANCE) * self.start
 
-    def words(self) -> str:
+    def words(self, stable: bool = True) -> str:
         """What the error does, as the end of a sentence that starts "the error ...".
+
+        Parameters
+        ----------
+        stable : bool
+            Every pole of the error is stable. If not, an error that ends smaller
+            than it starts "shrinks ... within the window": it does not decay.
 
         Returns
         -------
@@ -159,6 +165,8 @@ class ErrorVerdict:
         'grows from 1.73 to 1.88'
         >>> ErrorVerdict(start=0.0, end=1e-13, peak=1e-13, rounding=1e-9).words()
         'is zero to rounding'
+        >>> ErrorVerdict(start=1.73, end=1.6, peak=1.73).words(stable=False)
+        'shrinks from 1.73 to 1.6 within the window'
         """
         a, b, m = (f"{x:.3g}" for x in (self.start, self.end, self.peak))
         if not self.finite:
@@ -167,6 +175,10 @@ class ErrorVerdict:
             return "is zero to rounding"
         if self.grows:
             return f"grows from {a} to {b}"
+        if self.decays and not stable:
+            if self.outgrows_start:
+                return f"rises to {m}, then shrinks to {b} (from {a}) within the window"
+            return f"shrinks from {a} to {b} within the window"
         if self.decays:
             if self.outgrows_start:
                 return f"rises to {m}, then decays to {b} (from {a})"
@@ -254,7 +266,7 @@ def stability_message(
     >>> text = stability_message("UIO", np.array([0.02, -3.0]), np.array([True, True]), v, False)
     >>> print(*text.split("; "), sep="\n")
     pole 0.02 in the right half-plane: that mode grows, but slowly
-    within this window the error does not yet outgrow its start (it decays from 1.73 to 1.6)
+    the error shrinks from 1.73 to 1.6 within the window, not yet above its start
     """
     if not poles.size or verdict is None:
         return ""
@@ -271,7 +283,7 @@ def stability_message(
             this = "this pole makes" if grow.size == 1 else "these poles make"
             return (
                 f"{this} the {name} unstable: the error grows ({word} {listed} {where}; "
-                f"|e| {verdict.words().removeprefix('grows ')})"
+                f"|e| {verdict.words(stable=False).removeprefix('grows ')})"
                 if verdict.finite
                 else f"{this} the {name} unstable: the error grows ({word} {listed} {where})"
             )
@@ -279,17 +291,17 @@ def stability_message(
             it = "it" if grow.size == 1 else "them"
             return (
                 f"{word} {listed} {where}, but this start does not excite {it}: the error "
-                f"does not grow here (it {verdict.words()}; noise or another start would make "
-                "it grow)"
+                f"does not grow here (it {verdict.words(stable=False)}; noise or another start "
+                "would make it grow)"
             )
         if not verdict.outgrows_start:
             return (
-                f"{word} {listed} {where}: that mode grows, but slowly; within this window the "
-                f"error does not yet outgrow its start (it {verdict.words()})"
+                f"{word} {listed} {where}: that mode grows, but slowly; the error "
+                f"{verdict.words(stable=False)}, not yet above its start"
             )
         return (
             f"{word} {listed} {where}: that mode grows, but slowly; within this window the "
-            f"error {verdict.words()}, and grows later"
+            f"error {verdict.words(stable=False)}, and grows later"
         )
     edge_poles = poles[bad]
     word = "pole" if edge_poles.size == 1 else "poles"
@@ -347,10 +359,10 @@ def lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.messages import lmi_message
     >>> from uio_teach.lmi import LMIInfeasibleError
-    >>> lmi_message(case_study_scenario(), 0.4, LMIInfeasibleError("no", "infeasible"))[:38]
+    >>> lmi_message(scenario_of("case_study"), 0.4, LMIInfeasibleError("no", "infeasible"))[:38]
     'no gain meets the bound radius 0.4: th'
     """
     discrete = scenario.discrete
@@ -374,8 +386,15 @@ def lmi_message(scenario: Scenario, decay: float, exc: Exception) -> str:
     )
 
 
+NEXT_TO = 0.02
+"""A movable pole is "next to" an invariant zero within this fraction of the larger size."""
+
+
 def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
     """A note for each movable pole placed on (or next to) an invariant zero.
+
+    "Next to" is relative: the gap is at most :data:`NEXT_TO` of the larger of
+    ``|pole|`` and ``|zero|``. No note where no observer exists.
 
     Parameters
     ----------
@@ -391,22 +410,26 @@ def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
     Examples
     --------
     >>> import numpy as np
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.messages import zero_notes
-    >>> zero_notes(case_study_scenario(), np.array([0.5]))[0][:36]
+    >>> zero_notes(scenario_of("case_study"), np.array([0.5]))[0][:36]
     'pole 0.5 sits on the invariant zero '
     """
     zeros = scenario.invariant_zeros
     out: list[str] = []
+    if scenario.existence is not None and not scenario.existence.ok:
+        return out  # no observer: no pole of it sits anywhere
     for p in movable:
         if not zeros.size:
             break
         gaps = np.abs(zeros - p)
         j = int(np.argmin(gaps))
         z = zeros[j]
-        if gaps[j] > 0.02 * max(1.0, abs(z)):
+        # relative: "next to" means within NEXT_TO of the larger of the two sizes
+        size = max(abs(z), abs(p))
+        if gaps[j] > NEXT_TO * size:
             continue
-        where = "sits on" if gaps[j] <= 1e-9 * max(1.0, abs(z)) else "is next to"
+        where = "sits on" if gaps[j] <= 1e-9 * max(size, np.finfo(float).tiny) else "is next to"
         text = (
             f"pole {format_poles([p], 3)} {where} the invariant zero {format_poles([z], 3)}, "
             "where a fixed pole already is: the error there decays no faster than that fixed "
@@ -591,9 +614,12 @@ def explain(
     str
     """
     name = scenario.observer_name
+    exists = scenario.existence is None or scenario.existence.ok
     parts = []
     if scenario.family == "ginverse":
         parts.append(f"The {name} has no gain to tune: its poles are set by its structure.")
+    elif not exists:
+        parts.append(f"No {name} exists for this plant; its message says why.")
     elif movable.size:
         what = "The LMI bound picks" if s.mode == "lmi" else "The pole controls move"
         parts.append(f"{what} the {name} poles {format_poles(movable, 3)}.")
@@ -601,11 +627,13 @@ def explain(
         parts.append(f"No pole of the {name} can be moved.")
     elif not poles.size:  # the design failed for these settings: its message says why
         parts.append(f"No {name} could be designed for these settings; its message says why.")
-    if fixed.size:
+    if fixed.size and exists:
         parts.append(
             f"Fixed whatever the gain: {format_poles(fixed, 3)} (the invariant zeros, o on "
             "the pole map)."
         )
+    elif fixed.size:
+        parts.append(f"The invariant zeros: {format_poles(fixed, 3)} (o on the pole map).")
     if scenario.reconstruct:
         parts.append(
             "The input panels are zoomed on the true input (grey): larger swings of a "

@@ -219,8 +219,8 @@ class Settings:
 class Scenario:
     """What an explorer explores: the plant, the observer, the time grid and the control ranges.
 
-    Build one with :func:`pa9_scenario`, :func:`case_study_scenario`,
-    :func:`missile_scenario` or :func:`make_scenario`.
+    Build one with :func:`~uio_teach.explorers.scenario_of` (a worked example)
+    or :func:`make_scenario`.
 
     Attributes
     ----------
@@ -282,8 +282,8 @@ class Scenario:
 
     Examples
     --------
-    >>> from uio_teach.explorers import missile_scenario
-    >>> s = missile_scenario()
+    >>> from uio_teach.explorers import scenario_of
+    >>> s = scenario_of("missile")
     >>> s.movable, s.fixed_poles.round(1).tolist()
     (2, [(-105.6-142.1j), (-105.6+142.1j)])
     """
@@ -449,8 +449,8 @@ def disturbance_signals(
 
     Examples
     --------
-    >>> from uio_teach.explorers import disturbance_signals, missile_scenario
-    >>> s = missile_scenario()
+    >>> from uio_teach.explorers import disturbance_signals, scenario_of
+    >>> s = scenario_of("missile")
     >>> disturbance_signals(s, s.defaults)[0]   # the paper's unknown inputs
     [10 exp(-2 t) cos(10 t), 50 exp(-5 t) sin(100 t)]
     """

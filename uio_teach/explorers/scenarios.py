@@ -1,14 +1,14 @@
-"""The explorers' scenarios: the course's three worked experiments, and any plant.
+"""The explorers' scenarios: every worked example's, and any plant's.
 
-:func:`pa9_scenario`, :func:`case_study_scenario` and :func:`missile_scenario`
-read their plant, time window, inputs, initial state and starting poles from
-:mod:`uio_teach.experiments`; :func:`make_scenario` chooses sensible values for
-any plant.
+:func:`scenario_of` makes the explorer of a worked example of
+:data:`uio_teach.worked.WORKED` from its experiment and its explorer options
+(:func:`experiment_scenario`); :func:`make_scenario` chooses sensible values
+for any plant.
 
 Examples
 --------
->>> from uio_teach.explorers import missile_scenario
->>> s = missile_scenario()
+>>> from uio_teach.explorers import scenario_of
+>>> s = scenario_of("missile")
 >>> s.family, s.defaults.poles
 ('pmo', (-100.0, -120.0))
 """
@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 
 from ..existence import check_existence
-from ..experiments import CASE_STUDY, MISSILE, PA9, experiment_params
+from ..experiments import experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
-from ..worked import WORKED, resolve
+from ..worked import WORKED, RegistryError, resolve
 from .model import (
     FAMILIES,
     Channel,
@@ -39,9 +39,6 @@ from .model import (
 )
 
 __all__ = [
-    "pa9_scenario",
-    "case_study_scenario",
-    "missile_scenario",
     "make_scenario",
     "plant_controls",
     "scenario_of",
@@ -127,168 +124,6 @@ def _scenario(plant: Plant, family: str, **kwargs: Any) -> Scenario:
         initial_state=x0,
         existence=check_existence(plant),
         **kwargs,
-    )
-
-
-def pa9_scenario() -> Scenario:
-    """Practical Assignment 9: the decoupling UIO, three movable poles, ``d`` sinusoidal by default.
-
-    The known input, initial state and starting poles are those of
-    :data:`uio_teach.experiments.PA9` (``u = [1, 0.5 sin t]``,
-    ``x(0) = [1, -1, 0.5]``, poles ``-1, -2, -3``), and so is the default
-    disturbance, its sinusoid; the 10 s window is drawn on 1001 samples (half
-    the experiment's resolution, for a quick redraw).
-
-    Returns
-    -------
-    Scenario
-
-    Examples
-    --------
-    >>> from uio_teach.explorers import pa9_scenario
-    >>> s = pa9_scenario()
-    >>> s.movable, s.defaults.poles
-    (3, (-1.0, -2.0, -3.0))
-    """
-    return _scenario(
-        PA9.plant(),
-        "uio",
-        name="pa9",
-        title="PA9",
-        timepts=PA9.grid(samples=1001),
-        initial_state=PA9.initial_state,
-        u=PA9.inputs,
-        defaults=Settings(
-            poles=PA9.poles,
-            disturbance="sinusoid",
-            amplitude=PA9.sine_amplitude,
-            frequency=PA9.sine_frequency,
-            period=2.5,
-        ),
-        pole_limits=(-10.0, 1.0),
-        frequency_limits=(0.0, 10.0),
-        amplitude_limits=_range(PA9, "amplitude"),
-        disturbance_frequency_limits=_range(PA9, "frequency"),
-        period_limits=(0.25, 5.0),
-        noise_limits=_range(PA9, "noise"),
-        tau_limits=None,
-        decay_limits=None,
-        d_channels=(Channel(),),
-        v_channels=(),
-        static_values=(-8.0, -4.0, -2.0, -1.0, -0.5, -0.2, 0.2, 0.5),
-        static_control="pole",
-    )
-
-
-def case_study_scenario() -> Scenario:
-    """The discrete-time case study: projection-operator observer, one movable pole or the LMI.
-
-    Two fixed poles at 0.5 (the invariant zeros); ``d`` and ``v`` of the
-    chosen type (``v`` at half the amplitude and twice the frequency). The
-    steps ``k = 0 ... 40``, the initial state ``[1, -2, 3]`` and the default
-    ``d``, the experiment's ``u2``, come from
-    :data:`uio_teach.experiments.CASE_STUDY`. The alternative
-    mode designs the gain from the LMI with a radius bound
-    (``Settings(mode="lmi", decay=...)``).
-
-    Returns
-    -------
-    Scenario
-
-    Examples
-    --------
-    >>> from uio_teach.explorers import case_study_scenario
-    >>> s = case_study_scenario()
-    >>> s.movable, s.fixed_poles.real.round(6).tolist(), s.decay_limits
-    (1, [0.5, 0.5], (0.3, 1.0))
-    """
-    return _scenario(
-        CASE_STUDY.plant(),
-        "pmo",
-        name="case-study",
-        title="Case study",
-        timepts=CASE_STUDY.timepts,
-        initial_state=CASE_STUDY.initial_state,
-        u=None,
-        defaults=Settings(
-            poles=(0.0,),
-            decay=0.9,
-            disturbance="sinusoid",
-            amplitude=CASE_STUDY.u2_amplitude,
-            frequency=CASE_STUDY.u2_frequency,
-            period=5.0,
-        ),
-        pole_limits=(-1.1, 1.1),
-        frequency_limits=(0.0, 180.0),
-        amplitude_limits=_range(CASE_STUDY, "amplitude"),
-        disturbance_frequency_limits=_range(CASE_STUDY, "frequency"),
-        period_limits=(1.0, 20.0),
-        noise_limits=(0.0, 0.5),
-        tau_limits=None,
-        decay_limits=(0.3, 1.0),
-        d_channels=(Channel(),),
-        v_channels=(Channel(gain=0.5, speed=2.0),),
-        static_values=(-0.9, -0.5, 0.0, 0.3, 0.5, 0.7, 0.9, 0.97, 1.05),
-        static_control="pole",
-    )
-
-
-def missile_scenario() -> Scenario:
-    """The missile autopilot: PMO with two movable poles, the unknown inputs reconstructed.
-
-    The default disturbance is the paper's pair of damped sinusoids
-    ``v1 = 10 exp(-2t) cos(10t)``, ``v2 = 50 exp(-5t) sin(100t)``, with the
-    paper's initial state and the PMO poles ``-100, -120``, all from
-    :data:`uio_teach.experiments.MISSILE` (the observers start at ``z(0) = 0``
-    here); 0.5 s on 1001 samples. The unknown
-    inputs are reconstructed from each observer's estimate with
-    :func:`uio_teach.reconstruct_input` (filtered, ``tau`` = 2 ms).
-
-    Returns
-    -------
-    Scenario
-
-    Examples
-    --------
-    >>> from uio_teach.explorers import missile_scenario
-    >>> s = missile_scenario()
-    >>> s.defaults.poles, s.defaults.tau
-    ((-100.0, -120.0), 0.002)
-    """
-    # the controls' amplitude and frequency are v1's; each channel is a multiple of them
-    amplitude, _, frequency, _ = MISSILE.v_parameters[0]
-    return _scenario(
-        MISSILE.plant(),
-        "pmo",
-        name="missile",
-        title="Missile autopilot",
-        timepts=MISSILE.grid(samples=1001),
-        initial_state=MISSILE.initial_state,
-        u=None,
-        defaults=Settings(
-            poles=MISSILE.poles,
-            disturbance="damped sinusoid",
-            amplitude=amplitude,
-            frequency=frequency,
-            period=0.05,
-            tau=0.002,
-        ),
-        pole_limits=(-400.0, 40.0),
-        frequency_limits=(0.0, 300.0),
-        amplitude_limits=(0.0, 50.0),
-        disturbance_frequency_limits=(1.0, 200.0),
-        period_limits=(0.01, 0.25),
-        noise_limits=(0.0, 0.5),
-        tau_limits=(0.0, 0.05),
-        decay_limits=None,
-        d_channels=tuple(
-            Channel(gain=a / amplitude, speed=w / frequency, decay=rate / w, kind=kind)
-            for a, rate, w, kind in MISSILE.v_parameters
-        ),
-        v_channels=(),
-        static_values=(-400.0, -200.0, -100.0, -50.0, -20.0, -5.0, 5.0, 20.0),
-        static_control="pole",
-        input_symbol="v",
     )
 
 
@@ -413,31 +248,36 @@ def make_scenario(
     )
 
 
-def experiment_scenario(name: str, **plant_values: float) -> Scenario:
-    """The explorer of a worked example, made from its experiment and its registry entry.
+def _channels(given: tuple[tuple[Any, ...], ...]) -> tuple[Channel, ...]:
+    return tuple(Channel(*c) for c in given)
+
+
+def experiment_scenario(name: str, **values: Any) -> Scenario:
+    """The explorer of a worked example, made from its experiment and its explorer options.
 
     The plant, the time grid, the known input, the initial state, the starting
-    poles, the disturbance's amplitude and frequency (and their ranges, from
-    the fields declared with ``control="amplitude"`` / ``"frequency"``) come
-    from the experiment; one slider per physical parameter
-    (:func:`plant_controls`); the rest from the entry's ``explorer`` options:
-    ``title``, ``samples``, ``period``, ``pole_limits``, ``frequency_limits``,
-    ``period_limits``, ``noise_limits``, ``d_channels`` (``(gain, speed)`` per
-    unknown input), ``static_control`` and ``static_values`` (the static
-    book's slider: ``"pole"``, or ``"plant:<name>"`` for a physical
-    parameter) and ``note`` (``"module:function"`` called with the physical
-    parameters: a sentence on this plant).
+    poles, the disturbance's amplitude, frequency and noise (and their ranges,
+    from the fields declared with ``control="amplitude"``, ``"frequency"`` or
+    ``"noise"``) come from the experiment; a slider for each physical
+    parameter (:func:`plant_controls`); the rest from the entry's
+    :class:`~uio_teach.worked.ExplorerOptions`.
 
     Parameters
     ----------
     name : str
         The worked example (a key of :data:`uio_teach.worked.WORKED`).
-    **plant_values
-        Physical parameters of its plant.
+    **values
+        Fields of its experiment (the values of its sliders).
 
     Returns
     -------
     Scenario
+
+    Raises
+    ------
+    uio_teach.worked.RegistryError
+        A value for a field the experiment does not have, or an option that
+        a declared field already sets (the range of a control given twice).
 
     Examples
     --------
@@ -447,40 +287,82 @@ def experiment_scenario(name: str, **plant_values: float) -> Scenario:
     (False, [0.43, 0.34])
     """
     entry = WORKED[name]
-    options = dict(entry.explorer)
-    run = entry.run().with_values(**plant_values)
+    opts = entry.explorer
+    run = entry.run()
+    fields = {f for f, _ in experiment_params(run)}
+    unknown = sorted(set(values) - fields)
+    if unknown:
+        raise RegistryError(
+            f"the {name} explorer has no slider {', '.join(map(repr, unknown))}; "
+            f"its experiment declares {', '.join(sorted(fields))}"
+        )
+    run = run.with_values(**values)
     plant = run.plant()
-    values = {spec.control: getattr(run, f) for f, spec in experiment_params(run) if spec.control}
-    note = options.pop("note", None)
+    declared = {spec.control: f for f, spec in experiment_params(run) if spec.control}
+    limits = {
+        "amplitude": opts.amplitude_limits,
+        "frequency": opts.disturbance_frequency_limits,
+        "noise": opts.noise_limits,
+    }
+    start = {"amplitude": opts.amplitude, "frequency": opts.frequency}
+    for control, field_name in declared.items():
+        option = {"frequency": "disturbance_frequency"}.get(control, control)
+        if limits.get(control) is not None or start.get(control) is not None:
+            raise RegistryError(
+                f"the {name} explorer: the field {field_name!r} sets the {control} control "
+                f"(its range and value); drop the options {option}_limits / {control}"
+            )
+    for control in ("amplitude", "frequency"):
+        if control not in declared and (limits[control] is None or start[control] is None):
+            option = {"frequency": "disturbance_frequency"}.get(control, control)
+            raise RegistryError(
+                f"the {name} explorer: no field declares the {control} control, so the options "
+                f"{control!r} and '{option}_limits' are required"
+            )
+
+    def value(control: str, default: float) -> float:
+        given = getattr(run, declared[control]) if control in declared else start.get(control)
+        return default if given is None else given
+
     physical = {f: getattr(run, f) for f in type(run).plant_fields}
-    channels = options.pop("d_channels", ((1.0, 1.0),) * plant.q)
-    noise_limits = options.pop("noise_limits", (0.0, 0.5))
     return _scenario(
         plant,
         entry.family,
         name=name.replace("_", "-"),
-        title=options.pop("title", entry.title),
-        timepts=run.grid(samples=options.pop("samples", None)),
+        title=opts.title or entry.title,
+        timepts=run.grid(samples=opts.samples),
         initial_state=run.initial_state,
         u=run.inputs,
         defaults=Settings(
-            poles=run.poles,
-            disturbance="sinusoid",
-            amplitude=values.get("amplitude", 1.0),
-            frequency=values.get("frequency", 1.0),
-            period=options.pop("period"),
-            noise=values.get("noise", 0.0) or 0.0,
+            poles=run.poles if opts.poles is None else opts.poles,
+            decay=opts.decay,
+            disturbance=opts.disturbance,
+            amplitude=value("amplitude", 1.0),
+            frequency=value("frequency", 1.0),
+            period=opts.period,
+            noise=value("noise", 0.0),
+            tau=opts.tau,
         ),
-        amplitude_limits=_range(run, "amplitude"),
-        disturbance_frequency_limits=_range(run, "frequency"),
-        noise_limits=_range(run, "noise") if "noise" in values else noise_limits,
-        tau_limits=None,
-        decay_limits=None,
-        d_channels=tuple(Channel(gain=g, speed=v) for g, v in channels),
-        v_channels=(),
-        static_control=options.pop("static_control", "pole"),
+        pole_limits=opts.pole_limits,
+        frequency_limits=opts.frequency_limits,
+        amplitude_limits=_range(run, "amplitude")
+        if "amplitude" in declared
+        else limits["amplitude"],
+        disturbance_frequency_limits=(
+            _range(run, "frequency") if "frequency" in declared else limits["frequency"]
+        ),
+        period_limits=opts.period_limits,
+        noise_limits=(
+            _range(run, "noise") if "noise" in declared else (limits["noise"] or (0.0, 0.5))
+        ),
+        tau_limits=opts.tau_limits,
+        decay_limits=opts.decay_limits,
+        d_channels=_channels(opts.d_channels) or (Channel(),) * plant.q,
+        v_channels=_channels(opts.v_channels),
+        static_values=opts.static_values,
+        static_control=opts.static_control,
+        input_symbol=opts.input_symbol,
         plant_controls=plant_controls(run),
         rebuild=functools.partial(experiment_scenario, name),
-        note=resolve(note)(**physical) if note else "",
-        **options,
+        note=resolve(opts.note)(**physical) if opts.note else "",
     )

@@ -23,9 +23,9 @@ Each frame is computed by :func:`uio_teach.explorers.compute_frame` and drawn by
 
 Examples
 --------
->>> from uio_teach.explorers import case_study_scenario
+>>> from uio_teach.explorers import scenario_of
 >>> from uio_teach.explorers.static import static_explorer
->>> page = static_explorer(case_study_scenario(), values=(0.0, 0.5), disturbances=("sinusoid",))
+>>> page = static_explorer(scenario_of("case_study"), values=(0.0, 0.5), disturbances=("sinusoid",))
 >>> page.count
 2
 >>> "http" in page.html
@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._display import format_complex, format_poles
+from ..linalg import is_stable
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, Scenario, Settings
@@ -85,9 +86,9 @@ class StaticFrame:
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(pa9_scenario(), values=(-1.0,), disturbances=("sinusoid",))
+    >>> page = static_explorer(scenario_of("pa9"), values=(-1.0,), disturbances=("sinusoid",))
     >>> page.frames[0].png[:4], page.frames[0].label
     (b'\\x89PNG', '-1')
     """
@@ -128,9 +129,9 @@ class StaticExplorer:
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",))
+    >>> page = static_explorer(scenario_of("case_study"), values=(0.0,), disturbances=("sinusoid",))
     >>> page.element_id in page.html, page.count
     (True, 1)
     """
@@ -185,9 +186,9 @@ def frame_settings(
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import frame_settings
-    >>> s = pa9_scenario()
+    >>> s = scenario_of("pa9")
     >>> frame_settings(s, s.defaults, -4.0, "random steps").poles
     (-4.0, -2.0, -3.0)
     """
@@ -214,9 +215,9 @@ def frame_caption(frame: Frame) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers import compute_frame, scenario_of
     >>> from uio_teach.explorers.static import frame_caption
-    >>> frame_caption(compute_frame(pa9_scenario()))[:38]
+    >>> frame_caption(compute_frame(scenario_of("pa9")))[:38]
     'Disturbance: sinusoid, amplitude 1, fr'
     """
     name = frame.scenario.observer_name
@@ -253,25 +254,27 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
 
     Examples
     --------
-    >>> from uio_teach.explorers import compute_frame, pa9_scenario
+    >>> from uio_teach.explorers import compute_frame, scenario_of
     >>> from uio_teach.explorers.static import frame_alt
-    >>> frame_alt(compute_frame(pa9_scenario()), "UIO pole", "-1").split(". ")[1]
+    >>> frame_alt(compute_frame(scenario_of("pa9")), "UIO pole", "-1").split(". ")[1]
     'UIO: the error size |e| decays from 1.5 to 1.5e-05'
     """
     sc = frame.scenario
     parts = [f"{sc.title} explorer at {label} {value}."]
     rows = (
-        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message),
+        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message, frame.poles),
         (
             "Luenberger observer",
             frame.luenberger,
             frame.luenberger_verdict,
             frame.luenberger_message,
+            frame.luenberger_poles,
         ),
     )
-    for who, observer, verdict, message in rows:
+    for who, observer, verdict, message, poles in rows:
         if verdict is not None:
-            parts.append(f"{who}: the error size |e| {verdict.words()}.")
+            stable = bool(np.all(is_stable(poles, sc.discrete))) if poles.size else True
+            parts.append(f"{who}: the error size |e| {verdict.words(stable)}.")
         elif observer is None:
             parts.append(f"{who}: no curve (no design).")
         elif "overflows" in message:
@@ -337,9 +340,9 @@ def static_explorer(
 
     Examples
     --------
-    >>> from uio_teach.explorers import pa9_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_explorer
-    >>> page = static_explorer(pa9_scenario(), values=(-1.0, -2.0),
+    >>> page = static_explorer(scenario_of("pa9"), values=(-1.0, -2.0),
     ...                        disturbances=("sinusoid", "random steps"))
     >>> page.count, page.html.count('data-k="')
     (4, 4)
@@ -472,9 +475,9 @@ def static_html(
 
     Examples
     --------
-    >>> from uio_teach.explorers import case_study_scenario
+    >>> from uio_teach.explorers import scenario_of
     >>> from uio_teach.explorers.static import static_html
-    >>> text = static_html(case_study_scenario(), values=(0.0,), disturbances=("sinusoid",),
+    >>> text = static_html(scenario_of("case_study"), values=(0.0,), disturbances=("sinusoid",),
     ...                    element_id="demo")
     >>> text.startswith('<div id="demo"'), 'type="range"' in text
     (True, True)
@@ -499,7 +502,9 @@ _JS = (
     "if(n){n.srcset=f.getAttribute('data-narrow');}i.src=f.getAttribute('data-src');"
     "i.alt=f.getAttribute('data-alt');"
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
-    "this.mainval.value=f.getAttribute('data-label');r.classList.add('uio-live');}"
+    "this.mainval.value=f.getAttribute('data-label');"
+    "this.main.setAttribute('aria-valuetext',f.getAttribute('data-label'));"
+    "r.classList.add('uio-live');}"
 )
 
 NARROW_PX = 700
@@ -530,6 +535,7 @@ margin:0.3em 0}
 max-width:100%}
 .uio-static-explorer .uio-slider{display:inline-flex;align-items:center;gap:0.5em}
 .uio-static-explorer input[type=range]{margin:0;vertical-align:middle}
+.uio-static-explorer :focus-visible{outline:3px solid #c2185b;outline-offset:2px}
 .uio-static-explorer .uio-picture{max-width:100%}
 .uio-static-explorer img.uio-frame{display:block;width:100%;max-width:none;height:auto;margin:0}
 .uio-static-explorer .uio-captions{display:grid}
@@ -591,12 +597,13 @@ def _html(
         f'<source media="(max-width:{NARROW_PX}px)" srcset="{first.narrow_url}">' if phone else ""
     )
     return (
-        f'<div id="{eid}" class="uio-static-explorer">'
+        f'<div id="{eid}" class="uio-static-explorer" role="group" '
+        f'aria-label="{esc(scenario.title)} explorer">'
         f"<style>{css}</style>"
         f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}">'
         f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
         f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
-        f'step="1" value="{i0}" aria-label="{label}"> '
+        f'step="1" value="{i0}" aria-label="{label}" aria-valuetext="{esc(first.label)}"> '
         f'<output name="mainval">{esc(first.label)}</output></span></label>'
         f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'

@@ -61,13 +61,10 @@ from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
 from .model import DISTURBANCES, STARTS, Scenario, Settings
 from .scenarios import (
-    case_study_scenario,
     make_scenario,
-    missile_scenario,
-    pa9_scenario,
     scenario_of,
 )
-from .static import static_html
+from .static import frame_alt, static_html
 
 __all__ = [
     "Explorer",
@@ -206,12 +203,16 @@ class Explorer(DragPoles):
         self._static = static
         self._static_html: str | None = None
         self._holding = 0
+        self._reverting = False
+        self._refused = ""
         self.controls: dict[str, W.Widget] = {}
         self._slots: list[_Slot] = []
         self.figure = ExplorerFigure(scenario, dpi=dpi)
         self.frame: Frame | None = None
         self.image = W.Image(format="png", layout=W.Layout(width="100%", max_width="900px"))
         self.message = W.HTML()
+        # the picture in words, updated with it: its text alternative, read out on each change
+        self.words = W.HTML(layout=W.Layout(max_width="900px"))
         self.canvas: Any = None
         self._dragging: tuple[int, str] | None = None
         if drag is None:
@@ -319,7 +320,7 @@ class Explorer(DragPoles):
         boxes = [W.VBox(b, layout=W.Layout(margin="0 16px 4px 0")) for b in groups]
         controls = W.HBox(boxes, layout=W.Layout(flex_flow="row wrap"))
         view = self.canvas if self.canvas is not None else self.image
-        self.widget = W.VBox([controls, view, self.message])
+        self.widget = W.VBox([controls, view, self.words, self.message])
 
     @staticmethod
     def _pattern_label(k: int, pairs: int) -> str:
@@ -498,7 +499,24 @@ class Explorer(DragPoles):
         same figure (a new one only if its panels or legends differ)."""
         old = self.scenario
         values = {pc.name: float(self.controls[pc.name].value) for pc in old.plant_controls}
-        new = old.rebuild(**values)
+        if self._reverting:
+            return
+        try:
+            new = old.rebuild(**values)
+        except ValueError as exc:  # a plant the model refuses (a level below empty, ...)
+            self._refused = (
+                f"{change['owner'].description} = {change['new']:g} is refused: {exc}; the "
+                "plant is kept as it was"
+            )
+            self._reverting = True
+            try:
+                change["owner"].value = change["old"]
+            finally:
+                self._reverting = False
+            if not self._holding:
+                self.update()
+            return
+        self._refused = ""
         self.scenario = new
         _LIVE[new.name] = self
         if not self.figure.replace_scenario(new):  # other panels or legends: a new figure
@@ -540,7 +558,17 @@ class Explorer(DragPoles):
             )
             return
         self.frame = frame
-        self.message.value = _message_html(frame)
+        refused = (
+            f'<div style="color:#c0392b">{html.escape(self._refused)}</div>'
+            if self._refused
+            else ""
+        )
+        self.message.value = _message_html(frame) + refused
+        said = frame_alt(frame, "observer poles", format_poles(self.settings.poles, 3))
+        self.words.value = (
+            '<p role="status" aria-live="polite" style="font-size:0.85em;margin:0.2em 0">'
+            f"{html.escape(said)}</p>"
+        )
 
     def close(self) -> None:
         """Close the figure's canvas and the widgets (frees their memory at once).
@@ -633,7 +661,7 @@ def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
 
     Three movable poles (real, or one complex pair and a real pole), the
     disturbance type, amplitude, frequency or switching period, and the
-    measurement noise. See :func:`uio_teach.explorers.pa9_scenario`.
+    measurement noise. See :mod:`uio_teach.worked.pa9`.
 
     Parameters
     ----------
@@ -655,7 +683,7 @@ def pa9_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
     >>> sorted(n for n in ex.controls if n.startswith("pole"))
     ['pole 1', 'pole 2 frequency', 'pole 2 real part']
     """
-    return Explorer(pa9_scenario(), static=static, drag=drag)
+    return worked_explorer("pa9", static=static, drag=drag)
 
 
 def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Explorer:
@@ -663,7 +691,7 @@ def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Exp
 
     The two fixed poles at 0.5 are the invariant zeros; in ``"LMI bound"``
     mode the gain comes from the LMI, infeasible below radius 0.5. See
-    :func:`uio_teach.explorers.case_study_scenario`.
+    :mod:`uio_teach.worked.case_study`.
 
     Parameters
     ----------
@@ -685,7 +713,7 @@ def case_study_explorer(*, static: bool = True, drag: bool | None = None) -> Exp
     >>> bool(abs(ex.frame.poles).max() <= 0.8 + 1e-6)
     True
     """
-    return Explorer(case_study_scenario(), static=static, drag=drag)
+    return worked_explorer("case_study", static=static, drag=drag)
 
 
 def missile_explorer(
@@ -696,7 +724,7 @@ def missile_explorer(
     Two movable poles of the projection-operator observer (the other two
     are fixed at the invariant zeros), the unknown inputs (by default the
     paper's damped sinusoids), noise and the reconstruction filter's time
-    constant. See :func:`uio_teach.explorers.missile_scenario`.
+    constant. See :mod:`uio_teach.worked.missile`.
 
     Parameters
     ----------
@@ -727,7 +755,7 @@ def missile_explorer(
     """
     if observer_family not in ("pmo", "ginverse"):
         raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
-    scenario = missile_scenario()
+    scenario = scenario_of("missile")
     if observer_family == "ginverse":
         scenario = dataclasses.replace(
             scenario,

@@ -1,6 +1,7 @@
-"""Instructor tooling: the course's figures and lab notebooks, from the command line.
+"""Instructor tooling: the term's figures, lab notebooks and variants, from the command line.
 
-* :mod:`~uio_teach.instructor.cli` -- ``uio-teach figures`` and ``uio-teach labs``;
+* :mod:`~uio_teach.instructor.cli` -- ``uio-teach figures``, ``uio-teach labs`` and
+  ``uio-teach grade`` (whose engine is the grader, :mod:`uio_teach.grading`);
 * :mod:`~uio_teach.instructor.figures` -- the registry of the course's figures
   (:data:`~uio_teach.instructor.figures.FIGURES`) and
   :func:`~uio_teach.instructor.figures.generate`;

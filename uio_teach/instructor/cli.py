@@ -29,7 +29,7 @@ import time
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn, TextIO
+from typing import Any, NoReturn, TextIO
 
 import matplotlib
 
@@ -48,10 +48,11 @@ PROG = "uio-teach"
 _MAIN_DESCRIPTION = """\
 Instructor tools of the course "Unknown Input Observers".
 
-Three commands:
+Four commands:
   figures   regenerate every figure of the course (and Table II of the missile paper)
   labs      write the lab notebooks, a student version and a solution version
   grade     run the notebooks the groups handed in and write a gradebook (CSV)
+  merge     merge the gradebooks of a class graded in shards (grade --shard K/N)
 
 Run `uio-teach COMMAND --help` for the options of each command.
 """
@@ -201,8 +202,14 @@ Writes FILE (one row per hand-in: file, lab, group, status, reason, one
 column per check with ✓ or ✗, total and out_of), FILE's stem + _feedback/
 (a text and an HTML page per hand-in), FILE's stem + _groups.csv (one row per
 group) and + _canvas.csv (Canvas's gradebook import, with its "Points
-Possible" row). Each row is written as soon as its hand-in is graded;
---resume grades only the missing ones; Ctrl-C stops at once and keeps them.
+Possible" row; only with a --roster naming the students, since without one
+no row could be matched to a student). Each row is written as soon as its
+hand-in is graded; --resume grades only the missing ones; Ctrl-C stops at
+once and keeps them.
+
+A large class can be split over machines: --shard K/N grades shard K of N
+(each hand-in in exactly one shard, by its file name), and `uio-teach merge`
+puts the N gradebooks together into what one whole run writes.
 
 GRADING RUNS THE STUDENTS' CODE. Without bubblewrap (apt-get install
 bubblewrap) grading is refused; --no-sandbox runs the code with your
@@ -216,6 +223,7 @@ examples:
   uio-teach grade handed_in --out grades.csv --roster groups.csv
   uio-teach grade handed_in/*.ipynb --out grades.csv --timeout 600 --cell-timeout 120
   uio-teach grade handed_in --out grades.csv --jobs 2 --resume
+  uio-teach grade handed_in --out grades_2.csv --shard 2/4   # then uio-teach merge
 
 exit status:
   0 every hand-in has its row (whatever its grade or status), 1 the gradebook
@@ -224,8 +232,45 @@ exit status:
 """
 
 
+_MERGE_DESCRIPTION = """\
+Merge the gradebooks of a class graded in shards (`uio-teach grade ...
+--shard K/N` for K = 1..N, on one machine or several) into FILE: every row
+in the class's order, the feedback texts and pages, the per-group and Canvas
+exports and the manifest, exactly as one whole run writes them. Refused,
+naming the gradebooks: shards of different classes, answer keys or rosters,
+a shard given twice or missing, a hand-in with a row in two gradebooks, a
+shard whose run did not finish (resume it first with --resume).
+"""
+
+_MERGE_EPILOG = """\
+examples:
+  uio-teach merge marks/grades_1.csv marks/grades_2.csv marks/grades_3.csv --out grades.csv
+  uio-teach merge marks/grades_*.csv --out grades.csv
+
+exit status:
+  0 merged, 1 the merged gradebook could not be written, 2 the gradebooks
+  cannot be merged (the message says why).
+"""
+
+
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are one line: ``uio-teach labs: error: ...``."""
+    """An argument parser whose usage errors are one line: ``uio-teach labs: error: ...``.
+
+    A description given as a function is made only when the help is shown (the labs' help
+    lists what a term config sets that labs ignore, which loads the labs: no other command
+    pays for that, and grading starts sooner).
+    """
+
+    def __init__(self, *args: Any, description: Any = None, **kwargs: Any) -> None:
+        self._describe = description if callable(description) else None
+        super().__init__(
+            *args, description=None if callable(description) else description, **kwargs
+        )
+
+    def format_help(self) -> str:
+        if self._describe is not None:
+            self.description, self._describe = self._describe(), None
+        return super().format_help()
 
     def error(self, message: str) -> NoReturn:
         text = " ".join(str(message).split())
@@ -395,7 +440,7 @@ def build_parser() -> argparse.ArgumentParser:
     labs = commands.add_parser(
         "labs",
         help="write the lab notebooks (student and solution versions)",
-        description=_labs_description(),
+        description=_labs_description,
         epilog=_LABS_EPILOG,
         formatter_class=_Formatter,
     )
@@ -492,8 +537,38 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="run the notebooks WITHOUT isolation, with your permissions (trusted notebooks only)",
     )
+    grade.add_argument(
+        "--shard",
+        metavar="K/N",
+        type=_shard,
+        default=None,
+        help="grade only shard K of N of the hand-ins (merge the N gradebooks with merge)",
+    )
     grade.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+
+    merge = commands.add_parser(
+        "merge",
+        help="merge the gradebooks of a class graded in shards",
+        description=_MERGE_DESCRIPTION,
+        epilog=_MERGE_EPILOG,
+        formatter_class=_Formatter,
+    )
+    merge.add_argument(
+        "gradebooks", nargs="+", metavar="GRADEBOOK", help="the gradebook CSV of every shard"
+    )
+    merge.add_argument("--out", metavar="FILE", required=True, help="the merged gradebook CSV")
+    merge.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     return parser
+
+
+def _shard(text: str) -> tuple[int, int]:
+    from ..grading.merge import parse_shard  # deferred on purpose (see the imports)
+    from ..grading.rosters import GradeError  # deferred on purpose (see the imports)
+
+    try:
+        return parse_shard(text)
+    except GradeError as err:
+        raise argparse.ArgumentTypeError(str(err).removeprefix("shard: ")) from None
 
 
 def _seed(text: str) -> int:
@@ -636,7 +711,7 @@ def _labs(args: argparse.Namespace) -> int:
 
 
 def _grade(args: argparse.Namespace) -> int:
-    from . import grade  # deferred on purpose (see the imports)
+    from ..grading import grade  # deferred on purpose (see the imports)
 
     missing = [p for p in args.submissions if not os.path.lexists(p)]
     if missing:
@@ -680,6 +755,7 @@ def _grade(args: argparse.Namespace) -> int:
                 resume=args.resume,
                 jobs=args.jobs,
                 sandbox=not args.no_sandbox,
+                shard=args.shard,
             )
     except ImportError as err:
         _error(
@@ -692,26 +768,90 @@ def _grade(args: argparse.Namespace) -> int:
         _error("grade", str(err))
         return 2
     except OSError as err:
-        _error("grade", f"cannot write the gradebook {args.out}: {err.strerror or err}")
+        _error("grade", f"cannot write the gradebook {args.out}: {_os_error(err)}")
         return 1
-    look = [s for s in results if s.needs_a_look]
+    out = Path(args.out)
     if not args.quiet:
         elapsed = time.perf_counter() - start
-        out = Path(args.out)
-        feedback = out.with_name(f"{out.stem}_feedback")
+        part = f" (shard {args.shard[0]}/{args.shard[1]})" if args.shard else ""
         _say(
-            f"{len(results)} hand-in{'s' if len(results) != 1 else ''} graded in "
-            f"{elapsed:.1f} s: {out}, feedback in {feedback}"
+            f"{len(results)} hand-in{'s' if len(results) != 1 else ''} graded{part} in "
+            f"{elapsed:.1f} s: {out}, feedback in {out.with_name(f'{out.stem}_feedback')}"
         )
+    _summary("grade", out, roster=args.roster is not None, quiet=args.quiet)
+    return 0
+
+
+def _os_error(err: OSError) -> str:
+    """An OSError in one line, naming its file."""
+    why = err.strerror or str(err)
+    return f"{why}: {err.filename}" if err.filename else why
+
+
+def _summary(command: str, out: Path, *, roster: bool, quiet: bool) -> None:
+    """How many rows of the whole gradebook need a look (kept rows of a resumed run too)."""
+    from ..grading.gradebook import needs_a_look, read_gradebook  # deferred on purpose
+
+    header, rows = read_gradebook(out)
+    at = header.index("status") if header else 3
+    counts: dict[str, int] = {}
+    for row in rows:
+        if needs_a_look(row[at]):
+            counts[row[at]] = counts.get(row[at], 0) + 1
+    look = sum(counts.values())
+    whole = f"{len(rows)} row{'s' if len(rows) != 1 else ''} in {out.name}"
     if look:
-        counts: dict[str, int] = {}
-        for sub in look:
-            counts[sub.status] = counts.get(sub.status, 0) + 1
         kinds = ", ".join(f"{n} {status}" for status, n in counts.items())
-        verb = "rows need" if len(look) != 1 else "row needs"
-        _say(f"{len(look)} {verb} a look ({kinds})", sys.stderr)
-    elif not args.quiet:
-        _say("no row needs a look")
+        verb = "rows need" if look != 1 else "row needs"
+        _say(f"{look} {verb} a look ({kinds}) of the {whole}", sys.stderr)
+    elif not quiet:
+        _say(f"no row needs a look of the {whole}")
+    canvas = out.with_name(f"{out.stem}_canvas.csv")
+    if roster and canvas.is_file() and header:
+        import csv  # deferred on purpose: only this summary reads the export
+
+        with open(canvas, newline="", encoding="utf-8") as fh:
+            sections = {r[4] for r in list(csv.reader(fh))[2:] if len(r) > 4}
+        group = header.index("group")
+        alone = sorted({r[group] for r in rows if r[group]} - sections)
+        if alone:
+            _say(
+                f"{len(alone)} group{'s' if len(alone) != 1 else ''} with no student in the "
+                f"roster, not in {canvas.name}: {', '.join(alone[:10])}"
+                + (" ..." if len(alone) > 10 else ""),
+                sys.stderr,
+            )
+    if not roster and not quiet and command == "grade":
+        _say(
+            f"no Canvas import written: without --roster no group can be matched to its "
+            f"students (give a roster with a student column to get {out.stem}_canvas.csv)",
+            sys.stderr,
+        )
+
+
+def _merge(args: argparse.Namespace) -> int:
+    from ..grading.merge import MergeError, merge  # deferred on purpose (see the imports)
+
+    missing = [p for p in args.gradebooks if not os.path.isfile(p)]
+    if missing:
+        _error("merge", f"no such gradebook: {', '.join(missing)}")
+        return 2
+    try:
+        out = merge(args.gradebooks, args.out)
+    except MergeError as err:
+        _error("merge", str(err))
+        return 2
+    except OutputError as err:
+        _error("merge", str(err))
+        return 2
+    except OSError as err:
+        _error("merge", f"cannot write the gradebook {args.out}: {_os_error(err)}")
+        return 1
+    if not args.quiet:
+        _say(f"{len(args.gradebooks)} gradebooks merged into {out}")
+    from ..grading.gradebook import export_path  # deferred on purpose (see the imports)
+
+    _summary("merge", out, roster=export_path(out, "canvas").exists(), quiet=args.quiet)
     return 0
 
 
@@ -750,6 +890,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _figures(args)
         if args.command == "grade":
             return _grade(args)
+        if args.command == "merge":
+            return _merge(args)
         return _labs(args)
     except KeyboardInterrupt:
         _error(args.command, "interrupted")

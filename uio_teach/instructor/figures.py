@@ -38,27 +38,11 @@ import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import matplotlib.style
-import numpy as np
 
-import uio_teach as ut
-
-from .._display import format_poles
-from ..plotting import (
-    finish_panel,
-    new_figure,
-    plot_error,
-    plot_residual,
-    residual_colors,
-    symbol,
-    time_label,
-    with_unit,
-    zero_to_rounding,
-)
 from ..worked import WORKED, resolve, run_from_config
 from .config import (
     ConfigError,
@@ -78,9 +62,6 @@ from .output import (
     write_manifest,
 )
 
-if TYPE_CHECKING:  # pragma: no cover
-    from matplotlib.figure import Figure
-
 __all__ = [
     "FORMATS",
     "MANIFEST",
@@ -98,16 +79,14 @@ __all__ = [
     "generate",
 ]
 
-CATCH_TOL = 0.02
-"""Relative tolerance of the Table II catch times (2 % of the signal's peak)."""
-
 
 class _Runs:
-    """Every simulation the figures need, computed once and shared (lazily).
+    """What a worked example's figures ask for: its run, its observer, shared results.
 
     Each run is a worked experiment with the configuration's values in place of
     its own (:func:`uio_teach.worked.run_from_config`: every declared field
-    with a config key, none mapped here by hand).
+    with a config key, none mapped here by hand); each worked example's module
+    draws its figures from these (``draw(runs)``).
     """
 
     def __init__(self, cfg: FigureConfig) -> None:
@@ -124,275 +103,12 @@ class _Runs:
             cache[key] = compute()
         return cache[key]
 
-    # PA9 --------------------------------------------------------------------------------------
-    @cached_property
-    def pa9(self) -> dict[str, Any]:
-        c = self.cfg
-        run = self.run("pa9")
-        plant = run.plant()
-        uio = design_observer(c, "pa9.poles")
-        luen = ut.design_luenberger(plant, poles=list(run.poles))
-        d_sine, d_steps = run.d_sine, run.d_piecewise
-        return {
-            "plant": plant,
-            "uio": uio,
-            "d_sine": d_sine,
-            "d_steps": d_steps,
-            "uio_sine": run.simulate(uio, d=d_sine),
-            "uio_steps": run.simulate(uio, d=d_steps),
-            "luen_sine": run.simulate(luen, d=d_sine),
-            "luen_steps": run.simulate(luen, d=d_steps),
-        }
-
-    # case study -------------------------------------------------------------------------------
-    @cached_property
-    def case(self) -> dict[str, Any]:
-        run = self.run("case_study")
-        pmo = design_observer(self.cfg, "case_study.poles")
-        return {
-            "plant": run.plant(),
-            "pmo": pmo,
-            "loud": run.simulate(pmo),
-            "quiet": run.simulate(pmo, d=None, v=None),
-        }
-
-    # missile ----------------------------------------------------------------------------------
-    @cached_property
-    def missile(self) -> dict[str, Any]:
-        run = self.run("missile")
-        plant, t = run.plant(), run.timepts
-        out: dict[str, Any] = {"plant": plant, "time": t}
-        ginverse = ut.design_ginverse(plant)
-        out["free"] = run.simulate(ginverse, d=None, observer_state=None)
-        pmo = design_observer(self.cfg, "missile.pmo_poles")
-        # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
-        # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
-        # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles
-        # (chapter 5 explains both starts and Table II).
-        q0 = run.observer_state(pmo)
-        for name, obs in (("pmo", pmo), ("ginverse", ginverse)):
-            resp = run.simulate(obs, observer_state=q0)
-            est = ut.reconstruct_input(plant, resp)
-            out[name] = {
-                "observer": obs,
-                "response": resp,
-                "inputs": est,
-                "catch_states": ut.catch_time(t, resp.states, resp.estimates, tol=CATCH_TOL),
-                "catch_inputs": ut.catch_time(t, resp.inputs.d, est.estimates, tol=CATCH_TOL),
-            }
-        return out
-
-
-# drawing ----------------------------------------------------------------------------------------
-
-
-def _poles_text(obs) -> str:
-    return format_poles(obs.poles(), 4)
-
-
-def _pa9_disturbance(runs: _Runs, which: str) -> Figure:
-    r = runs.pa9
-    resp, d = r[f"uio_{which}"], r[f"d_{which}"]
-    fig = new_figure(8.0, 6.5)
-    ax_d, ax_e, ax_r = fig.subplots(3, 1, sharex=True)
-    t = resp.time
-    ax_d.plot(t, resp.inputs.d[0], color="k")
-    formula = repr(d)
-    ax_d.set_title(f"d(t) = {formula if len(formula) <= 80 else formula[:77] + '...'}")
-    finish_panel(ax_d, with_unit("disturbance $d$"), legend=False)
-    plot_error(ax_e, resp)
-    plot_residual(ax_r, resp)
-    ax_r.set_xlabel(time_label(resp.plant.dt))
-    kind = "sinusoidal" if which == "sine" else "piecewise-constant"
-    fig.suptitle(f"PA9: UIO with a {kind} disturbance (poles {_poles_text(r['uio'])})")
-    return fig
-
-
-def _pa9_sine(runs: _Runs) -> Figure:
-    return _pa9_disturbance(runs, "sine")
-
-
-def _pa9_piecewise(runs: _Runs) -> Figure:
-    return _pa9_disturbance(runs, "steps")
-
-
-def _pa9_states(runs: _Runs) -> Figure:
-    r = runs.pa9
-    return r["uio_sine"].plot(
-        fig=new_figure(9.0, 6.0), title=f"PA9: UIO, sinusoidal disturbance d(t) = {r['d_sine']!r}"
-    )
-
-
-def _pa9_luenberger(runs: _Runs) -> Figure:
-    r = runs.pa9
-    fig = new_figure(9.0, 5.5)
-    axes = fig.subplots(2, 2, sharex=True, sharey="row")
-    pairs = [
-        ("UIO", r["uio_sine"], r["uio_steps"]),
-        ("Luenberger observer", r["luen_sine"], r["luen_steps"]),
-    ]
-    for col, (name, sine, steps) in enumerate(pairs):
-        for row, (what, sym, label) in enumerate(
-            [("error", "e", "error $e$"), ("residual", "r", "residual $r$")]
-        ):
-            ax = axes[row, col]
-            values = getattr(sine, what)
-            colors = (
-                residual_colors(sine.plant.C)
-                if what == "residual"
-                else [f"C{i}" for i in range(values.shape[0])]
-            )
-            for i in range(values.shape[0]):
-                ax.plot(sine.time, values[i], color=colors[i], label=symbol(sym, i))
-                ax.plot(steps.time, getattr(steps, what)[i], color=colors[i], linestyle="--")
-            finish_panel(ax, label)
-        axes[0, col].set_title(name)
-        axes[1, col].set_xlabel(time_label(r["plant"].dt))
-    fig.suptitle(
-        f"PA9, poles {_poles_text(r['uio'])}: solid sinusoidal d, dashed piecewise-constant d"
-    )
-    return fig
-
-
-def _case_response(runs: _Runs) -> Figure:
-    r = runs.case
-    return r["loud"].plot(
-        fig=new_figure(9.0, 6.0),
-        title=f"Case study: PMO (poles {_poles_text(r['pmo'])}), unknown input u2 and "
-        "disturbance v active",
-    )
-
-
-def _case_error(runs: _Runs) -> Figure:
-    r = runs.case
-    loud, quiet = r["loud"], r["quiet"]
-    k = loud.time
-    fig = new_figure(8.0, 4.5)
-    ax = fig.subplots()
-    norm = np.linalg.norm(loud.error, axis=0)
-    ax.semilogy(k, norm, "o", label=r"$\|e[k]\|$ with $u_2$ and $v$")
-    ax.semilogy(k, np.linalg.norm(quiet.error, axis=0), "k+", label=r"$\|e[k]\|$ without them")
-    rho = float(np.max(np.abs(r["pmo"].poles())))
-    if rho > 0:
-        ax.semilogy(k, norm[0] * rho**k, "--", label=rf"$\|e[0]\|\,{rho:.3g}^k$")
-    ax.set_xlabel(time_label(True))  # the case study counts steps k
-    finish_panel(ax, with_unit(r"$\|e[k]\|_2$"))
-    ax.set_title("Case study: the estimation error ignores both unknown signals")
-    return fig
-
-
-def _missile_states(runs: _Runs, name: str, label: str, figs: str) -> Figure:
-    m = runs.missile
-    resp, free = m[name]["response"], m["free"]
-    fig = new_figure(9.0, 6.0)
-    axes = fig.subplots(2, 2, sharex=True)
-    t = resp.time
-    for i, ax in enumerate(axes.flat):
-        ax.plot(t, resp.states[i], color="tab:red", label=f"{symbol('x', i)} with $v$")
-        ax.plot(t, free.states[i], color="tab:green", label=f"{symbol('x', i)} without $v$")
-        hat = symbol("x", i, hat=True)
-        ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=hat)
-        finish_panel(ax, with_unit(symbol("x", i)))
-    for ax in axes[1]:
-        ax.set_xlabel(time_label(m["plant"].dt))
-    fig.suptitle(
-        f"Missile autopilot, {label} (poles {_poles_text(m[name]['observer'])}); the paper's {figs}"
-    )
-    return fig
-
-
-def _missile_pmo(runs: _Runs) -> Figure:
-    return _missile_states(runs, "pmo", "PMO", "Fig. 4.1-4.4")
-
-
-def _missile_ginverse(runs: _Runs) -> Figure:
-    return _missile_states(runs, "ginverse", "g-inverse observer", "Fig. 4.7-4.10")
-
-
-def _missile_error(runs: _Runs) -> Figure:
-    m = runs.missile
-    fig = new_figure(9.0, 6.0)
-    axes = fig.subplots(2, 2, sharex=True)
-    for i, ax in enumerate(axes.flat):
-        errors = []
-        for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", "--")):
-            resp = m[name]["response"]
-            ax.plot(resp.time, resp.error[i], linestyle=style, label=label)
-            errors.append(resp.error[i])
-        finish_panel(ax, with_unit(rf"$e_{i + 1} = x_{i + 1} - \hat{{x}}_{i + 1}$"))
-        # a measured state is estimated exactly: its error is rounding noise, shown on zero
-        scale = float(np.max(np.abs(m["pmo"]["response"].states[i])))
-        zero_to_rounding(ax, np.array(errors), scale)
-    for ax in axes[1]:
-        ax.set_xlabel(time_label(m["plant"].dt))
-    fig.suptitle("Missile autopilot: estimation error of both observers")
-    return fig
-
-
-def _missile_inputs(runs: _Runs) -> Figure:
-    m = runs.missile
-    fig = new_figure(9.0, 5.5)
-    axes = fig.subplots(2, 1, sharex=True)
-    t = m["time"]
-    actual = m["pmo"]["response"].inputs.d
-    for i, ax in enumerate(axes):
-        ax.plot(t, actual[i], color="tab:red", lw=2.5, alpha=0.6, label=symbol("v", i))
-        for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", ":")):
-            est = m[name]["inputs"].estimates[i]
-            hat = symbol("v", i, hat=True)
-            ax.plot(t, est, color="k", linestyle=style, lw=1.2, label=f"{hat} {label}")
-        finish_panel(ax, with_unit(symbol("v", i)))
-        lim = 1.3 * float(np.max(np.abs(actual[i])))
-        ax.set_ylim(-lim, lim)
-    axes[-1].set_xlabel(time_label(m["plant"].dt))
-    fig.suptitle(
-        r"Missile autopilot: unknown inputs and their reconstructions "
-        r"$\hat{v} = E^+(\dot{\hat{x}} - A\hat{x})$ (Fig. 4.5-4.6, 4.11-4.12)"
-    )
-    return fig
-
-
-def _table2_rows(runs: _Runs) -> list[tuple[str, float, float, float, float]]:
-    m = runs.missile
-    pub = ut.examples.MISSILE_PUBLISHED
-    names = ["x1", "x2", "x3", "x4", "v1", "v2"]
-    computed = {
-        name: list(m[name]["catch_states"]) + list(m[name]["catch_inputs"])
-        for name in ("pmo", "ginverse")
-    }
-    return [
-        (
-            s,
-            float(computed["pmo"][i]),
-            float(pub.catch_pmo[s]),
-            float(computed["ginverse"][i]),
-            float(pub.catch_ginverse[s]),
-        )
-        for i, s in enumerate(names)
-    ]
-
-
-def _table2(runs: _Runs, out: Path) -> list[Path]:
-    rows = _table2_rows(runs)
-    csv_path, md_path = out / "missile_table2.csv", out / "missile_table2.md"
-    header = "signal,pmo_computed_s,pmo_paper_s,ginverse_computed_s,ginverse_paper_s"
-    csv = [header] + [f"{s},{a:.4f},{b:.2f},{c:.4f},{d:.2f}" for s, a, b, c, d in rows]
-    m = runs.missile
-    md = [
-        "Table II: time (s) after which each estimate stays within "
-        f"{CATCH_TOL:.0%} of the signal's peak",
-        "",
-        f"PMO poles {_poles_text(m['pmo']['observer'])}; g-inverse observer poles "
-        f"{_poles_text(m['ginverse']['observer'])}; simulated over {m['time'][-1]:g} s "
-        f"({m['time'].size} time points).",
-        "",
-        "| signal | PMO, computed | PMO, paper | g-inverse, computed | g-inverse, paper |",
-        "| --- | ---: | ---: | ---: | ---: |",
-    ]
-    md += [f"| {s} | {a:.3f} | {b:.2f} | {c:.3f} | {d:.2f} |" for s, a, b, c, d in rows]
-    for path, lines in ((csv_path, csv), (md_path, md)):
-        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return [csv_path, md_path]
+    def observer(self, name: str) -> Any:
+        """The observer of the worked example ``name`` with the config's poles (and plant)."""
+        key = WORKED[name].poles_key()
+        if key is None:
+            raise ValueError(f"the worked example {name!r} has no poles in the term config")
+        return design_observer(self.cfg, key)
 
 
 @dataclass(frozen=True)

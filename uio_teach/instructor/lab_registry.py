@@ -1,29 +1,31 @@
 """The labs of the course: which chapter, which parameters, which checks.
 
 :data:`LABS` names each lab of the course by id, with its chapter in
-``book/``, its parameter class (:mod:`uio_teach.instructor.lab_params`) and
-the check ids its check cells produce; :func:`lab_of` finds the lab of a
-chapter. :class:`LabError` and :class:`LabUsageError` are the errors of
-everything that makes labs. This module imports only the parameter classes,
-so the notebook builder (:mod:`~uio_teach.instructor.lab_notebook`), the
+``book/``, its parameter class and the check ids its check cells produce,
+read from the worked examples that have a lab (their ``LabEntry`` in
+:data:`uio_teach.worked.WORKED`); :func:`lab_of` finds the lab of a chapter.
+:class:`LabError` and :class:`LabUsageError` are the errors of everything
+that makes labs. This module imports only the registry, so the notebook
+builder (:mod:`~uio_teach.instructor.lab_notebook`), the
 variants (:mod:`~uio_teach.instructor.variants`) and the writer
 (:mod:`~uio_teach.instructor.labs`) can all import it.
 
 Examples
 --------
 >>> from uio_teach.instructor.lab_registry import LABS, lab_of
->>> list(LABS), lab_of("book/lab_pa9.md").id
-(['pa9', 'case_study', 'missile'], 'pa9')
+>>> "pa9" in LABS, lab_of("book/lab_pa9.md").id
+(True, 'pa9')
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import UIOTeachError
-from .lab_params import CaseStudyParams, MissileParams, PA9Params
+from ..worked import WORKED
 
 __all__ = ["LABS", "Lab", "LabError", "LabUsageError", "lab_of"]
 
@@ -43,11 +45,11 @@ class Lab:
     Attributes
     ----------
     id : str
-        ``"pa9"``, ``"case_study"`` or ``"missile"``.
+        The worked example's name (``"pa9"``, ...).
     source : str
         The file name of its chapter in ``book/``.
     params : type
-        Its parameter class (:mod:`uio_teach.instructor.lab_params`).
+        Its parameter class (a :class:`uio_teach.lab_params.LabParams`).
     check_ids : tuple of str
         The ``check_id`` of every result its check cells produce, in order.
 
@@ -64,45 +66,31 @@ class Lab:
     check_ids: tuple[str, ...]
 
 
-def _registry() -> dict[str, Lab]:
-    return {
-        "pa9": Lab(
-            "pa9",
-            "lab_pa9.md",
-            PA9Params,
-            ("pa9.design", "pa9.simulation", "pa9.plot", "pa9.piecewise", "pa9.piecewise_plot"),
-        ),
-        "case_study": Lab(
-            "case_study",
-            "lab_case_study.md",
-            CaseStudyParams,
-            (
-                "case_study.projection",
-                "case_study.lmi",
-                "case_study.pole",
-                "case_study.simulation",
-                "case_study.residual",
-                "case_study.plot",
-            ),
-        ),
-        "missile": Lab(
-            "missile",
-            "lab_missile.md",
-            MissileParams,
-            (
-                "missile.pmo",
-                "missile.ginverse",
-                "missile.reconstruction",
-                "missile.plot",
-                "missile.catch_times",
-                "missile.noise",
-            ),
-        ),
-    }
+class _Labs(Mapping):
+    """The labs of the worked examples of the registry that have one (read on use)."""
+
+    def _items(self) -> dict[str, Lab]:
+        return {
+            name: Lab(name, entry.lab.source, entry.lab.params, entry.lab.check_ids)
+            for name, entry in WORKED.items()
+            if entry.lab is not None
+        }
+
+    def __getitem__(self, name: str) -> Lab:
+        return self._items()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._items())
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __repr__(self) -> str:
+        return f"LABS({', '.join(self)})"
 
 
-LABS: dict[str, Lab] = _registry()
-"""The labs of the course, by id (each a :class:`Lab`)."""
+LABS: Mapping[str, Lab] = _Labs()
+"""The labs of the course, by id (each a :class:`Lab`), from :data:`uio_teach.worked.WORKED`."""
 
 
 def lab_of(source: str | os.PathLike[str]) -> Lab | None:

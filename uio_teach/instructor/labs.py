@@ -102,7 +102,7 @@ class UnreadKeys:
 COMMAND = "uio-teach labs"
 """The command recorded in the manifest of a labs folder."""
 
-LABS: dict[str, Lab] = lab_registry.LABS
+LABS: Mapping[str, Lab] = lab_registry.LABS
 """The labs of the course, by id (``uio_teach.instructor.lab_registry.LABS``, also here)."""
 
 UNREAD_CONFIG_KEYS: tuple[UnreadKeys, ...] = (

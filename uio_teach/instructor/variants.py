@@ -1,8 +1,8 @@
 """Variants of the labs, one per group, and their answer key.
 
 :func:`draw_variants` draws distinct parameter sets of a lab, each a fair
-exercise (see the ``problems()`` of each class of
-:mod:`uio_teach.instructor.lab_params`), from a seed; :func:`write_answer_key`
+exercise (see the ``problems()`` of each lab's parameter class, in its worked
+example's module), from a seed; :func:`write_answer_key`
 writes the expected matrices and numbers of every (lab, group) to a CSV file.
 
 Examples
@@ -108,7 +108,7 @@ def write_answer_key(path: Path, rows: Sequence[tuple[Any, str, Any]]) -> Path:
     >>> import tempfile, pathlib, csv
     >>> from uio_teach.instructor.lab_registry import LABS
     >>> from uio_teach.instructor.variants import write_answer_key
-    >>> from uio_teach.instructor.lab_params import PA9Params
+    >>> from uio_teach.worked.pa9 import PA9Params
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     key = write_answer_key(pathlib.Path(tmp) / "k.csv", [(LABS["pa9"], "g01", PA9Params())])
     ...     row = next(csv.DictReader(key.open()))

@@ -175,7 +175,7 @@ def design_pmo(
         if plant.nv:
             raise ValueError("Mv is not supported together with a measurement disturbance D")
         Mv = as_matrix("Mv", Mv, plant.n, plant.p, what="n x p")
-    dec = decoupling(plant, Mv, zeros=report.invariant_zeros)
+    dec = decoupling(plant, Mv, zeros=report.invariant_zeros, radius=report.zero_radius)
     certificate = None
     if method == "lmi":
         res = lmi_gain(

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import tolerances as tols
 from .._validation import as_matrix, read_only
 from ..existence import ExistenceReport, UIOExistenceError, check_existence
 from ..linalg import pinv
@@ -101,9 +102,9 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
     H, K = obs._H, obs._K1 + obs._K2
     nH, nC, nK = (float(np.linalg.norm(X, 2)) for X in (H, pl.C, obs._K1))
     nA = float(np.linalg.norm(pl.A, 2))
-    if nH * nC > 1e6:
+    if nH * nC > tols.AMPLIFICATION_LIMIT:
         cause = f"||H|| ||C|| = {nH * nC:.2g}: a C E small next to E makes H large"
-    elif nK * nC > 1e6 * max(nA, 1e-300):
+    elif nK * nC > tols.AMPLIFICATION_LIMIT * max(nA, 1e-300):
         cause = (
             f"||K1|| ||C|| = {nK * nC:.2g} against ||A|| = {nA:.2g}: the placement needs a "
             "large gain (many states per output, poles close together or far from the plant's)"
@@ -125,6 +126,12 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
     )
 
 
+def _entries(M: np.ndarray) -> str:
+    """The entries of a small matrix with 3 significant digits (a tiny non-zero shows as one)."""
+    rows = np.atleast_2d(M)
+    return "[" + "; ".join(", ".join(f"{x:.3g}" for x in row) for row in rows) + "]"
+
+
 def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
     """Check an explicit gain (shape n x p, ``gain D = 0``).
 
@@ -137,11 +144,11 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
     scale = max(1.0, float(np.abs(G).max()))
     GD = G @ plant.D
     residual = float(np.abs(GD).max())
-    if residual <= 1e-9 * scale:
+    if residual <= tols.GAIN_EXACT_RTOL * scale:
         return G
-    if residual <= 1e-3 * scale:
+    if residual <= tols.GAIN_ROUNDED_RTOL * scale:
         warnings.warn(
-            f"{name} D = {np.array2string(GD.ravel(), precision=2)} is not exactly 0 (a rounded "
+            f"{name} D = {_entries(GD)} is not exactly 0 (a rounded "
             f"gain?); using the nearest gain with {name} D = 0",
             UserWarning,
             stacklevel=3,
@@ -149,7 +156,7 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
         return G - GD @ pinv(plant.D)
     raise ValueError(
         f"{name} D must be 0 so that the measurement disturbance does not enter the "
-        f"error; got {name} D = {np.array2string(GD, precision=4)}"
+        f"error; got {name} D = {_entries(GD)}"
     )
 
 

@@ -127,7 +127,7 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     if (poles is None) == (K1 is None):
         raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
     report = require_existence(plant, "an unknown input observer")
-    dec = decoupling(plant, zeros=report.invariant_zeros)
+    dec = decoupling(plant, zeros=report.invariant_zeros, radius=report.zero_radius)
     requested = None
     if K1 is None:
         K1, requested = place_pair_poles(dec.pair, poles, given=(dec.A1, plant.C, dec.N))

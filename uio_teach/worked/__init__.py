@@ -1,9 +1,14 @@
-"""The course's worked examples, one registry entry each: everything else derives from it.
+"""The course's worked examples, one module each: everything else derives from their entries.
 
-A :class:`WorkedExample` names, for one worked example, its plant factory
-(:mod:`uio_teach.examples`), its experiment (:mod:`uio_teach.experiments`), the
-observer family its poles set, its figures, its explorer scenario and, when it
-has one, its lab chapter. From these entries come
+Each worked example is one module of this package (:mod:`~uio_teach.worked.pa9`,
+:mod:`~uio_teach.worked.case_study`, :mod:`~uio_teach.worked.missile`,
+:mod:`~uio_teach.worked.quadruple_tank`) that holds all of it: its experiment
+(the fields an instructor may change, each declared once with
+:func:`uio_teach.experiments.param`), the drawing code of its figures, its
+explorer's options and, when it has a lab, the lab's parameter class. A
+:class:`WorkedExample` in the module's ``EXAMPLES`` names these, with the
+plant factory (:mod:`uio_teach.examples`) and the observer family its poles
+set. From these entries come
 
 * the experiments by name (:data:`uio_teach.experiments.EXPERIMENTS`) and the
   plant of each lab (:func:`uio_teach.experiments.plant_from_params`);
@@ -12,37 +17,58 @@ has one, its lab chapter. From these entries come
 * the figures of ``uio-teach figures`` (``uio_teach.instructor.figures``), each
   drawn from the experiment with the config's values in place
   (:func:`run_from_config`);
-* the explorer of each example (``WorkedExample.make_scenario``), whose sliders
-  for physical parameters are the experiment's fields passed to the plant
-  factory that declare a ``range``.
+* the explorer of each example (``WorkedExample.make_scenario``, from its
+  :class:`ExplorerOptions`), with a slider for every declared field that has a
+  ``range``;
+* the labs of ``uio-teach labs`` (``uio_teach.instructor.labs.LABS``): the
+  chapter, the parameter class and the check ids of each :class:`LabEntry`.
 
-The entries live in the modules of this package, each holding a tuple
-``EXAMPLES``; a new worked example is one new module here (see
-:mod:`uio_teach.worked.quadruple_tank`), found when the registry is first read.
+A new worked example is one new module here, with a tuple ``EXAMPLES``: it is
+found when the registry is first read (:func:`discover` also reads the modules
+of another package), and the tests, the API page, the figure list, the term
+config and the command line take it from there.
 
 Examples
 --------
 >>> from uio_teach.worked import WORKED
->>> list(WORKED)
-['pa9', 'case_study', 'missile', 'quadruple_tank']
->>> WORKED["quadruple_tank"].family, WORKED["pa9"].lab
+>>> WORKED["quadruple_tank"].family, WORKED["pa9"].lab.source
 ('uio', 'lab_pa9.md')
+>>> all(name in WORKED for name in ("pa9", "case_study", "missile", "quadruple_tank"))
+True
 """
 
 from __future__ import annotations
 
+import dataclasses
+import difflib
 import importlib
 import pkgutil
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["WorkedExample", "FigureEntry", "WORKED", "resolve", "run_from_config"]
+from ..errors import UIOTeachError
 
-_GENERIC_SCENARIO = "uio_teach.explorers.scenarios:experiment_scenario"
+__all__ = [
+    "WorkedExample",
+    "FigureEntry",
+    "LabEntry",
+    "ExplorerOptions",
+    "RegistryError",
+    "WORKED",
+    "discover",
+    "resolve",
+    "run_from_config",
+]
+
+_SCENARIO_BUILDER = "uio_teach.explorers.scenarios:experiment_scenario"
 
 FAMILIES = ("uio", "pmo")
 """The observer families whose poles a worked example's config key sets."""
+
+
+class RegistryError(UIOTeachError, ValueError):
+    """A worked example's declaration that cannot be used (the message names what and why)."""
 
 
 def resolve(target: str) -> Any:
@@ -99,6 +125,218 @@ class FigureEntry:
     table: bool = False
 
 
+_REQUIRED: Any = object()  # marks an explorer option without a default
+
+
+def _pair(name: str, value: Any) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise RegistryError(
+            f"explorer option {name!r} must be a pair (low, high), got {value!r}"
+        ) from None
+    if not lo < hi:
+        raise RegistryError(f"explorer option {name!r} must have low < high, got {value!r}")
+    return (lo, hi)
+
+
+@dataclass(frozen=True, init=False)
+class ExplorerOptions:
+    """A worked example's explorer: what its experiment's declarations do not say.
+
+    The plant, the time grid, the known input, the initial state, the starting
+    poles and the disturbance's amplitude, frequency and noise (with their
+    ranges, from the fields declared with ``control="amplitude"``,
+    ``"frequency"`` or ``"noise"``) come from the experiment, and every other
+    declared field with a ``range`` gets a slider of its own; these options
+    say the rest. Built from keywords only: a missing required option or an
+    unknown one is a :class:`RegistryError` naming it.
+
+    Attributes
+    ----------
+    period : float
+        The starting switching period of the piecewise-constant and
+        random-step disturbances (required).
+    pole_limits : (float, float)
+        The range of a real pole (required).
+    frequency_limits : (float, float)
+        The range of a complex pair's imaginary part (required).
+    period_limits : (float, float)
+        The range of the switching period (required).
+    static_values : tuple of float
+        The values of the static book's main control (required).
+    title : str or None
+        The figure title (``None``: the entry's title).
+    samples : int or None
+        Time points of the explorer's grid (``None``: the experiment's).
+    poles : tuple of complex or None
+        The starting poles, when the experiment has none (an LMI gain).
+    disturbance : str
+        The starting disturbance type.
+    amplitude, frequency : float or None
+        The starting amplitude and frequency, for an experiment that declares
+        no field for them (then ``amplitude_limits`` and
+        ``disturbance_frequency_limits`` are required too).
+    amplitude_limits, disturbance_frequency_limits, noise_limits : (float, float) or None
+        The ranges of controls that no declared field sets (given while a
+        field declares one: an error, the value would be set twice).
+    decay : float
+        The starting LMI bound.
+    decay_limits : (float, float) or None
+        The LMI bound's range (``None``: no LMI mode).
+    tau : float
+        The starting time constant of the input reconstruction's filter.
+    tau_limits : (float, float) or None
+        Its range (``None``: the inputs are not reconstructed).
+    d_channels, v_channels : tuple of tuple
+        How each channel of ``d`` (``v``) follows the disturbance controls:
+        ``(gain, speed)`` or ``(gain, speed, decay, kind)`` per channel
+        (``d_channels`` empty: ``(1, 1)`` for each unknown input).
+    static_control : str
+        The static book's main control: ``"pole"``, ``"amplitude"`` or
+        ``"plant:<field>"`` (a field's own slider).
+    note : str or None
+        ``"module:function"`` called with the fields that have sliders: a
+        sentence on this plant (``None``: none).
+    input_symbol : str
+        The unknown input's symbol in the figure.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import ExplorerOptions
+    >>> opts = ExplorerOptions(period=2.5, pole_limits=(-10, 1), frequency_limits=(0, 10),
+    ...                        period_limits=(0.25, 5), static_values=(-1.0, -2.0))
+    >>> opts.pole_limits, opts.disturbance
+    ((-10.0, 1.0), 'sinusoid')
+    >>> ExplorerOptions(period=2.5, pole_limits=(-10, 1), frequency_limits=(0, 10),
+    ...                 period_limits=(0.25, 5), static_values=(-1.0,), perod=3)
+    Traceback (most recent call last):
+    ...
+    uio_teach.worked.RegistryError: unknown explorer option 'perod' (did you mean 'period'?)...; ...
+    >>> ExplorerOptions(pole_limits=(-10, 1), frequency_limits=(0, 10),
+    ...                 period_limits=(0.25, 5), static_values=(-1.0,))
+    Traceback (most recent call last):
+    ...
+    uio_teach.worked.RegistryError: explorer option 'period' is missing ...
+    """
+
+    period: float = _REQUIRED
+    pole_limits: tuple[float, float] = _REQUIRED
+    frequency_limits: tuple[float, float] = _REQUIRED
+    period_limits: tuple[float, float] = _REQUIRED
+    static_values: tuple[float, ...] = _REQUIRED
+    title: str | None = None
+    samples: int | None = None
+    poles: tuple[complex, ...] | None = None
+    disturbance: str = "sinusoid"
+    amplitude: float | None = None
+    frequency: float | None = None
+    amplitude_limits: tuple[float, float] | None = None
+    disturbance_frequency_limits: tuple[float, float] | None = None
+    noise_limits: tuple[float, float] | None = None
+    decay: float = 0.9
+    decay_limits: tuple[float, float] | None = None
+    tau: float = 0.0
+    tau_limits: tuple[float, float] | None = None
+    d_channels: tuple[tuple[Any, ...], ...] = ()
+    v_channels: tuple[tuple[Any, ...], ...] = ()
+    static_control: str = "pole"
+    note: str | None = None
+    input_symbol: str = "d"
+
+    def __init__(self, **options: Any) -> None:
+        names = [f.name for f in dataclasses.fields(self)]
+        for key in options:
+            if key not in names:
+                close = difflib.get_close_matches(key, names, 1)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                raise RegistryError(
+                    f"unknown explorer option {key!r}{hint}; expected some of {', '.join(names)}"
+                )
+        for f in dataclasses.fields(self):
+            value = options.get(f.name, f.default)
+            if value is _REQUIRED:
+                raise RegistryError(
+                    f"explorer option {f.name!r} is missing (what it is: see ExplorerOptions)"
+                )
+            object.__setattr__(self, f.name, value)
+        self._check()
+
+    def _check(self) -> None:
+        set_ = object.__setattr__
+        for name in (
+            "pole_limits",
+            "frequency_limits",
+            "period_limits",
+            "amplitude_limits",
+            "disturbance_frequency_limits",
+            "noise_limits",
+            "decay_limits",
+            "tau_limits",
+        ):
+            set_(self, name, _pair(name, getattr(self, name)))
+        for name in ("period", "decay", "tau", "amplitude", "frequency"):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, (int, float)):
+                raise RegistryError(f"explorer option {name!r} must be a number, got {value!r}")
+        if self.samples is not None and (not isinstance(self.samples, int) or self.samples < 2):
+            raise RegistryError(
+                f"explorer option 'samples' must be an int >= 2, got {self.samples!r}"
+            )
+        try:
+            set_(self, "static_values", tuple(float(v) for v in self.static_values))
+        except (TypeError, ValueError):
+            raise RegistryError(
+                f"explorer option 'static_values' must be numbers, got {self.static_values!r}"
+            ) from None
+        for name in ("d_channels", "v_channels"):
+            channels = tuple(tuple(c) for c in getattr(self, name))
+            for c in channels:
+                if len(c) not in (2, 4):
+                    raise RegistryError(
+                        f"explorer option {name!r}: each channel is (gain, speed) or "
+                        f"(gain, speed, decay, kind), got {c!r}"
+                    )
+            set_(self, name, channels)
+        if self.poles is not None:
+            set_(self, "poles", tuple(self.poles))
+        if not (
+            self.static_control in ("pole", "amplitude") or self.static_control.startswith("plant:")
+        ):
+            raise RegistryError(
+                "explorer option 'static_control' must be 'pole', 'amplitude' or "
+                f"'plant:<field>', got {self.static_control!r}"
+            )
+
+
+@dataclass(frozen=True)
+class LabEntry:
+    """The lab of a worked example: its chapter, its parameter class and its checks.
+
+    Attributes
+    ----------
+    source : str
+        The file name of the lab chapter in ``book/``.
+    params : type
+        The lab's parameter class (a ``uio_teach.lab_params.LabParams``).
+    check_ids : tuple of str
+        The ``check_id`` of every result its check cells produce, in order.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import WORKED
+    >>> lab = WORKED["pa9"].lab
+    >>> lab.source, lab.params.__name__, lab.check_ids[0]
+    ('lab_pa9.md', 'PA9Params', 'pa9.design')
+    """
+
+    source: str
+    params: type
+    check_ids: tuple[str, ...]
+
+
 @dataclass(frozen=True)
 class WorkedExample:
     """A worked example of the course: the one declaration everything else reads.
@@ -113,21 +351,16 @@ class WorkedExample:
         ``"module:function"`` of the plant factory; the experiment's fields
         listed in ``Experiment.plant_fields`` are passed to it as keywords.
     experiment : str
-        ``"module:NAME"`` of the experiment (:mod:`uio_teach.experiments`).
+        ``"module:NAME"`` of the experiment (an ``uio_teach.experiments.Experiment``).
     family : str
         The observer that the experiment's ``poles`` set: ``"uio"`` or
         ``"pmo"`` (``None`` poles of a PMO: the LMI gain).
-    scenario : str or None
-        ``"module:function"`` returning the explorer's scenario (``None``: made
-        from the experiment and ``explorer`` by
-        ``uio_teach.explorers.scenarios.experiment_scenario``).
-    explorer : dict
-        The explorer's options beyond the experiment's declarations (ranges of
-        the poles, the channels of ``d``, ...; see ``experiment_scenario``).
+    explorer : ExplorerOptions
+        Its explorer's options beyond the experiment's declarations.
     figures : tuple of FigureEntry
         Its outputs of ``uio-teach figures``, in order.
-    lab : str or None
-        The file name of its lab chapter in ``book/`` (``None``: no lab).
+    lab : LabEntry or None
+        Its lab (``None``: no lab).
     order : int
         Its place among the worked examples (the book's order).
 
@@ -136,7 +369,7 @@ class WorkedExample:
     >>> from uio_teach.worked import WORKED
     >>> tank = WORKED["quadruple_tank"]
     >>> tank.plant_factory()(gamma1=0.43, gamma2=0.34).name
-    'quadruple tank (P- levels, gamma 0.43, 0.34)'
+    'quadruple tank (P- pumps, gamma 0.43, 0.34)'
     >>> tank.poles_key(), tank.lab is None
     ('quadruple_tank.poles', True)
     """
@@ -146,15 +379,27 @@ class WorkedExample:
     plant: str
     experiment: str
     family: str
-    scenario: str | None = None
-    explorer: Mapping[str, Any] = field(default_factory=dict)
+    explorer: ExplorerOptions
     figures: tuple[FigureEntry, ...] = ()
-    lab: str | None = None
+    lab: LabEntry | None = None
     order: int = 100
 
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
-            raise ValueError(f"family must be one of {FAMILIES}, got {self.family!r}")
+            raise RegistryError(
+                f"worked example {self.name!r}: family must be one of {FAMILIES}, "
+                f"got {self.family!r}"
+            )
+        if not isinstance(self.explorer, ExplorerOptions):
+            raise RegistryError(
+                f"worked example {self.name!r}: explorer must be ExplorerOptions, "
+                f"got {type(self.explorer).__name__}"
+            )
+        if self.lab is not None and not isinstance(self.lab, LabEntry):
+            raise RegistryError(
+                f"worked example {self.name!r}: lab must be a LabEntry or None, "
+                f"got {type(self.lab).__name__}"
+            )
 
     def plant_factory(self) -> Callable[..., Any]:
         """The plant factory (imported on first use)."""
@@ -164,11 +409,9 @@ class WorkedExample:
         """The experiment (imported on first use, looked up on every call)."""
         return resolve(self.experiment)
 
-    def make_scenario(self, **plant_values: Any) -> Any:
-        """The explorer's scenario; ``plant_values`` set physical parameters of the plant."""
-        if self.scenario is None:
-            return resolve(_GENERIC_SCENARIO)(self.name, **plant_values)
-        return resolve(self.scenario)(**plant_values)
+    def make_scenario(self, **values: Any) -> Any:
+        """The explorer's scenario; ``values`` set fields of the experiment (its sliders)."""
+        return resolve(_SCENARIO_BUILDER)(self.name, **values)
 
     def poles_key(self) -> str | None:
         """The config key that sets the observer's poles (``None``: not in the config)."""
@@ -180,22 +423,33 @@ class WorkedExample:
 
 
 class _Registry(Mapping):
-    """The worked examples by name, found in this package's modules on first use."""
+    """The worked examples by name, found in the modules of the packages read on first use."""
 
     def __init__(self) -> None:
         self._entries: dict[str, WorkedExample] | None = None
+        self._packages: list[tuple[list[str], str]] = [(list(__path__), __name__)]
+
+    def add_package(self, path: list[str], prefix: str) -> None:
+        if (path, prefix) not in self._packages:
+            self._packages.append((path, prefix))
+        self._entries = None
+
+    def remove_package(self, prefix: str) -> None:
+        self._packages = [p for p in self._packages if p[1] != prefix or p[1] == __name__]
+        self._entries = None
 
     def _load(self) -> dict[str, WorkedExample]:
         if self._entries is None:
             found: list[WorkedExample] = []
-            for info in pkgutil.iter_modules(__path__):
-                module = importlib.import_module(f"{__name__}.{info.name}")
-                found += list(getattr(module, "EXAMPLES", ()))
+            for path, prefix in self._packages:
+                for info in pkgutil.iter_modules(path):
+                    module = importlib.import_module(f"{prefix}.{info.name}")
+                    found += list(getattr(module, "EXAMPLES", ()))
             found.sort(key=lambda e: (e.order, e.name))
             names = [e.name for e in found]
             twice = sorted({n for n in names if names.count(n) > 1})
             if twice:
-                raise ValueError(f"worked examples declared twice: {', '.join(twice)}")
+                raise RegistryError(f"worked examples declared twice: {', '.join(twice)}")
             self._entries = {e.name: e for e in found}
         return self._entries
 
@@ -214,6 +468,52 @@ class _Registry(Mapping):
 
 WORKED: Mapping[str, WorkedExample] = _Registry()
 """The course's worked examples by name, in the book's order."""
+
+
+def __getattr__(name: str) -> Any:
+    """A worked example's module, imported on first use (``ut.worked.pa9``)."""
+    if any(info.name == name for info in pkgutil.iter_modules(__path__)):
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def discover(package: str | None = None, *, remove: bool = False) -> list[str]:
+    """Read the worked examples of another package too (or no more, with ``remove``).
+
+    The registry reads the modules of :mod:`uio_teach.worked`; a course that
+    keeps its own examples elsewhere (or a test) adds its package here, and
+    every module of it with ``EXAMPLES`` joins the registry: the term config,
+    the figures, the labs and the explorers then know them.
+
+    Parameters
+    ----------
+    package : str, optional
+        An importable package (``None``: just read the registry again).
+    remove : bool
+        Forget ``package`` instead.
+
+    Returns
+    -------
+    list of str
+        The names of the worked examples now registered.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import discover
+    >>> discover()[:2]
+    ['pa9', 'case_study']
+    """
+    registry = WORKED
+    assert isinstance(registry, _Registry)
+    if package is not None:
+        if remove:
+            registry.remove_package(package)
+        else:
+            module = importlib.import_module(package)
+            registry.add_package(list(module.__path__), package)
+    else:
+        registry._entries = None
+    return list(registry)
 
 
 def run_from_config(name: str, config: Mapping[str, Any]) -> Any:

@@ -1,11 +1,13 @@
 """The quadruple-tank process (Johansson, 2000): its experiment, figures, explorer and entry.
 
 Four tanks, two pumps, the two lower levels measured; both pump flows are the
-unknown inputs (``E = B``, :func:`uio_teach.examples.quadruple_tank`). The
-valves ``gamma1, gamma2`` decide whether a UIO exists: the invariant zeros
-solve ``(1 + s T3)(1 + s T4) = (1 - gamma1)(1 - gamma2) / (gamma1 gamma2)``,
-and one of them is at the origin when ``gamma1 + gamma2 = 1`` and in the
-right half-plane below. With the plant in :mod:`uio_teach.examples`, this
+unknown inputs (``E = B``, :func:`uio_teach.examples.quadruple_tank`), the
+model linearized at the steady state of the valves and pump voltages. The
+valves ``gamma1, gamma2`` decide whether a UIO exists: at 0 the rank
+condition fails; above 0 the invariant zeros solve
+``(1 + s T3)(1 + s T4) = (1 - gamma1)(1 - gamma2) / (gamma1 gamma2)``, and one
+of them is at the origin when ``gamma1 + gamma2 = 1`` and in the right
+half-plane below. With the plant in :mod:`uio_teach.examples`, this
 module is the whole of the worked example in the package: the experiment
 (:data:`QUADRUPLE_TANK`, its fields the config table ``[quadruple_tank]``),
 its figures, its explorer's options (a slider per valve) and its registry entry.
@@ -17,8 +19,9 @@ Examples
 >>> QUADRUPLE_TANK.gamma1, QUADRUPLE_TANK.gamma2, QUADRUPLE_TANK.poles
 (0.7, 0.6, (-0.1, -0.2))
 >>> print(valve_verdict(0.43, 0.34))   # doctest: +NORMALIZE_WHITESPACE
-gamma1 + gamma2 = 0.77 < 1: the pumps fill the upper tanks more than the lower ones, an
-invariant zero lies in the right half-plane at 0.0225, and no UIO with a stable error exists
+gamma1 + gamma2 = 0.77 < 1: the valves send on average less than half of the pumps' flow to
+the lower tanks, an invariant zero lies in the right half-plane at 0.0129, and no UIO with a
+stable error exists
 """
 
 from __future__ import annotations
@@ -33,12 +36,13 @@ import numpy as np
 
 from .. import signals
 from .._display import format_poles
-from ..examples import quadruple_tank
+from ..examples import TankOperatingPoint, quadruple_tank, tank_operating_point
 from ..existence import check_existence
 from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
 from ..luenberger import luenberger_poles
 from ..observers import design_luenberger, design_uio
-from . import FigureEntry, WorkedExample
+from ..simulation import UIOResponse
+from . import ExplorerOptions, FigureEntry, WorkedExample
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -50,15 +54,18 @@ VALVE_DOC = "the share of pump {i}'s flow sent to lower tank {i} (the rest to up
 
 @dataclass(frozen=True)
 class QuadrupleTankExperiment(Experiment):
-    """The quadruple tank at the operating point of setting P-, with valves of one's choice.
+    """The quadruple tank with the pumps of P-, linearized at the steady state of its valves.
 
     The UIO (two movable poles; the two invariant zeros are its fixed poles)
     watches the levels while pump 1 steps and pump 2 oscillates, unknown to it.
+    Both observers start from the estimate ``xhat(0) = 0``
+    (:meth:`observer_state`). Initial levels or pump voltages that would be
+    negative are refused, and so is a run whose linear model empties a tank.
 
     Attributes
     ----------
     gamma1 : float
-        Valve 1's split (strictly between 0 and 1); passed to the plant.
+        Valve 1's split (from 0 up to 0.99); passed to the plant.
     gamma2 : float
         Valve 2's split.
     step_size : float
@@ -81,7 +88,7 @@ class QuadrupleTankExperiment(Experiment):
     plant_fields: ClassVar[tuple[str, ...]] = ("gamma1", "gamma2")
     tables: ClassVar[Mapping[str, str]] = MappingProxyType(
         {
-            "": "the quadruple-tank process of Johansson (2000), operating point P-",
+            "": "the quadruple-tank process of Johansson (2000), pumps of setting P-",
             "pump1": "pump 1's unknown deviation, a step",
             "pump2": "pump 2's unknown deviation, a sinusoid",
         }
@@ -108,18 +115,18 @@ class QuadrupleTankExperiment(Experiment):
         0.70,
         "float",
         VALVE_DOC.format(i=1, j=4),
-        positive=True,
+        minimum=0.0,
         maximum=0.99,
-        range=(0.05, 0.95),
+        range=(0.0, 0.95),
         control="plant",
     )
     gamma2: float = param(
         0.60,
         "float",
         VALVE_DOC.format(i=2, j=3),
-        positive=True,
+        minimum=0.0,
         maximum=0.99,
-        range=(0.05, 0.95),
+        range=(0.0, 0.95),
         control="plant",
     )
     step_size: float = param(
@@ -149,6 +156,115 @@ class QuadrupleTankExperiment(Experiment):
         control="frequency",
     )
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.matrices:  # the plant's own matrices: its states need not be levels
+            return
+        h0 = self.operating_point().h0
+        low = h0 + self.initial_state
+        if low.size == h0.size and np.any(low < 0):
+            i = int(np.argmin(low))
+            raise ValueError(
+                f"initial_state: the deviation {self.initial_state[i]:g} cm would leave tank "
+                f"{i + 1} at {low[i]:.3g} cm, below empty (its level at this operating point is "
+                f"{h0[i]:.3g} cm); keep every h(0) - h0 above -h0"
+            )
+        for key, what, lowest in (
+            ("pump1.step", f"a step of {self.step_size:g} V", self.v0[0] + min(self.step_size, 0)),
+            (
+                "pump2.amplitude",
+                f"an amplitude of {self.sine_amplitude:g} V",
+                self.v0[1] - abs(self.sine_amplitude),
+            ),
+        ):
+            if lowest < 0:
+                pump = key[4]
+                raise ValueError(
+                    f"{key}: {what} takes pump {pump} to {lowest:.3g} V, below 0 (it runs at "
+                    f"{self.v0[int(pump) - 1]:g} V at the operating point)"
+                )
+
+    def operating_point(self) -> TankOperatingPoint:
+        """The steady state of the run's valves and pump voltages (levels, time constants).
+
+        Returns
+        -------
+        uio_teach.examples.TankOperatingPoint
+
+        Examples
+        --------
+        >>> from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK
+        >>> QUADRUPLE_TANK.operating_point().h0.round(2).tolist()
+        [12.26, 12.69, 1.63, 1.4]
+        """
+        return tank_operating_point(gamma1=self.gamma1, gamma2=self.gamma2)
+
+    def observer_state(self, observer: Any) -> np.ndarray:
+        """The observer state whose estimate ``xhat(0)`` is zero, as for any observer.
+
+        The UIO's estimate is ``z + H y``: it starts at ``z(0) = -H y(0)``. With
+        ``z(0) = 0`` instead its error would start in the upper tanks alone,
+        where its gain never acts.
+
+        Parameters
+        ----------
+        observer : Observer
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Examples
+        --------
+        >>> import numpy as np, uio_teach as ut
+        >>> from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK as run
+        >>> uio = ut.design_uio(run.plant(), poles=run.poles)
+        >>> real = uio.realization()
+        >>> y0 = run.plant().C @ run.initial_state
+        >>> bool(np.allclose(real.C @ run.observer_state(uio) + real.D_y @ y0, 0))
+        True
+        """
+        real = observer.realization()
+        y0 = self.plant().C @ self.initial_state
+        return np.linalg.lstsq(real.C, -real.D_y @ y0, rcond=None)[0]
+
+    def simulate(self, observer: Any, **changes: Any) -> UIOResponse:
+        """As :meth:`uio_teach.experiments.Experiment.simulate`; a level below empty is refused.
+
+        Parameters
+        ----------
+        observer : Observer
+        **changes
+            Keywords of :func:`uio_teach.simulate`.
+
+        Returns
+        -------
+        UIOResponse
+
+        Raises
+        ------
+        ValueError
+            The linear model takes a level below 0 (the deviations are too large for it).
+        """
+        res = super().simulate(observer, **changes)
+        if self.matrices:
+            return res
+        h0 = self.operating_point().h0
+        levels = h0[:, None] + res.states
+        if np.any(levels < 0):
+            i, k = np.unravel_index(int(np.argmin(levels)), levels.shape)
+            raise ValueError(
+                f"the run takes tank {i + 1} to {levels[i, k]:.3g} cm at t = {res.time[k]:g} s, "
+                f"below empty (its level at the operating point is {h0[i]:.3g} cm): the pump "
+                "deviations are too large for the linear model"
+            )
+        return res
+
+    @property
+    def v0(self) -> tuple[float, float]:
+        """Setting P-'s pump voltages at the operating point, in V."""
+        return tank_operating_point().v0
+
     @property
     def d(self) -> signals.Signal:
         """The pumps' unknown deviations ``[d1; d2]``."""
@@ -168,16 +284,19 @@ QUADRUPLE_TANK = QuadrupleTankExperiment(
 )
 """The run of the quadruple tank.
 
-600 s on 1201 points, the valves of P-, UIO poles -0.1, -0.2."""
+600 s on 1201 points, the valves and pumps of P-, UIO poles -0.1, -0.2, both observers
+started from the estimate 0."""
 
 
-def valve_verdict(gamma1: float, gamma2: float) -> str:
+def valve_verdict(gamma1: float, gamma2: float, v0: Any = None) -> str:
     """One sentence: does a UIO exist for these valves, and why (from the existence check).
 
     Parameters
     ----------
     gamma1, gamma2 : float
         The valve splits.
+    v0 : pair of float, optional
+        The pump voltages (default: setting P-'s).
 
     Returns
     -------
@@ -187,32 +306,60 @@ def valve_verdict(gamma1: float, gamma2: float) -> str:
     --------
     >>> from uio_teach.worked.quadruple_tank import valve_verdict
     >>> print(valve_verdict(0.7, 0.3))   # doctest: +NORMALIZE_WHITESPACE
-    gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike, an invariant zero
-    sits at the origin (to round-off), and no UIO with a stable error exists
+    gamma1 + gamma2 = 1: the valves send on average half of the pumps' flow to the lower
+    tanks, an invariant zero sits at the origin (to round-off), and no UIO with a stable error
+    exists
     >>> valve_verdict(0.5, 0.5 + 1e-6)[:43]
-    'gamma1 + gamma2 = 1.000001 > 1: the pumps f'
+    'gamma1 + gamma2 = 1.000001 > 1: the valves '
+    >>> print(valve_verdict(0.0, 0.6))   # doctest: +NORMALIZE_WHITESPACE
+    gamma1 = 0: pump 1 feeds upper tank 4 only and reaches the measured levels only through it,
+    so CE is singular, the rank condition fails and no UIO exists
     """
-    report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2))
+    report = check_existence(quadruple_tank(gamma1=gamma1, gamma2=gamma2, v0=v0))
+    closed = [i for i, g in ((1, gamma1), (2, gamma2)) if g == 0]
+    if closed:
+        upper = {1: 4, 2: 3}
+        if len(closed) == 1:
+            (i,) = closed
+            what = f"gamma{i} = 0: pump {i} feeds upper tank {upper[i]} only and reaches"
+            tail = "through it, so CE is singular"
+        else:
+            what = (
+                "gamma1 = 0 and gamma2 = 0: pumps 1 and 2 feed upper tanks 4 and 3 only and reach"
+            )
+            tail = "through them, so CE = 0"
+        return f"{what} the measured levels only {tail}, the rank condition fails and no UIO exists"
+    if report["rank condition"].holds is not True:  # a valve so nearly closed that CE is singular
+        i, g = min(((1, gamma1), (2, gamma2)), key=lambda pair: pair[1])
+        return (
+            f"gamma{i} = {g:.3g}: pump {i} sends almost nothing to lower tank {i}, so CE is "
+            "singular to round-off, the rank condition fails and no UIO exists"
+        )
     zeros = np.sort(report.invariant_zeros.real)
     total = gamma1 + gamma2
     if abs(total - 1) <= 4 * np.finfo(float).eps:  # 0.7 + 0.3 is 1 to round-off
-        head = "gamma1 + gamma2 = 1: the pumps fill the upper and the lower tanks alike"
+        head = (
+            "gamma1 + gamma2 = 1: the valves send on average half of the pumps' flow to the "
+            "lower tanks"
+        )
     else:
         # close to 1: enough digits to tell the side
         digits = max(3, 2 + math.ceil(-math.log10(abs(total - 1))))
-        more, less = ("lower", "upper") if total > 1 else ("upper", "lower")
+        share = "more" if total > 1 else "less"
         sign = ">" if total > 1 else "<"
         head = (
-            f"gamma1 + gamma2 = {total:.{digits}g} {sign} 1: the pumps fill the {more} tanks "
-            f"more than the {less} ones"
+            f"gamma1 + gamma2 = {total:.{digits}g} {sign} 1: the valves send on average {share} "
+            "than half of the pumps' flow to the lower tanks"
         )
     if report.ok:
         slow = zeros[-1]
         return (
             f"{head}, both invariant zeros are stable ({', '.join(f'{z:.3g}' for z in zeros)}) "
-            f"and a UIO exists; its slowest fixed pole {slow:.3g} takes {-1 / slow:.3g} s per "
-            "e-fold of the error, whatever the gain"
+            f"and a UIO exists; its slowest fixed pole {slow:.3g} ({-1 / slow:.3g} s per e-fold) "
+            "is a mode of the error that no gain moves"
         )
+    if not zeros.size:  # pragma: no cover - the rank condition holds: the plant has its zeros
+        return f"{head}, and no UIO with a stable error exists"
     worst = float(zeros[-1])
     if abs(worst) <= 1e-9 * max(1.0, float(np.max(np.abs(zeros)))):
         place = "an invariant zero sits at the origin (to round-off)"
@@ -255,9 +402,11 @@ def _figure_error(runs: Any) -> Figure:
         ax_d.plot(resp.time, resp.inputs.d[i], label=symbol("d", i))
     finish_panel(ax_d, with_unit("pump deviations $d$", "V"))
     plot_error(ax_e, resp)
-    ax_e.set_title(f"UIO, poles {format_poles(r['uio'].poles(), 3)}", fontsize=9)
+    ax_e.set_title(
+        f"UIO, poles {format_poles(r['uio'].poles(), 3)}, from the estimate 0", fontsize=9
+    )
     plot_error(ax_l, luen)
-    ax_l.set_title("Luenberger observer with the same poles", fontsize=9)
+    ax_l.set_title("Luenberger observer with the same poles, from the same start", fontsize=9)
     ax_l.set_xlabel(time_label(r["plant"].dt))
     run = r["run"]
     fig.suptitle(
@@ -296,7 +445,10 @@ def _figure_zeros(runs: Any) -> Figure:
     ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="C3")
     lim = 2.5 * max(float(np.max(np.abs(mine))), 0.02)
     ax.set_ylim(-lim, 0.6 * lim)
-    ax.set_xlabel(r"$\gamma_1 + \gamma_2$" + f" (along $\\gamma_2 = {ratio:.3g}\\,\\gamma_1$)")
+    ax.set_xlabel(
+        r"$\gamma_1 + \gamma_2$"
+        + f" (along $\\gamma_2 = {ratio:.3g}\\,\\gamma_1$, each at its own steady state)"
+    )
     finish_panel(ax, "invariant zero (1/s)")
     ax.set_title("Quadruple tank: the zeros move with the valves and cross 0 at 1")
     return fig
@@ -310,21 +462,20 @@ EXAMPLES = (
         experiment=f"{__name__}:QUADRUPLE_TANK",
         family="uio",
         order=40,
-        explorer=MappingProxyType(
-            {
-                "title": "Quadruple tank",
-                "samples": 601,
-                "period": 100.0,
-                "pole_limits": (-0.5, 0.01),
-                "frequency_limits": (0.0, 0.5),
-                "period_limits": (10.0, 300.0),
-                "noise_limits": (0.0, 0.2),
-                "d_channels": ((1.0, 1.0), (0.5, 1.5)),
-                # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3)
-                "static_control": "plant:gamma2",
-                "static_values": (0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
-                "note": f"{__name__}:valve_verdict",
-            }
+        explorer=ExplorerOptions(
+            title="Quadruple tank",
+            samples=601,
+            period=100.0,
+            pole_limits=(-0.5, 0.01),
+            frequency_limits=(0.0, 0.5),
+            period_limits=(10.0, 300.0),
+            noise_limits=(0.0, 0.2),
+            d_channels=((1.0, 1.0), (0.5, 1.5)),
+            # the static book's slider: valve 2, valve 1 at 0.7 (the line is at 0.3; at 0 the
+            # rank condition fails)
+            static_control="plant:gamma2",
+            static_values=(0.0, 0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
+            note=f"{__name__}:valve_verdict",
         ),
         figures=(
             FigureEntry(

@@ -4,15 +4,16 @@ The answers a notebook exported are untrusted data: a right solution may carry
 a figure with thousands of empty axes, or an array of millions of entries,
 that would keep the checks busy for minutes. So the grader never rebuilds
 them in its own process. :func:`check_in_child` starts a fresh Python process
-(``python -m uio_teach.instructor.checking``) that
+(``python -m uio_teach.grading.checking``) that
 
 1. limits its own memory (address space) and CPU time;
 2. parses each answer file and measures it against the caps of
    :data:`CAPS` (entries of an array and of all arrays, axes and lines of a
    figure, characters of a string, items of a list): an answer over a cap is
    not rebuilt, its checks fail saying why, and the row is "over limits";
-3. rebuilds the rest as genuine objects of the package and runs the lab's
-   checks with the answer key's parameters (:mod:`uio_teach.checks.grading`);
+3. rebuilds the rest as genuine objects of the package and runs the lab
+   chapter's own check cells with the answer key's parameters
+   (:mod:`uio_teach.grading.lab_checks`);
 4. writes the results back as JSON.
 
 The grader waits for it at most ``timeout`` seconds (then kills it: "over
@@ -20,7 +21,7 @@ limits"), and kills it at once when the grading run is interrupted.
 
 Examples
 --------
->>> from uio_teach.instructor.checking import TooLarge, measure
+>>> from uio_teach.grading.checking import TooLarge, measure
 >>> measure({"x": [1, 2, 3]})
 >>> try:
 ...     measure({"__uio__": "figure", "axes": [{}] * 100})
@@ -148,7 +149,7 @@ def _assigns(source: str, name: str) -> bool:
 
 def _missing(name: str, position: int | None, errors: list[dict[str, Any]]) -> Any:
     """Why ``name`` is absent at ``position``: the cell that raised before it, if any."""
-    from ..checks.grading import Missing  # deferred on purpose: the child imports the checks
+    from .lab_checks import Missing  # deferred on purpose: the child imports the checks
 
     before = [e for e in errors if position is None or e["position"] < position]
     if not before:
@@ -165,8 +166,9 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     request : mapping
-        ``lab``, ``params``, ``positions`` (capture tag -> cell), ``errors``
-        (the cells that raised, as dicts) and ``captures`` (tag -> answer text).
+        ``checks`` (the lab's check cells, ``LabChecks.to_dict()``), ``params``,
+        ``positions`` (capture tag -> cell), ``errors`` (the cells that raised,
+        as dicts) and ``captures`` (tag -> answer text).
 
     Returns
     -------
@@ -174,9 +176,10 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
         ``results`` (list of dict), ``notes`` (list of str), ``over`` (bool).
     """
     from ..checks.answers import AnswerError, from_data, parse  # deferred: the child only
-    from ..checks.grading import GRADED, Missing, grade_answers, lab_plant
+    from .lab_checks import LabChecks, Missing, grade_answers, lab_plant, setup_namespace
 
-    lab, params = request["lab"], request["params"]
+    checks = LabChecks.from_dict(request["checks"])
+    lab, params = checks.lab, request["params"]
     positions, errors = request["positions"], request["errors"]
     notes: list[str] = []
     over = False
@@ -187,7 +190,10 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
         except AnswerError as err:
             notes.append(f"the answers after one check could not be read ({err})")
             parsed[tag] = None
-    plant = lab_plant(lab, params)
+    namespace = setup_namespace(checks, params)
+    plant = namespace.get("plant")
+    if plant is None:
+        plant = lab_plant(lab, params)
     cache: dict[tuple[str, str], Any] = {}
 
     def rebuild(tag: str, name: str) -> Any:
@@ -213,19 +219,19 @@ def check_answers(request: Mapping[str, Any]) -> dict[str, Any]:
                     )
         return cache[(tag, name)]
 
-    every = sorted({n for check in GRADED[lab] for n in check.names})
+    every = checks.names
     if parsed.get("final") is not None:
         final = {n: rebuild("final", n) for n in every}
     else:
         final = {n: _missing(n, None, errors) for n in every}
     per_check = []
-    for index, check in enumerate(GRADED[lab]):
+    for index, check in enumerate(checks.checks):
         tag = str(index)
         if parsed.get(tag) is not None:
             per_check.append({n: rebuild(tag, n) for n in check.names})
         else:  # its check cell was deleted or never reached: what the notebook ended with
             per_check.append({n: final[n] for n in check.names})
-    results = grade_answers(lab, final, params, plant=plant, per_check=per_check)
+    results = grade_answers(checks, final, params, per_check=per_check, namespace=namespace)
     return {"results": [r.to_dict() for r in results], "notes": notes, "over": over}
 
 
@@ -258,7 +264,7 @@ def main(argv: list[str]) -> int:
     int
     """
     if len(argv) != 3 or argv[0] != "--check":
-        print("usage: python -m uio_teach.instructor.checking --check MEMORY_MB CPU_SECONDS")
+        print("usage: python -m uio_teach.grading.checking --check MEMORY_MB CPU_SECONDS")
         return 2
     _limit(int(argv[1]), int(argv[2]))
     request = json.loads(sys.stdin.buffer.read())
@@ -304,7 +310,7 @@ def check_in_child(
         ``stop`` was set while the checks ran.
     """
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
-    command = [sys.executable, "-m", "uio_teach.instructor.checking", "--check"]
+    command = [sys.executable, "-m", "uio_teach.grading.checking", "--check"]
     command += [str(int(memory_mb)), str(int(timeout) + 5)]
     with tempfile.TemporaryFile() as data:  # the request, read by the child as its stdin
         data.write(json.dumps(request).encode())

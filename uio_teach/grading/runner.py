@@ -10,15 +10,19 @@ the end that writes every answer variable of the lab to ``answers/final.json``
 (used for a check whose cell the group deleted).
 
 :func:`run_notebook` runs that copy in a fresh kernel, in a separate process,
-inside the :class:`~uio_teach.instructor.sandbox.Sandbox` (unless told not to),
+inside the :class:`~uio_teach.grading.sandbox.Sandbox` (unless told not to),
 with a time limit per cell (the cell is interrupted, the next ones run) and
 for the whole notebook (then every process of the run is killed), and a cap
 on all it writes into its folder (the run is stopped beyond). It reads back
 only data: the answer files (regular files, no links, bounded size, kept as
-text for the checking process) and the errors of the executed copy, read as
-plain JSON and matched against the grader's own copy (a copy the notebook
-rewrote gives no cell errors, never a crash). Nothing the notebook prints
-decides anything, and the runner's own output is kept to its last lines.
+text for the checking process) and the runner's log of the cells that raised,
+matched against the grader's own copy (a log the notebook rewrote gives no
+cell errors, never a crash). The notebook is never saved while it runs, so a
+run costs in proportion to its cells; what it prints or displays beyond
+ ``Limits.output_mb`` is cut, and the row says so. Nothing the notebook
+prints decides anything, and the runner's own output is kept to its last
+lines; a failure of the runner itself is the grader's ("grader error"), never
+the notebook's.
 
 :func:`clean_notebook` turns the JSON of a hand-in into a fresh notebook of the
 grader's own: code, markdown and raw cells with their source and their string
@@ -28,9 +32,10 @@ anything else reads it.
 
 Examples
 --------
->>> from uio_teach.instructor.runner import check_function
->>> check_function("checks.pa9_design(H, T, K1, F, K2, poles=PARAMS['poles'])")
-'pa9_design'
+>>> from uio_teach.grading.runner import clean_notebook
+>>> nb, notes = clean_notebook({"nbformat": 4, "cells": [{"cell_type": "code", "source": "x"}]})
+>>> nb.cells[0].source, notes
+('x', [])
 """
 
 from __future__ import annotations
@@ -53,7 +58,7 @@ from typing import Any
 
 import nbformat
 
-from ..checks.grading import GRADED
+from .lab_checks import LabChecks, check_function
 from .sandbox import HOME, Limits, Sandbox, drop_privileges
 
 __all__ = [
@@ -62,7 +67,6 @@ __all__ = [
     "clean_notebook",
     "prepare",
     "run_notebook",
-    "check_function",
     "read_limited",
     "GRADING_TAG",
     "MAX_FILE_BYTES",
@@ -72,11 +76,16 @@ __all__ = [
 GRADING_TAG = "uio-teach-grade"
 """The tag of the cells the grader adds."""
 MAX_FILE_BYTES = 256 * 1024 * 1024
-"""The largest executed notebook read back."""
+"""The largest file of the run read back."""
+OUTPUT_CUT = "output-cut"
+"""The file that says a run's output was cut (written in its folder)."""
+ERRORS = "errors.jsonl"
+"""The runner's log of the cells that raised, one JSON line each, written as each cell ends."""
+RUNNER_FAILED = "runner-failed.json"
+"""What the runner writes when it fails itself (not the notebook): the grader's error."""
 MAX_ANSWER_BYTES = 64 * 1024 * 1024
 """The largest answer file read back (a larger one is a row "over limits")."""
 _TAIL_BYTES = 64 * 1024
-_CALL = re.compile(r"\bchecks\.(\w+)\s*\(")
 _SETUP = """\
 def _uio_export(_uio_tag, _uio_names):
     from uio_teach.checks import answers as _uio_answers
@@ -84,6 +93,21 @@ def _uio_export(_uio_tag, _uio_names):
     _uio_values = {_n: _uio_ns[_n] for _n in _uio_names if _n in _uio_ns}
     with open(f"answers/{_uio_tag}.json", "w", encoding="utf-8") as _uio_fh:
         _uio_fh.write(_uio_answers.dumps(_uio_values))
+import os as _uio_os, sys as _uio_sys
+def _uio_cap(_uio_stream, _uio_left=[%d], _uio_mark=_uio_os.path.abspath("%s")):
+    _uio_write = _uio_stream.write
+    def write(text):
+        if _uio_left[0] <= 0:
+            return len(text)
+        _uio_left[0] -= len(text)
+        if _uio_left[0] < 0:
+            open(_uio_mark, "w").close()
+            return _uio_write(text[: len(text) + _uio_left[0]]) or len(text)
+        return _uio_write(text)
+    _uio_stream.write = write
+_uio_cap(_uio_sys.stdout)
+_uio_cap(_uio_sys.stderr)
+del _uio_cap
 """
 
 
@@ -138,21 +162,6 @@ class RunOutcome:
     notes: list[str] = field(default_factory=list)
 
 
-def check_function(source: str) -> str | None:
-    """The check function a check cell calls (``checks.<name>(...)``), or None.
-
-    Parameters
-    ----------
-    source : str
-
-    Returns
-    -------
-    str or None
-    """
-    match = _CALL.search(source)
-    return match[1] if match else None
-
-
 def _tags(cell: Any) -> list[str]:
     tags = cell.get("metadata", {}).get("tags", []) if isinstance(cell, Mapping) else []
     return [t for t in tags if isinstance(t, str)] if isinstance(tags, list) else []
@@ -193,11 +202,11 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     Raises
     ------
     ValueError
-        ``raw`` is not a notebook of format 4 (one line).
+        ``raw`` is not a notebook of format 4 or 3 (one line naming its format).
 
     Examples
     --------
-    >>> from uio_teach.instructor.runner import clean_notebook
+    >>> from uio_teach.grading.runner import clean_notebook
     >>> raw = {"nbformat": 4, "cells": [
     ...     {"cell_type": "code", "source": "x = 1", "metadata": {"tags": 5}}]}
     >>> nb, notes = clean_notebook(raw)
@@ -206,7 +215,24 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     """
     if not isinstance(raw, dict):
         raise ValueError("not a notebook (not a JSON object)")
-    if raw.get("nbformat") != 4 or not isinstance(raw.get("cells"), list):
+    version = raw.get("nbformat")
+    converted = []
+    if "nbformat" not in raw:
+        raise ValueError("not a notebook (no nbformat field)")
+    if version == 3:
+        raw = _upgrade(raw)
+        converted.append("a notebook of format 3 (nbformat 3), converted to format 4 to run")
+    elif isinstance(version, int) and not isinstance(version, bool) and version < 3:
+        raise ValueError(
+            f"a notebook of format {version} (nbformat {version}), too old to convert: open it "
+            "in Jupyter and save it again (format 4)"
+        )
+    elif version != 4:
+        raise ValueError(
+            f"a notebook of format {_one_line(repr(version), 40)} (nbformat): the grader reads "
+            "formats 4 and 3"
+        )
+    if not isinstance(raw.get("cells"), list):
         raise ValueError("not a notebook of format 4 (no list of cells)")
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {
@@ -214,7 +240,7 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
         "display_name": "Python 3",
         "language": "python",
     }
-    notes: list[str] = []
+    notes: list[str] = converted
 
     def note(text: str) -> None:
         if text not in notes:
@@ -242,28 +268,52 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     return nb, notes
 
 
-def prepare(nb: Any, lab: str, params: Mapping[str, Any] | None) -> tuple[Any, dict[str, int]]:
+def _upgrade(raw: dict[str, Any]) -> Any:
+    """A notebook of format 3 as format 4 (nbformat's converter), or a one-line ValueError."""
+    try:
+        node = nbformat.from_dict(raw)
+        node.setdefault("nbformat_minor", 0)
+        new = nbformat.converter.convert(node, 4)
+        return json.loads(json.dumps(new))
+    except Exception as err:  # the converter raises many kinds on a malformed notebook
+        raise ValueError(
+            f"a notebook of format 3 (nbformat 3) that could not be converted to format 4 "
+            f"({type(err).__name__}): open it in Jupyter and save it again"
+        ) from None
+
+
+def prepare(
+    nb: Any,
+    checks: LabChecks | None,
+    params: Mapping[str, Any] | None,
+    *,
+    output_mb: int = Limits.output_mb,
+) -> tuple[Any, dict[str, int]]:
     """The copy to run: outputs cleared, the key's parameters set, the export cells added.
 
     Parameters
     ----------
     nb : nbformat.NotebookNode
         The hand-in, as :func:`clean_notebook` made it (modified in place and returned).
-    lab : str
-        Its lab (a key of :data:`uio_teach.checks.grading.GRADED`; another
-        lab gets no export cells).
+    checks : LabChecks or None
+        The check cells of its lab (:func:`uio_teach.grading.lab_checks.lab_checks`);
+        None (no lab of the course) adds no export cells.
     params : mapping or None
         The group's parameters from the answer key.
+    output_mb : int
+        The output a run keeps (``Limits.output_mb``): the notebook's streams
+        are cut at half of it in the kernel, so the runner never receives much
+        more than it keeps.
 
     Returns
     -------
     (NotebookNode, dict)
         The copy, and capture tag -> index of its cell.
     """
-    graded = GRADED.get(lab, ())
-    by_function = {c.check_id.replace(".", "_"): i for i, c in enumerate(graded)}
+    graded = checks.checks if checks is not None else ()
+    by_function = {c.function: i for i, c in enumerate(graded)}
     every = sorted({n for c in graded for n in c.names})
-    cells = [_ours(_SETUP)]
+    cells = [_ours(_SETUP % (output_mb * 1024 * 1024 // 2, OUTPUT_CUT))]
     has_params = False
     placed: set[int] = set()
     for cell in nb.cells:
@@ -327,36 +377,42 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _errors(executed: Any, prepared: Any) -> list[CellError] | None:
-    """The student's cells that raised, from the executed copy's JSON (None if it was rewritten).
+def _errors(log: bytes, prepared: Any) -> list[CellError] | None:
+    """The student's cells that raised, from the runner's log (None if it is not the runner's).
 
     The cells' code and tags come from ``prepared`` (the grader's own copy);
-    only the error outputs are read from ``executed``, and only as strings.
+    only the position, the exception's class and its message are read from
+    the log, and only as strings; a position that is not a cell of the
+    student's is not the runner's.
     """
-    cells = executed.get("cells") if isinstance(executed, dict) else None
-    if not isinstance(cells, list) or len(cells) != len(prepared.cells):
-        return None
-    out = []
+    numbers = {}
     number = 0
-    for position, (cell, mine) in enumerate(zip(cells, prepared.cells, strict=True)):
-        if mine.get("cell_type") != "code" or GRADING_TAG in _tags(mine):
-            continue
-        number += 1
-        outputs = cell.get("outputs", []) if isinstance(cell, dict) else []
-        for output in outputs if isinstance(outputs, list) else []:
-            if isinstance(output, dict) and output.get("output_type") == "error":
-                out.append(
-                    CellError(
-                        number,
-                        position,
-                        _one_line(output.get("ename", ""), 60),
-                        _one_line(output.get("evalue", "")),
-                        str(mine.get("source", "")),
-                        "check" in _tags(mine),
-                    )
-                )
-                break
-    return out
+    for position, mine in enumerate(prepared.cells):
+        if mine.get("cell_type") == "code" and GRADING_TAG not in _tags(mine):
+            number += 1
+            numbers[position] = number
+    out: dict[int, CellError] = {}
+    for line in log.decode("utf-8", "replace").splitlines():
+        try:
+            entry = json.loads(line)
+            position = entry["position"]
+        except (ValueError, KeyError, TypeError, RecursionError):
+            return None
+        if not isinstance(position, int) or position not in numbers:
+            return None
+        mine = prepared.cells[position]
+        out.setdefault(
+            position,
+            CellError(
+                numbers[position],
+                position,
+                _one_line(entry.get("ename", ""), 60),
+                _one_line(entry.get("evalue", "")),
+                str(mine.get("source", "")),
+                "check" in _tags(mine),
+            ),
+        )
+    return [out[p] for p in sorted(out)]
 
 
 def _kill_group(pgid: int) -> None:
@@ -482,7 +538,7 @@ def run_notebook(
     stop : threading.Event, optional
         When set (the grader was interrupted), the run is killed at once.
     user : int, optional
-        The user id the sandbox runs as (:func:`~uio_teach.instructor.sandbox.sandbox_user`).
+        The user id the sandbox runs as (:func:`~uio_teach.grading.sandbox.sandbox_user`).
 
     Returns
     -------
@@ -498,14 +554,15 @@ def run_notebook(
     inside = Path(HOME) if sandbox else work
     pid_file = folder / "kernel.pid"
     limit_arg = f"{limits.memory_mb},{limits.processes},{limits.file_mb},{limits.cpu_seconds}"
+    limit_arg += f",{limits.output_mb}"
     limit_arg += f",{user if sandbox and user is not None else ''}"
     command = [
         sys.executable,
         "-m",
-        "uio_teach.instructor.runner",
+        "uio_teach.grading.runner",
         "--run",
         os.fspath(inside / "submission.ipynb"),
-        os.fspath(inside / "executed.ipynb"),
+        os.fspath(inside / ERRORS),
         repr(float(cell_timeout)),
         limit_arg,
         "" if sandbox else os.fspath(pid_file),
@@ -558,17 +615,29 @@ def run_notebook(
         proc.wait()
         tail.join(timeout=5)
     outcome = RunOutcome(status, positions=dict(positions), notes=notes)
-    raw = read_limited(work / "executed.ipynb")
-    errors = None
-    if raw is not None:
-        try:
-            errors = _errors(json.loads(raw.decode("utf-8")), nb)
-        except (ValueError, RecursionError):  # half written or rewritten: no cell errors
-            errors = None
-    if errors is None and raw is not None:
-        notes.append("the executed copy was changed by the notebook: its cell errors are unknown")
+    raw = read_limited(work / ERRORS)
+    errors = _errors(raw, nb) if raw is not None else []
+    if errors is None:
+        notes.append("the runner's log of cell errors was changed by the notebook: not read")
     outcome.errors = errors or []
-    if status == "ok" and proc.returncode != 0:
+    failed = read_limited(work / RUNNER_FAILED, 4096)
+    if failed is not None:  # the runner's own failure: never the notebook's
+        try:
+            why = _one_line(json.loads(failed.decode("utf-8")).get("error", ""), 160)
+        except (ValueError, AttributeError, RecursionError):
+            why = "unknown"
+        status = "grader error"
+        notes.insert(0, f"the grader's notebook runner failed ({why}), not the notebook")
+    cut = read_limited(work / OUTPUT_CUT, 4096)
+    if cut is not None and status in ("ok", "error", "timeout"):
+        if not any(n.startswith("the notebook's output") for n in notes):
+            notes.insert(
+                0,
+                f"the notebook's output (what it printed or displayed) came to more than "
+                f"{limits.output_mb} MB and was cut there; its answers are graded as usual",
+            )
+        status = "over limits"
+    elif status == "ok" and proc.returncode != 0:
         text = tail.text()
         noise = ("[IPKernelApp]", "WARNING", "[W ", "[I ", "To connect another client")
         lines = [x for x in text.splitlines() if x.strip() and not x.lstrip().startswith(noise)]
@@ -607,16 +676,48 @@ def run_notebook(
     return outcome
 
 
-def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str) -> int:
-    """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts)."""
+def _size(msg: Mapping[str, Any]) -> int:
+    """About how many bytes an output message carries (its text and its data)."""
+    content = msg.get("content") or {}
+    size = len(content.get("text") or "")
+    for value in (content.get("data") or {}).values():
+        size += len(value) if isinstance(value, str) else len(json.dumps(value))
+    return size
+
+
+def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str) -> int:
+    """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts).
+
+    Nothing is saved per cell: each cell that raised is appended to ``log``
+    (one JSON line) as it ends, and its outputs are dropped (the grader reads
+    answers from their files, never outputs), so the cost of a run grows with
+    its cells and its memory does not. Output beyond the limit's ``output_mb``
+    is cut (the file :data:`OUTPUT_CUT` says so). A failure of the runner
+    itself is written to :data:`RUNNER_FAILED`, for the grader to report as
+    its own.
+    """
     from nbclient import NotebookClient  # deferred on purpose: only the runner needs it
+    from nbclient.exceptions import DeadKernelError
 
     *numbers, user = limits.split(",")
     drop_privileges(int(user) if user else None)  # before anything else: no root, no capability
-    memory, processes, file_mb, cpu = (int(v) for v in numbers)
+    memory, processes, file_mb, cpu, output_mb = (int(v) for v in numbers)
     Limits(memory, processes, file_mb, cpu).apply()
+    folder = Path(src).parent
     nb = nbformat.read(src, as_version=4)
-    client = NotebookClient(
+
+    class Client(NotebookClient):  # type: ignore[misc]
+        kept = 0
+
+        def output(self, outs: Any, msg: Any, display_id: Any, cell_index: int) -> Any:
+            if msg.get("msg_type") != "error":
+                self.kept += _size(msg)
+                if self.kept > output_mb * 1024 * 1024:
+                    (folder / OUTPUT_CUT).touch()
+                    return None
+            return super().output(outs, msg, display_id, cell_index)
+
+    client = Client(
         nb,
         timeout=cell_timeout,
         kernel_name="python3",
@@ -627,7 +728,7 @@ def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str
             "evalue": f"the cell ran longer than {cell_timeout:g} s and was interrupted",
             "traceback": [],
         },
-        resources={"metadata": {"path": os.path.dirname(os.path.abspath(src))}},
+        resources={"metadata": {"path": os.fspath(folder)}},
     )
 
     def started(**_: Any) -> None:
@@ -635,22 +736,39 @@ def _execute(src: str, dst: str, cell_timeout: float, limits: str, pid_file: str
         if pid and pid_file:
             Path(pid_file).write_text(str(pid))
 
-    def save(**_: Any) -> None:  # a run stopped at the time limit still shows its errors
-        part = dst + ".part"
-        nbformat.write(nb, part)
-        os.replace(part, dst)
+    with open(log, "a", encoding="utf-8") as errors:
 
-    client.on_notebook_start = started
-    client.on_cell_executed = save
-    try:
-        client.execute()
-    finally:
-        save()
+        def executed(cell: Any, cell_index: int, **_: Any) -> None:
+            for out in cell.get("outputs", []):
+                if out.get("output_type") == "error":
+                    entry = {
+                        "position": cell_index,
+                        "ename": str(out.get("ename", ""))[:200],
+                        "evalue": str(out.get("evalue", ""))[:2000],
+                    }
+                    errors.write(json.dumps(entry) + "\n")
+                    errors.flush()
+                    break
+            cell.outputs = []  # read; kept no longer
+
+        client.on_notebook_start = started
+        client.on_cell_executed = executed
+        try:
+            client.execute()
+        except DeadKernelError:
+            raise  # the notebook ended its kernel: the notebook's doing
+        except (Exception, MemoryError) as exc:  # the runner's own failure, never the notebook's
+            why = f"{type(exc).__name__}: {_one_line(exc, 120)}".rstrip(": ")
+            try:
+                (folder / RUNNER_FAILED).write_text(json.dumps({"error": why}))
+            except OSError:
+                pass
+            return 3
     return 0
 
 
 def main(argv: Sequence[str]) -> int:
-    """The runner's command line: ``--run SRC DST CELL_TIMEOUT LIMITS PID_FILE``.
+    """The runner's command line: ``--run SRC LOG CELL_TIMEOUT LIMITS PID_FILE``.
 
     Parameters
     ----------
@@ -662,7 +780,7 @@ def main(argv: Sequence[str]) -> int:
     """
     if len(argv) == 6 and argv[0] == "--run":
         return _execute(argv[1], argv[2], float(argv[3]), argv[4], argv[5])
-    print("usage: python -m uio_teach.instructor.runner --run SRC DST CELL_TIMEOUT LIMITS PID")
+    print("usage: python -m uio_teach.grading.runner --run SRC LOG CELL_TIMEOUT LIMITS PID")
     return 2
 
 

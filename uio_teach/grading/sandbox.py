@@ -5,11 +5,15 @@
 
 * its own mount namespace holding only: the read-only system folders
   (``/usr`` and the ``/bin``, ``/lib`` links, a few files of ``/etc``), the
-  read-only Python installation and virtual environment, the read-only
-  ``uio_teach`` package, and the hand-in's own work folder (writable, as
-  ``/home/student``); a fresh ``/tmp`` in memory with a size cap, ``/dev``
-  and ``/proc``. The mounts are made parents first, so none hides another:
-  an environment or a checkout under ``/tmp`` or ``/home`` is still there;
+  read-only Python installation, virtual environment and site folders, the
+  package's code as a read-only copy of its modules alone
+  (:func:`package_view`: no lab chapter, solution, answer key or notebook of
+  the course, which a wheel carries in ``uio_teach/_course``; the installed
+  package and the book's folder are hidden wherever a mounted folder holds
+  them), and the hand-in's own work folder (writable, as ``/home/student``);
+  a fresh ``/tmp`` in memory with a size cap, ``/dev`` and ``/proc``. The
+  mounts are made parents first, so none hides another: an environment or
+  a checkout under ``/tmp`` or ``/home`` is still there;
 * its own process-id namespace (it sees no process of the grader; when the
   run ends, every process it started ends with it), network namespace (no
   network at all), IPC, UTS and user namespaces, and a new session (no
@@ -24,25 +28,28 @@
   sandbox then holds no capability and no privilege on the host's files.
 
 The total written into the work folder is capped by the runner
-(:mod:`uio_teach.instructor.runner`), which stops a run that exceeds it.
+(:mod:`uio_teach.grading.runner`), which stops a run that exceeds it.
 :func:`sandbox_problem` says why isolation is unavailable (no ``bwrap``, user
 namespaces disabled, or the real interpreter cannot start or import the
 package inside), or ``None``.
 
 Examples
 --------
->>> from uio_teach.instructor.sandbox import Limits
+>>> from uio_teach.grading.sandbox import Limits
 >>> Limits().memory_mb
 4096
 """
 
 from __future__ import annotations
 
+import atexit
 import functools
+import json
 import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,8 +65,11 @@ __all__ = [
     "sandbox_problem",
     "sandbox_user",
     "drop_privileges",
+    "package_view",
+    "hidden_paths",
     "BWRAP",
     "HOME",
+    "TEMP_PREFIX",
     "UID_BASE",
 ]
 
@@ -71,6 +81,11 @@ UID_BASE = 1_700_000_000
 """When the grader runs as root, hand-in ``k`` runs as user id ``UID_BASE + k``: far above any
 login account, one per hand-in, so the limit on processes of one never counts another's."""
 _PACKAGE_ROOT = "/opt/uio-teach"
+TEMP_PREFIX = "uio-teach-grade-"
+"""The name of every temporary folder of a grading run starts so (removed by the next run when
+the run that made it was killed: see ``uio_teach.grading.grade.clean_leftovers``)."""
+OWNER = "owner.json"
+"""The file naming the process that owns a temporary folder (its pid and start time)."""
 _ETC = (
     "/etc/ld.so.cache",
     "/etc/ld.so.conf",
@@ -107,10 +122,13 @@ class Limits:
         Size of the sandbox's ``/tmp`` (in memory).
     disk_mb : int
         All a run may write into its work folder; the run is stopped beyond.
+    output_mb : int
+        All a run may print or display (text, figures, rich output); beyond,
+        the output is cut and the row says so (its answers are graded).
 
     Examples
     --------
-    >>> from uio_teach.instructor.sandbox import Limits
+    >>> from uio_teach.grading.sandbox import Limits
     >>> Limits(memory_mb=2048).memory_mb, Limits().processes
     (2048, 256)
     """
@@ -121,6 +139,7 @@ class Limits:
     cpu_seconds: int = 3600
     tmp_mb: int = 256
     disk_mb: int = 512
+    output_mb: int = 32
 
     def apply(self) -> None:
         """Set the limits on the calling process; everything it starts inherits them.
@@ -146,6 +165,103 @@ class Limits:
                 resource.setrlimit(what, (value, value if what != resource.RLIMIT_CPU else hard))
             except (ValueError, OSError):  # a limit this system does not allow lowering
                 pass
+
+
+def start_time(pid: int) -> str | None:
+    """When the process ``pid`` started (clock ticks since boot), or None if it does not run."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError):
+        return None
+
+
+def own_folder(folder: Path) -> None:
+    """Write :data:`OWNER` into ``folder``: this process owns it while it runs."""
+    owner = {"pid": os.getpid(), "start": start_time(os.getpid())}
+    (folder / OWNER).write_text(json.dumps(owner), encoding="utf-8")
+
+
+@functools.lru_cache(maxsize=1)
+def package_view() -> str:
+    """A read-only copy of the package's modules alone, for the sandbox to import.
+
+    Only the ``*.py`` files of ``uio_teach`` (and their compiled copies) are
+    copied (once per process, into a temporary folder removed at exit): no lab
+    chapter, no book, nothing else an installed package may carry. Readable by
+    every user (a grader running as root runs each hand-in as a user of its own).
+
+    Returns
+    -------
+    str
+        The copy's ``uio_teach`` folder.
+    """
+    package = Path(uio_teach.__file__).resolve().parent
+    root = Path(tempfile.mkdtemp(prefix=f"{TEMP_PREFIX}package-"))
+    own_folder(root)
+    view = root / "uio_teach"
+    tag = sys.implementation.cache_tag or ""
+    for source in sorted(package.rglob("*.py")):
+        relative = source.relative_to(package)
+        if relative.parts[0].startswith("_course") or "__pycache__" in relative.parts:
+            continue
+        target = view / relative
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, target)  # its time kept: the compiled copy below stays valid
+        compiled = source.parent / "__pycache__" / f"{source.stem}.{tag}.pyc"
+        if tag and compiled.is_file():  # imports in the sandbox need not compile every module
+            (target.parent / "__pycache__").mkdir(exist_ok=True)
+            shutil.copy2(compiled, target.parent / "__pycache__" / compiled.name)
+    for path in [root, *root.rglob("*")]:
+        path.chmod(0o755 if path.is_dir() else 0o644)
+    atexit.register(shutil.rmtree, root, True)
+    return os.fspath(view)
+
+
+def hidden_paths() -> list[Path]:
+    """What the sandbox hides wherever a mounted folder holds it: the package as installed
+    (its modules are seen through :func:`package_view` instead) and the book's chapters.
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    package = Path(uio_teach.__file__).resolve().parent
+    hidden = [package]
+    checkout = package.parent
+    if (checkout / "_toc.yml").is_file() or (checkout / "book").is_dir():
+        hidden.append(checkout / "book")  # a checkout: its chapters, solutions included
+    return hidden
+
+
+def _masks(mounted: Sequence[tuple[str, str, str]]) -> list[tuple[str, str, str]]:
+    """Mounts that hide :func:`hidden_paths` inside the read-only folders mounted as they are."""
+    view = package_view()
+    package = Path(uio_teach.__file__).resolve().parent
+    out: list[tuple[str, str, str]] = []
+    for kind, source, dest in mounted:
+        if kind not in ("--ro-bind", "--ro-bind-try") or not source:
+            continue
+        root = Path(source).resolve()
+        for secret in hidden_paths():
+            if secret == root or root not in secret.parents or not secret.exists():
+                continue
+            where = os.fspath(Path(dest) / secret.relative_to(root))
+            if secret == package:
+                out.append(("--ro-bind", view, where))
+            else:
+                out.append(("--tmpfs", "", where))
+    return out
+
+
+def _site_folders() -> list[str]:
+    """The site folders on the grader's ``sys.path`` (a ``.pth`` may add one outside the
+    environment): mounted so the sandbox imports what the grader imports, and nothing else."""
+    found = []
+    for entry in sys.path:
+        path = Path(entry or ".")
+        if path.name in ("site-packages", "dist-packages") and path.is_dir():
+            found.append(os.fspath(path.resolve()))
+    return found
 
 
 def _bwrap() -> str | None:
@@ -180,7 +296,7 @@ def sandbox_user(index: int) -> int | None:
     Examples
     --------
     >>> import os
-    >>> from uio_teach.instructor.sandbox import UID_BASE, sandbox_user
+    >>> from uio_teach.grading.sandbox import UID_BASE, sandbox_user
     >>> sandbox_user(3) == (UID_BASE + 3 if os.geteuid() == 0 else None)
     True
     """
@@ -192,7 +308,7 @@ def sandbox_user(index: int) -> int | None:
 def _probe_command(user: int | None) -> list[str]:
     """The real interpreter, importing the package and the notebook runner, as a hand-in would."""
     code = (
-        "from uio_teach.instructor.sandbox import drop_privileges; "
+        "from uio_teach.grading.sandbox import drop_privileges; "
         f"drop_privileges({user!r}); "
         "import uio_teach, nbclient, ipykernel, numpy; "
         "open('/tmp/probe', 'w').write('x'); open('probe', 'w').write('x'); "
@@ -262,7 +378,7 @@ def sandbox_problem() -> str | None:
 
     Examples
     --------
-    >>> from uio_teach.instructor.sandbox import sandbox_problem
+    >>> from uio_teach.grading.sandbox import sandbox_problem
     >>> sandbox_problem() is None or isinstance(sandbox_problem(), str)
     True
     """
@@ -300,7 +416,7 @@ class Sandbox:
     Examples
     --------
     >>> from pathlib import Path
-    >>> from uio_teach.instructor.sandbox import Sandbox
+    >>> from uio_teach.grading.sandbox import Sandbox
     >>> cmd = Sandbox(Path("/tmp/x")).wrap(["python3", "-c", "pass"])
     >>> "--unshare-net" in cmd and "--unshare-pid" in cmd
     True
@@ -324,11 +440,14 @@ class Sandbox:
                 mounts.append(("--ro-bind", f"/{name}", f"/{name}"))
         for path in _ETC:
             mounts.append(("--ro-bind-try", path, path))
-        for prefix in sorted({sys.base_prefix, sys.prefix, sys.exec_prefix}):
-            if not prefix.startswith("/usr/"):
+        mounted = {"/usr"}
+        for prefix in sorted({sys.base_prefix, sys.prefix, sys.exec_prefix, *_site_folders()}):
+            inside = any(prefix == m or prefix.startswith(m.rstrip("/") + "/") for m in mounted)
+            if not inside:
                 mounts.append(("--ro-bind", prefix, prefix))
-        package = os.fspath(Path(uio_teach.__file__).resolve().parent)
-        mounts.append(("--ro-bind", package, f"{_PACKAGE_ROOT}/uio_teach"))
+                mounted.add(prefix)
+        mounts += _masks(mounts)
+        mounts.append(("--ro-bind", package_view(), f"{_PACKAGE_ROOT}/uio_teach"))
         mounts += [
             ("--proc", "", "/proc"),
             ("--dev", "", "/dev"),

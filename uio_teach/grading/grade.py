@@ -4,30 +4,31 @@
 
 1. reads it without following links (:func:`read_handin`): only a regular
    file of the folder is read, never written; its group comes from the file
-   name (``pa9_g03.ipynb``) or the roster (:func:`read_roster`), and what the
+   name (``pa9_g03.ipynb``) or the roster
+   (:func:`~uio_teach.grading.rosters.read_roster`), and what the
    notebook's metadata says is only compared with it; a clean copy of its
-   cells is made (``uio_teach.instructor.runner.clean_notebook``);
+   cells is made (``uio_teach.grading.runner.clean_notebook``);
 2. compares the class (``_identity_notes``): a notebook that disagrees
    with its name, a group handing in twice, the same code from two groups or
    no group at all is "check by hand", never ``ok``;
 3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
-   data (``uio_teach.instructor.runner``);
+   data (``uio_teach.grading.runner``);
 4. runs the copy in a fresh kernel inside a sandbox
-   (``uio_teach.instructor.sandbox``: only its own copy visible, no
+   (``uio_teach.grading.sandbox``: only its own copy visible, no
    network, no other process, an unprivileged user when the grader is root,
    limits on memory, processes, writes and time); a cell that raises or
    loops is recorded and the next cells still run;
 5. checks the answers in a child process with limits of time and memory
-   (``uio_teach.instructor.checking``): answers over the size caps are not
+   (``uio_teach.grading.checking``): answers over the size caps are not
    rebuilt, the rest are rebuilt as genuine objects and checked with **the
-   answer key's parameters** (``uio_teach.checks.grading``). The verdicts
+   answer key's parameters** (``uio_teach.grading.lab_checks``). The verdicts
    the check cells printed count for nothing, and nothing the notebook
    defines (``PARAMS``, a patched class, a patched module) reaches the
    checks: only right values pass;
 6. appends its row to the gradebook and writes its feedback at once
-   (``uio_teach.instructor.gradebook``), so a killed or interrupted run
+   (``uio_teach.grading.gradebook``), so a killed or interrupted run
    keeps every finished row and ``resume=True`` grades only what is missing.
 
 Whatever fails on one hand-in (reading, preparing, running, reading back,
@@ -39,19 +40,16 @@ killed are removed by the next.
 
 Examples
 --------
->>> from uio_teach.instructor.grade import group_from_name
+>>> from uio_teach.grading.grade import group_from_name
 >>> group_from_name("submissions/pa9_g03.ipynb")
 ('pa9', 'g03')
 """
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import hashlib
 import json
 import os
-import re
 import shutil
 import stat
 import sys
@@ -59,7 +57,7 @@ import tempfile
 import threading
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -67,9 +65,9 @@ from typing import Any
 
 import nbformat
 
-from ..checks.grading import GRADED
-from ..errors import UIOTeachError, UIOTeachWarning
+from ..errors import UIOTeachWarning
 from .checking import check_in_child
+from .copies import fingerprint
 from .gradebook import (
     FAIL,
     PASS,
@@ -79,9 +77,27 @@ from .gradebook import (
     check_gradebook_target,
     feedback_folder,
 )
-from .labs import LABS
+from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks, course_labs
+from .merge import check_shard, shard_of
+from .rosters import (
+    GradeError,
+    file_sha256,
+    group_from_name,
+    group_id,
+    is_late,
+    read_answer_key,
+    read_roster,
+)
 from .runner import RunOutcome, clean_notebook, prepare, run_notebook
-from .sandbox import Limits, sandbox_problem, sandbox_user
+from .sandbox import (
+    OWNER,
+    TEMP_PREFIX,
+    Limits,
+    own_folder,
+    sandbox_problem,
+    sandbox_user,
+    start_time,
+)
 
 __all__ = [
     "GradeError",
@@ -107,15 +123,6 @@ __all__ = [
     "TEMP_PREFIX",
 ]
 
-TEMP_PREFIX = "uio-teach-grade-"
-"""The name of every temporary folder of a grading run starts so."""
-_OWNER = "owner.json"
-_GROUP_NAME = re.compile(r"^(?P<lab>.+?)_(?P<group>g\d+)$")
-
-
-class GradeError(UIOTeachError, ValueError):
-    """Grading cannot start (a missing answer key, an unreadable key, a bad option); one line."""
-
 
 class SandboxRefused(GradeError):
     """Submissions cannot be isolated here, and running them unisolated was not asked for."""
@@ -125,88 +132,7 @@ class UnsandboxedWarning(UIOTeachWarning):
     """The submissions run with the grader's permissions (``sandbox=False``)."""
 
 
-def group_from_name(path: str | os.PathLike[str]) -> tuple[str, str]:
-    """The lab and group of a file named ``<lab>_<group>.ipynb`` (``("", "")`` otherwise).
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file.
-
-    Returns
-    -------
-    (str, str)
-
-    Examples
-    --------
-    >>> from uio_teach.instructor.grade import group_from_name
-    >>> group_from_name("pa9_g12.ipynb"), group_from_name("lab_pa9.ipynb")
-    (('pa9', 'g12'), ('', ''))
-    """
-    match = _GROUP_NAME.match(Path(path).stem)
-    return (match["lab"], match["group"]) if match else ("", "")
-
-
-def read_answer_key(path: str | os.PathLike[str]) -> dict[tuple[str, str], dict[str, Any]]:
-    """The parameters of every (lab, group) in an answer key written by ``uio-teach labs``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The CSV, with at least the columns ``lab``, ``group`` and ``params``
-        (the JSON of the group's ``PARAMS``).
-
-    Returns
-    -------
-    dict
-        ``(lab, group) -> params``.
-
-    Raises
-    ------
-    GradeError
-        The file is missing, lacks a column, or a ``params`` cell is not JSON.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import read_answer_key
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     key = pathlib.Path(tmp) / "answer_key.csv"
-    ...     _ = key.write_text('lab,group,params\\npa9,g01,"{""poles"": [-1, -2, -3]}"\\n')
-    ...     read_answer_key(key)
-    {('pa9', 'g01'): {'poles': [-1, -2, -3]}}
-    """
-    name = os.fspath(path)
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.DictReader(fh))
-    except FileNotFoundError:
-        raise GradeError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise GradeError(f"{name}: cannot read it ({err})") from None
-    key: dict[tuple[str, str], dict[str, Any]] = {}
-    for number, row in enumerate(rows, start=2):
-        missing = [c for c in ("lab", "group", "params") if c not in row or row[c] is None]
-        if missing:
-            raise GradeError(f"{name}: line {number}: no column {', '.join(missing)}")
-        try:
-            params = json.loads(row["params"])
-        except ValueError:
-            raise GradeError(f"{name}: line {number}: params is not JSON") from None
-        if not isinstance(params, dict):
-            raise GradeError(f"{name}: line {number}: params is not a JSON object")
-        key[(row["lab"], row["group"])] = params
-    return key
-
-
 # temporary folders --------------------------------------------------------------------------
-
-
-def _start_time(pid: int) -> str | None:
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19]
-    except (OSError, IndexError):
-        return None
 
 
 def _remove(folder: Path) -> None:
@@ -241,7 +167,7 @@ def clean_leftovers(root: str | os.PathLike[str] | None = None) -> list[Path]:
     Examples
     --------
     >>> import tempfile
-    >>> from uio_teach.instructor.grade import clean_leftovers
+    >>> from uio_teach.grading.grade import clean_leftovers
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     clean_leftovers(tmp)
     []
@@ -253,11 +179,11 @@ def clean_leftovers(root: str | os.PathLike[str] | None = None) -> list[Path]:
             info = folder.lstat()
             if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
                 continue
-            owner = json.loads((folder / _OWNER).read_text(encoding="utf-8"))
+            owner = json.loads((folder / OWNER).read_text(encoding="utf-8"))
             pid, started = int(owner["pid"]), str(owner["start"])
         except (OSError, ValueError, KeyError, TypeError):
             continue
-        if _start_time(pid) != started:
+        if start_time(pid) != started:
             _remove(folder)
             removed.append(folder)
     return removed
@@ -284,7 +210,7 @@ class Handin:
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import Handin
+    >>> from uio_teach.grading.grade import Handin
     >>> Handin("pa9_g01.ipynb", "pa9", "g01").status
     ''
 
@@ -295,7 +221,7 @@ class Handin:
     lab, group : str
         From the roster, else from the file name (never from the notebook).
     notebook : NotebookNode or None
-        The grader's clean copy (``uio_teach.instructor.runner.clean_notebook``).
+        The grader's clean copy (``uio_teach.grading.runner.clean_notebook``).
     status, reason : str
         ``"refused"`` or ``"unreadable"`` and why (empty when it can run).
     notes : list of str
@@ -379,7 +305,7 @@ def _meta(raw: Any) -> tuple[str, str, str]:
         value = meta.get(key)
         return _one_line(value, 40) if isinstance(value, str) else ""
 
-    return text("lab"), text("group"), text("source")
+    return text("lab"), group_id(text("group")), text("source")
 
 
 def _one_line(text: Any, limit: int = 200) -> str:
@@ -387,23 +313,25 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _fingerprint(nb: Any) -> str:
-    """The code of a notebook, whitespace and its parameters cell left out, hashed."""
-    parts = []
+def _fingerprint(nb: Any, keep: Iterable[str]) -> str:
+    """The code of a notebook, normalised (:mod:`uio_teach.grading.copies`), hashed.
+
+    The cells every group has alike are left out: ``parameters``, ``check``.
+    """
+    sources = []
     for cell in nb.cells:
         tags = cell.get("metadata", {}).get("tags", [])
-        if cell.get("cell_type") != "code" or "parameters" in tags:
+        if cell.get("cell_type") != "code" or {"parameters", CHECK_TAG} & set(tags):
             continue
-        code = "\n".join(line.rstrip() for line in cell.source.splitlines() if line.strip())
-        if code:
-            parts.append(code)
-    if not parts:
-        return ""
-    return hashlib.sha256("\n\x00".join(parts).encode()).hexdigest()
+        sources.append(cell.source)
+    return fingerprint(sources, keep=keep)
 
 
 def read_handin(
-    path: str | os.PathLike[str], roster: Mapping[str, tuple[str, str]] | None = None
+    path: str | os.PathLike[str],
+    roster: Mapping[str, tuple[str, str]] | None = None,
+    *,
+    keep: Iterable[str] = (),
 ) -> Handin:
     """Read one hand-in: refuse what is not a regular file, parse it, find its lab and group.
 
@@ -417,7 +345,10 @@ def read_handin(
     ----------
     path : str or path-like
     roster : mapping, optional
-        File name -> (lab, group), from :func:`read_roster`.
+        File name -> (lab, group), from :func:`~uio_teach.grading.rosters.read_roster`.
+    keep : iterable of str
+        The answer variables of the labs: names a copy cannot change
+        (see ``uio_teach.grading.copies``).
 
     Returns
     -------
@@ -426,7 +357,7 @@ def read_handin(
     Examples
     --------
     >>> import tempfile, pathlib, os
-    >>> from uio_teach.instructor.grade import read_handin
+    >>> from uio_teach.grading.grade import read_handin
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     link = pathlib.Path(tmp) / "pa9_g01.ipynb"
     ...     os.symlink("/etc/passwd", link)
@@ -439,6 +370,8 @@ def read_handin(
     lab, group = (roster or {}).get(Path(file).name, (name_lab, name_group))
     lab = lab or name_lab
     handin = Handin(file, lab, group)
+    if is_late(file):
+        handin.notes.append("the LMS marked this hand-in late (_LATE_ in its name)")
     data, why = _read_bytes(Path(file))
     if data is None:
         handin.status, handin.reason = "refused", why
@@ -446,10 +379,13 @@ def read_handin(
     raw, why = _parse(data)
     if raw is not None:
         try:
-            handin.notebook, handin.notes = clean_notebook(raw)
+            handin.notebook, notes = clean_notebook(raw)
+            handin.notes += notes
         except ValueError as err:
-            why = f"not a notebook: {err}".replace(
-                "not a notebook: not a notebook", "not a notebook"
+            why = (
+                str(err)
+                if str(err).startswith(("not a notebook", "a notebook"))
+                else (f"not a notebook: {err}")
             )
     if handin.notebook is None:
         handin.status, handin.reason = "unreadable", why
@@ -457,10 +393,8 @@ def read_handin(
     handin.meta_lab, handin.meta_group, source = _meta(raw)
     if not handin.lab:
         stem = Path(source).stem if source else Path(file).stem
-        handin.lab = handin.meta_lab or next(
-            (k for k, v in LABS.items() if Path(v.source).stem == stem), ""
-        )
-    handin.code = _fingerprint(handin.notebook)
+        handin.lab = handin.meta_lab or next((k for k in course_labs() if f"lab_{k}" == stem), "")
+    handin.code = _fingerprint(handin.notebook, keep)
     return handin
 
 
@@ -499,14 +433,13 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
             continue
         for h in same:
             others = ", ".join(
-                f"{o.file} ({o.group or 'no group'})" for o in same if o.group != h.group
+                f"group {o.group or '(none)'} ({o.file})" for o in same if o.group != h.group
             )
-            notes[h.file].append(f"the same code as another group's hand-in: {others}")
+            notes[h.file].append(
+                f"the same code as {others}, once comments, blank lines, formatting and the "
+                "names of variables are set aside"
+            )
     return notes
-
-
-def _defaults(lab: str) -> dict[str, Any]:
-    return LABS[lab].params().to_params()
 
 
 def _error_notes(outcome: RunOutcome) -> list[str]:
@@ -526,6 +459,7 @@ class _Run:
     """The settings every hand-in of one grading run shares."""
 
     key: Mapping[tuple[str, str], dict[str, Any]] | None
+    checks: Mapping[str, LabChecks]
     root: Path
     sandbox: bool
     timeout: float
@@ -538,8 +472,8 @@ class _Run:
 def _grade_one(handin: Handin, identity: list[str], index: int, run: _Run) -> Submission:
     start = time.perf_counter()
     sub = Submission(handin.file, handin.lab, handin.group, "ok")
-    if handin.lab in GRADED:
-        sub.expected = tuple(c.check_id for c in GRADED[handin.lab])
+    if handin.lab in run.checks:
+        sub.expected = run.checks[handin.lab].check_ids
     try:
         _run_one(sub, handin, identity, index, run)
     except InterruptedError:
@@ -563,9 +497,10 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         return
     sub.errors += handin.notes
     sub.errors += identity
-    if lab not in GRADED:
+    if lab not in run.checks:
         sub.status = "unknown lab"
-        sub.reason = f"lab {lab!r} is not one of the course's labs ({', '.join(GRADED)}): not run"
+        labs = ", ".join(run.checks)
+        sub.reason = f"lab {lab!r} is not one of the course's labs ({labs}): not run"
         sub.errors.append(sub.reason)
         return
     params = None if key is None else key.get((lab, group))
@@ -575,10 +510,13 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         sub.reason = f"{why}; not run: name the file <lab>_<group>.ipynb or list it in --roster"
         sub.errors.append(sub.reason)
         return
+    checks = run.checks[lab]
     if params is None:
-        params = _defaults(lab)
+        params = checks.default_params()
     sub.params = params
-    copy, positions = prepare(handin.notebook, lab, params if key is not None else None)
+    copy, positions = prepare(
+        handin.notebook, checks, params if key is not None else None, output_mb=limits.output_mb
+    )
     folder = run.root / f"{index:04d}"
     try:
         outcome = run_notebook(
@@ -599,7 +537,7 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
     sub.status = outcome.status
     sub.errors += _error_notes(outcome)
     request = {
-        "lab": lab,
+        "checks": checks.to_dict(),
         "params": params,
         "positions": outcome.positions,
         "errors": [
@@ -632,6 +570,8 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         sub.status, sub.reason = "check by hand", identity[0]
     elif not group:
         sub.status, sub.reason = "check by hand", "no group: graded with the course's own numbers"
+    if sub.status == "grader error" and not identity:
+        sub.reason = next((n for n in outcome.notes if "runner failed" in n), "the grader failed")
     if sub.status in ("error", "timeout") and not sub.reason:
         sub.reason = (sub.errors or [sub.status])[0]
 
@@ -667,7 +607,7 @@ def write_gradebook(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import Submission, write_gradebook
+    >>> from uio_teach.grading.grade import Submission, write_gradebook
     >>> s = Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",))
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
@@ -690,72 +630,14 @@ def _positive(name: str, value: Any) -> None:
         raise GradeError(f"{name}: must be > 0 s, got {value!r}")
 
 
-def read_roster(
-    path: str | os.PathLike[str],
-) -> tuple[dict[str, tuple[str, str]], dict[str, list[tuple[str, str]]]]:
-    """The groups of a roster CSV: which hand-in is whose, and who is in each group.
-
-    The CSV has a column ``group`` and at least one of ``file`` (the name of a
-    hand-in, e.g. ``notebook (3).ipynb``) and ``student`` (a student's id in
-    the LMS, e.g. its SIS user id); ``lab`` and ``name`` are optional. A row
-    with a file says that file is the group's hand-in; a row with a student
-    puts the student in the group (for the Canvas export).
-
-    Parameters
-    ----------
-    path : str or path-like
-
-    Returns
-    -------
-    (dict, dict)
-        File name -> (lab, group), and group -> list of (student, name).
-
-    Raises
-    ------
-    GradeError
-        The file is missing or unreadable, lacks the columns, or names a file twice.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.grade import read_roster
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     roster = pathlib.Path(tmp) / "groups.csv"
-    ...     _ = roster.write_text("file,lab,group,student,name\\nx.ipynb,pa9,g01,s1,Ann\\n")
-    ...     read_roster(roster)
-    ({'x.ipynb': ('pa9', 'g01')}, {'g01': [('s1', 'Ann')]})
-    """
-    name = os.fspath(path)
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.DictReader(fh))
-    except FileNotFoundError:
-        raise GradeError(f"{name}: no such file") from None
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
-        raise GradeError(f"{name}: cannot read it ({err})") from None
-    files: dict[str, tuple[str, str]] = {}
-    students: dict[str, list[tuple[str, str]]] = {}
-    for number, row in enumerate(rows, start=2):
-        group = (row.get("group") or "").strip()
-        file = (row.get("file") or "").strip()
-        student = (row.get("student") or "").strip()
-        if not group or not (file or student):
-            raise GradeError(f"{name}: line {number}: needs a group and a file or a student")
-        if file:
-            entry = ((row.get("lab") or "").strip(), group)
-            if files.get(file, entry) != entry:
-                raise GradeError(f"{name}: line {number}: {file} is listed for two groups")
-            files[file] = entry
-        if student:
-            students.setdefault(group, []).append((student, (row.get("name") or "").strip()))
-    return files, students
-
-
 _SELF_TEST: dict[tuple[Any, ...], str | None] = {}
 
 
-def _self_test(limits: Limits) -> str | None:
-    """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None."""
+def _self_test(limits: Limits, stop: threading.Event | None = None) -> str | None:
+    """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None.
+
+    ``stop`` (the run was interrupted) ends it at once; that answer is not kept.
+    """
     key = (sys.executable, dataclasses.replace(limits, cpu_seconds=0))  # CPU time aside
     if key in _SELF_TEST:
         return _SELF_TEST[key]
@@ -768,7 +650,7 @@ def _self_test(limits: Limits) -> str | None:
             "language": "python",
         }
         nb.cells.append(nbformat.v4.new_code_cell("import uio_teach\nx = 1 + 1"))
-        copy, positions = prepare(nb, "", None)
+        copy, positions = prepare(nb, None, None)
         root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
         try:
             outcome = run_notebook(
@@ -780,9 +662,12 @@ def _self_test(limits: Limits) -> str | None:
                 cell_timeout=120,
                 limits=limits,
                 user=sandbox_user(0),
+                stop=stop,
             )
         finally:
             _remove(root)
+        if outcome.status == "interrupted":
+            return "the run was interrupted"
         if outcome.status != "ok" or "final" not in outcome.captures:
             why = "; ".join(_error_notes(outcome)) or outcome.status
             problem = f"a one-cell notebook does not run in the sandbox ({_one_line(why, 300)})"
@@ -804,6 +689,7 @@ def grade(
     jobs: int = 1,
     sandbox: bool = True,
     limits: Limits | None = None,
+    shard: tuple[int, int] | None = None,
 ) -> list[Submission]:
     """Grade hand-ins; write the gradebook ``out`` (CSV), its exports and the feedback.
 
@@ -829,7 +715,7 @@ def grade(
         graded with its group's parameters (and runs with them). Without it,
         with the course's own numbers.
     roster : path, optional
-        A CSV naming each hand-in's group (see :func:`read_roster`).
+        A CSV naming each hand-in's group (see :func:`~uio_teach.grading.rosters.read_roster`).
     timeout : float
         Seconds a notebook may run in all; then every process of its run is
         killed and it is graded on what it computed ("timeout").
@@ -849,6 +735,12 @@ def grade(
         ``UnsandboxedWarning``.
     limits : Limits, optional
         Memory, processes, file size, CPU time and writes of a run.
+    shard : (int, int), optional
+        ``(K, N)``: grade only shard K of N of the hand-ins (each hand-in is in
+        exactly one shard, by its file name, whatever order they are listed
+        in; see :func:`~uio_teach.grading.merge.shard_of`). Every hand-in is
+        still read, so copies and groups handing in twice are caught across
+        shards; ``uio-teach merge`` puts the shards' gradebooks together.
 
     Returns
     -------
@@ -870,7 +762,7 @@ def grade(
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import grade, GradeError
+    >>> from uio_teach.grading.grade import grade, GradeError
     >>> try:
     ...     grade([], "grades.csv", timeout=0)
     ... except GradeError as err:
@@ -883,17 +775,20 @@ def grade(
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise GradeError(f"jobs: must be a whole number >= 1, got {jobs!r}")
     key = read_answer_key(answer_key) if answer_key is not None else None
+    try:
+        checks = course_checks()
+    except LabChecksError as err:
+        raise GradeError(f"cannot read the labs' check cells: {err}") from None
     files_roster, students = read_roster(roster) if roster is not None else ({}, {})
+    sources = {
+        "answer_key_sha256": file_sha256(answer_key) if answer_key is not None else None,
+        "roster_sha256": file_sha256(roster) if roster is not None else None,
+    }
+    if shard is not None:
+        shard = check_shard(shard)
     check_gradebook_target(out)  # before the notebooks run, not after
     limits = limits or Limits(cpu_seconds=int(timeout) + 60)
-    if sandbox:
-        problem = _self_test(limits)
-        if problem is not None:
-            raise SandboxRefused(
-                f"cannot isolate the hand-ins: {problem}. Grading runs the students' code; "
-                "--no-sandbox runs it with your permissions (only for notebooks you trust)"
-            )
-    else:
+    if not sandbox:
         warnings.warn(
             "the submissions run WITHOUT a sandbox, with your permissions: a notebook can read "
             "the answer key and your files, change the gradebook, and end your processes",
@@ -902,10 +797,11 @@ def grade(
         )
     clean_leftovers()
     files = handin_files(submissions)
+    keep = {n for c in checks.values() for n in c.names}
     handins = []
-    for file in files:
+    for file in files:  # every hand-in of the class, also in a shard: copies across shards
         try:
-            handins.append(read_handin(file, files_roster))
+            handins.append(read_handin(file, files_roster, keep=keep))
         except Exception as exc:  # never stops the run: the row says so
             handins.append(
                 Handin(file, status="grader error", reason=f"cannot be read ({type(exc).__name__})")
@@ -913,47 +809,115 @@ def grade(
     identity = _identity_notes(handins)
     columns: list[str] = []
     for h in handins:
-        columns += [c.check_id for c in GRADED.get(h.lab, ()) if c.check_id not in columns]
+        ids = checks[h.lab].check_ids if h.lab in checks else ()
+        columns += [c for c in ids if c not in columns]
     graded: list[Submission] = []
-    with Gradebook(out, files, columns, resume=resume, students=students) as book:
-        todo = [(i, h) for i, h in enumerate(handins) if not book.has(h.file)]
+    book = Gradebook(
+        out, files, columns, resume=resume, students=students, shard=shard, sources=sources
+    )
+    book.lock()  # another run into this gradebook is refused before any notebook runs
+    try:
+        kept = book.prior()
+        todo = [
+            (i, h)
+            for i, h in enumerate(handins)
+            if h.file not in kept and (shard is None or shard_of(h.file, shard[1]) == shard[0])
+        ]
         seen: set[str] = set()
         todo = [(i, h) for i, h in todo if not (h.file in seen or seen.add(h.file))]
-        root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
-        stop = threading.Event()
-        pool = ThreadPoolExecutor(max_workers=jobs)
-        try:
-            (root / _OWNER).write_text(
-                json.dumps({"pid": os.getpid(), "start": _start_time(os.getpid())}),
-                encoding="utf-8",
-            )
-            run = _Run(
-                key, root, sandbox, timeout, min(cell_timeout, timeout), check_timeout, limits, stop
-            )
-            running: dict[Future[Submission], Handin] = {}
-            queue = list(todo)
-            while queue or running:
-                while queue and len(running) < jobs:
-                    index, handin = queue.pop(0)
-                    future = pool.submit(
-                        _grade_one, handin, identity.get(handin.file, []), index, run
-                    )
-                    running[future] = handin
-                finished, _ = wait(running, timeout=0.5, return_when=FIRST_COMPLETED)
-                for future in finished:
+        _grade_all(
+            book,
+            todo,
+            identity,
+            graded,
+            progress,
+            jobs,
+            sandbox,
+            limits,
+            _Run(
+                key,
+                checks,
+                Path(),
+                sandbox,
+                timeout,
+                min(cell_timeout, timeout),
+                check_timeout,
+                limits,
+                threading.Event(),
+            ),
+        )
+    except BaseException:
+        book.__exit__(*sys.exc_info())
+        raise
+    book.__exit__(None, None, None)
+    order = {f: i for i, f in enumerate(files)}
+    graded.sort(key=lambda s: order[s.file])
+    return graded
+
+
+def _grade_all(
+    book: Gradebook,
+    todo: Sequence[tuple[int, Handin]],
+    identity: Mapping[str, list[str]],
+    graded: list[Submission],
+    progress: Callable[[int, int, Submission], None] | None,
+    jobs: int,
+    sandbox: bool,
+    limits: Limits,
+    settings: _Run,
+) -> None:
+    """Grade ``todo``, ``jobs`` at a time, while the sandbox is tested beside them.
+
+    The first hand-ins start at once; the one-cell test of the sandbox runs
+    beside them, and no row is written before it has passed (the gradebook is
+    opened only then: a sandbox that fails leaves an earlier gradebook as it
+    was, and every run is stopped).
+    """
+    root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
+    stop = settings.stop
+    run = dataclasses.replace(settings, root=root)
+    pool = ThreadPoolExecutor(max_workers=jobs)
+    tester = ThreadPoolExecutor(max_workers=1)
+    test = tester.submit(_self_test, limits, stop) if sandbox else None
+    opened = False
+    held: list[Submission] = []
+    try:
+        own_folder(root)
+        running: dict[Future[Submission], Handin] = {}
+        queue = list(todo)
+        while queue or running or not opened:
+            while queue and len(running) < jobs:
+                index, handin = queue.pop(0)
+                future = pool.submit(_grade_one, handin, identity.get(handin.file, []), index, run)
+                running[future] = handin
+            waiting: list[Future[Any]] = [*running] + ([test] if test and not opened else [])
+            finished, _ = wait(waiting, timeout=0.5, return_when=FIRST_COMPLETED)
+            for future in finished:
+                if future in running:
                     running.pop(future)
-                    sub = future.result()
+                    held.append(future.result())
+            if not opened and (test is None or test.done()):
+                problem = test.result() if test is not None else None
+                if problem is not None:
+                    raise SandboxRefused(
+                        f"cannot isolate the hand-ins: {problem}. Grading runs the students' "
+                        "code; --no-sandbox runs it with your permissions (only for notebooks "
+                        "you trust)"
+                    )
+                book.open()
+                opened = True
+            if opened:
+                for sub in held:
                     book.add(sub)
                     graded.append(sub)
                     if progress is not None:
                         progress(len(graded), len(todo), sub)
-        finally:  # interrupted: stop every run still going at once, keep the finished rows
-            stop.set()
-            pool.shutdown(wait=True, cancel_futures=True)
-            _remove(root)
-    order = {f: i for i, f in enumerate(files)}
-    graded.sort(key=lambda s: order[s.file])
-    return graded
+                held.clear()
+    finally:  # interrupted: stop every run still going at once, keep the finished rows
+        stop.set()
+        pool.shutdown(wait=True, cancel_futures=True)
+        tester.shutdown(wait=False, cancel_futures=True)
+        _remove(root)
 
 
 def handin_files(
@@ -971,7 +935,7 @@ def handin_files(
 
     Examples
     --------
-    >>> from uio_teach.instructor.grade import handin_files
+    >>> from uio_teach.grading.grade import handin_files
     >>> handin_files(["b.ipynb", "a.ipynb"])
     ['b.ipynb', 'a.ipynb']
     """

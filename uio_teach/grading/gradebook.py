@@ -20,7 +20,7 @@ alone and the run refused before any notebook runs.
 
 Examples
 --------
->>> from uio_teach.instructor.gradebook import Submission
+>>> from uio_teach.grading.gradebook import Submission
 >>> s = Submission("a.ipynb", "pa9", "g01", "ok",
 ...                results={"pa9.design": {"passed": True, "items": []}},
 ...                expected=("pa9.design", "pa9.plot"))
@@ -31,17 +31,18 @@ Examples
 from __future__ import annotations
 
 import csv
+import hashlib
 import html
 import io
 import json
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .output import (
+from ..instructor.output import (
     MANIFEST,
     FolderBusy,
     FolderLock,
@@ -61,6 +62,14 @@ __all__ = [
     "feedback_names",
     "export_path",
     "safe_cell",
+    "shown",
+    "exports",
+    "read_gradebook",
+    "header_of",
+    "write_table",
+    "write_exports",
+    "needs_a_look",
+    "MAX_NAME_BYTES",
     "PASS",
     "FAIL",
     "COMMAND",
@@ -116,7 +125,7 @@ class Submission:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import Submission
+    >>> from uio_teach.grading.gradebook import Submission
     >>> s = Submission("pa9_g01.ipynb", "pa9", "g01", "unreadable",
     ...                errors=["not a notebook"], expected=("pa9.design",))
     >>> s.row(["pa9.design"])
@@ -148,12 +157,12 @@ class Submission:
     @property
     def needs_a_look(self) -> bool:
         """Whether an instructor should look at this row before its marks count."""
-        return self.status not in _GOOD
+        return needs_a_look(self.status)
 
     def feedback(self) -> str:
         """The feedback text for the group: every check's messages, then the grader's notes."""
         lines = [
-            f"Submission: {self.file}",
+            f"Submission: {shown(self.file)}",
             f"Lab: {self.lab or 'unknown'}    Group: {self.group or 'unknown'}",
             f"Status: {self.status}" + (f" ({self.reason})" if self.reason else ""),
         ]
@@ -174,7 +183,7 @@ class Submission:
         if self.errors:
             lines += ["", "Problems while running the notebook:"]
             lines += [f"  - {e}" for e in self.errors]
-        return "\n".join(lines) + "\n"
+        return shown("\n".join(lines) + "\n")
 
     def feedback_html(self) -> str:
         """The feedback as a small HTML page (every text escaped)."""
@@ -183,11 +192,11 @@ class Submission:
         parts = [
             "<!DOCTYPE html>",
             '<html lang="en"><head><meta charset="utf-8">',
-            f"<title>Feedback: {e(Path(self.file).name)}</title>",
+            f"<title>Feedback: {e(shown(Path(self.file).name))}</title>",
             "<style>body{font-family:sans-serif;max-width:50em;margin:2em auto}"
             ".ok{color:#06602a}.no{color:#a3001b}li{margin:.2em 0}</style></head><body>",
             f"<h1>Lab {e(self.lab or 'unknown')}, group {e(self.group or 'unknown')}</h1>",
-            f"<p>Hand-in: <code>{e(self.file)}</code><br>Status: <strong>{e(self.status)}"
+            f"<p>Hand-in: <code>{e(shown(self.file))}</code><br>Status: <strong>{e(self.status)}"
             f"</strong>{e(' (' + self.reason + ')') if self.reason else ''}<br>"
             f"Checks passed: {self.total} of {len(verdicts)}</p>",
         ]
@@ -211,7 +220,7 @@ class Submission:
             parts += [f"<li>{e(str(x))}</li>" for x in self.errors]
             parts.append("</ul>")
         parts.append("</body></html>")
-        return "\n".join(parts) + "\n"
+        return shown("\n".join(parts) + "\n")
 
     def row(self, columns: Sequence[str]) -> list[Any]:
         """The CSV row under the check columns ``columns`` (empty for a check of another lab)."""
@@ -219,6 +228,36 @@ class Submission:
         marks = ["" if c not in verdicts else (PASS if verdicts[c] else FAIL) for c in columns]
         first = [self.file, self.lab, self.group, self.status, self.reason]
         return [*first, *marks, self.total, len(verdicts)]
+
+
+def shown(text: Any) -> str:
+    """A name as text that any file can hold: bytes that are not UTF-8 as ``\\xe9``.
+
+    A Linux file name is bytes, in any encoding; Python keeps those that are
+    not UTF-8 as lone surrogates, which no UTF-8 file can hold. They are
+    shown as backslash escapes, so the name stays readable and distinct.
+
+    Parameters
+    ----------
+    text : object
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> import os
+    >>> from uio_teach.grading.gradebook import shown
+    >>> print(shown(os.fsdecode(b"Jos\\xe9_pa9_g01.ipynb")))
+    Jos\\xe9_pa9_g01.ipynb
+    """
+    text = str(text)
+    try:
+        raw = text.encode("utf-8", "surrogateescape")
+    except UnicodeEncodeError:
+        raw = text.encode("utf-8", "surrogatepass")
+    return raw.decode("utf-8", "backslashreplace")
 
 
 def safe_cell(value: Any) -> str:
@@ -237,11 +276,11 @@ def safe_cell(value: Any) -> str:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import safe_cell
+    >>> from uio_teach.grading.gradebook import safe_cell
     >>> print(safe_cell('=HYPERLINK("http://x")'), safe_cell("-3"), safe_cell("a\\nb"))
     '=HYPERLINK("http://x") -3 a b
     """
-    text = _CONTROL.sub(" ", str(value)).strip()
+    text = _CONTROL.sub(" ", shown(value)).strip()
     if text[:1] in ("=", "+", "-", "@") and not _NUMBER.match(text):
         text = "'" + text
     return text
@@ -260,7 +299,7 @@ def feedback_folder(out: str | os.PathLike[str]) -> Path:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import feedback_folder
+    >>> from uio_teach.grading.gradebook import feedback_folder
     >>> feedback_folder("marks/grades.csv").as_posix()
     'marks/grades_feedback'
     """
@@ -285,7 +324,7 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.gradebook import check_gradebook_target
+    >>> from uio_teach.grading.gradebook import check_gradebook_target
     >>> from uio_teach.instructor.output import OutputError
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     mine = pathlib.Path(tmp) / "grades_feedback"
@@ -311,8 +350,30 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
         )
 
 
+MAX_NAME_BYTES = 200
+"""The longest stem of a feedback file, in bytes: with its suffix and the temporary name it is
+written under (``.<name>.html.part``), within the 255 bytes a file name may have."""
+
+
+def _short(stem: str, whole: str) -> str:
+    """``stem`` cut to :data:`MAX_NAME_BYTES` bytes (whole characters), then a hash of ``whole``."""
+    raw = stem.encode("utf-8", "surrogateescape")
+    if len(raw) <= MAX_NAME_BYTES:
+        return stem
+    digest = hashlib.sha256(whole.encode("utf-8", "surrogateescape")).hexdigest()[:10]
+    cut = raw[: MAX_NAME_BYTES - 11]
+    while cut and (cut[-1] & 0xC0) == 0x80:  # never half a UTF-8 character
+        cut = cut[:-1]
+    if cut and cut[-1] >= 0xC0:
+        cut = cut[:-1]
+    return f"{cut.decode('utf-8', 'surrogateescape')}-{digest}"
+
+
 def feedback_names(files: Sequence[str]) -> dict[str, str]:
     """Submission -> the name of its feedback text (its stem; its folder too on a clash).
+
+    A stem longer than :data:`MAX_NAME_BYTES` bytes is cut and ends in a hash
+    of the whole name, so every name of any legal length has its own text.
 
     Parameters
     ----------
@@ -324,9 +385,11 @@ def feedback_names(files: Sequence[str]) -> dict[str, str]:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import feedback_names
+    >>> from uio_teach.grading.gradebook import feedback_names
     >>> feedback_names(["a/x.ipynb", "b/x.ipynb"])
     {'a/x.ipynb': 'x.txt', 'b/x.ipynb': 'b_x.txt'}
+    >>> len(feedback_names(["é" * 120 + ".ipynb"])["é" * 120 + ".ipynb"].encode())
+    203
     """
     names: dict[str, str] = {}
     for file in files:
@@ -334,8 +397,16 @@ def feedback_names(files: Sequence[str]) -> dict[str, str]:
         candidates = [path.stem, f"{path.parent.name}_{path.stem}"]
         candidates += [f"{path.stem}-{n}" for n in range(2, len(files) + 2)]
         taken = set(names.values())
-        names[file] = next(f"{c}.txt" for c in candidates if f"{c}.txt" not in taken)
+        names[file] = next(
+            f"{_short(c, file)}.txt" for c in candidates if f"{_short(c, file)}.txt" not in taken
+        )
     return names
+
+
+def _feedback_names(files: Sequence[str]) -> dict[str, str]:
+    """:func:`feedback_names` of the names as shown (a name that is not UTF-8 escaped)."""
+    by_shown = feedback_names(list(dict.fromkeys(shown(f) for f in files)))
+    return {f: by_shown[shown(f)] for f in files}
 
 
 def export_path(out: str | os.PathLike[str], kind: str) -> Path:
@@ -352,12 +423,29 @@ def export_path(out: str | os.PathLike[str], kind: str) -> Path:
 
     Examples
     --------
-    >>> from uio_teach.instructor.gradebook import export_path
+    >>> from uio_teach.grading.gradebook import export_path
     >>> export_path("marks/grades.csv", "canvas").as_posix()
     'marks/grades_canvas.csv'
     """
     out = Path(out)
     return out.with_name(f"{out.stem}_{kind}.csv")
+
+
+def header_of(columns: Sequence[str]) -> list[str]:
+    """The header of a gradebook with these check columns.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.gradebook import header_of
+    >>> header_of(["pa9.design"])
+    ['file', 'lab', 'group', 'status', 'reason', 'pa9.design', 'total', 'out_of']
+    """
+    return [*_FIRST, *columns, *_LAST]
+
+
+def write_table(path: str | os.PathLike[str], rows: Iterable[Sequence[Any]]) -> None:
+    """Write rows as a CSV, atomically (a reader never sees half of it)."""
+    _write_atomic(Path(path), _csv_text(rows))
 
 
 def _write_atomic(path: Path, text: str) -> None:
@@ -377,6 +465,131 @@ def _csv_text(rows: Iterable[Sequence[Any]]) -> str:
     return buf.getvalue()
 
 
+def exports(
+    header: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    students: Mapping[str, Sequence[tuple[str, str]]],
+) -> tuple[list[list[str]], list[list[str]] | None]:
+    """The export keyed by group, and Canvas's (None without students: it could match none).
+
+    Parameters
+    ----------
+    header : sequence of str
+        The gradebook's header.
+    rows : sequence of sequence of str
+        Its rows, in order.
+    students : mapping
+        Group -> list of (student id, name), from the roster.
+
+    Returns
+    -------
+    (list, list or None)
+    """
+    at = {name: i for i, name in enumerate(header)}
+    labs: dict[str, str] = {}
+    groups: dict[tuple[str, str], list[Sequence[str]]] = {}
+    for row in rows:
+        lab, group = row[at["lab"]], row[at["group"]]
+        if lab:
+            labs.setdefault(lab, row[at["out_of"]])
+        if lab and group:
+            groups.setdefault((lab, group), []).append(row)
+    plain: list[list[Any]] = [["group", "lab", "total", "out_of", "status", "reason", "file"]]
+    scores: dict[tuple[str, str], str] = {}
+    for (lab, group), same in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+        row = same[0]
+        status, reason = row[at["status"]], row[at["reason"]]
+        if len(same) > 1:
+            status, reason = "check by hand", "more than one hand-in"
+        score = row[at["total"]] if status in _GOOD else ""
+        scores[(lab, group)] = score
+        files = "; ".join(r[at["file"]] for r in same)
+        plain.append([group, lab, score, row[at["out_of"]], status, reason, files])
+    plain = [[safe_cell(c) for c in r] for r in plain]
+    if not students:
+        return plain, None
+    names = [f"{lab} (uio-teach)" for lab in labs]
+    canvas: list[list[Any]] = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", *names]]
+    canvas.append(["Points Possible", "", "", "", "", *labs.values()])
+    for group in sorted({g for _, g in groups}):
+        marks = [scores.get((lab, group), "") for lab in labs]
+        for student, name in students.get(group, []):
+            canvas.append([name or student, "", student, "", group, *marks])
+    return plain, [[safe_cell(c) for c in r] for r in canvas]
+
+
+def write_exports(
+    out: str | os.PathLike[str],
+    header: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    students: Mapping[str, Sequence[tuple[str, str]]],
+) -> None:
+    """Write the exports of :func:`exports` beside the gradebook ``out``.
+
+    Without students, no Canvas import is written (one of an earlier grading
+    into the same gradebook is removed: it would no longer be this one's).
+
+    Parameters
+    ----------
+    out : str or path-like
+    header, rows, students
+        As :func:`exports` takes them.
+    """
+    plain, canvas = exports(header, rows, students)
+    _write_atomic(export_path(out, "groups"), _csv_text(plain))
+    target = export_path(out, "canvas")
+    if canvas is not None:
+        _write_atomic(target, _csv_text(canvas))
+    else:
+        target.unlink(missing_ok=True)
+
+
+def read_gradebook(out: str | os.PathLike[str]) -> tuple[list[str], list[list[str]]]:
+    """The header and the whole rows of a gradebook CSV (a row cut short by a kill left out).
+
+    Parameters
+    ----------
+    out : str or path-like
+
+    Returns
+    -------
+    (list of str, list of list of str)
+
+    Raises
+    ------
+    uio_teach.instructor.output.OutputError
+        It cannot be read, or it is not a gradebook of uio-teach.
+    """
+    try:
+        with open(out, newline="", encoding="utf-8") as fh:
+            table = list(csv.reader(fh))
+    except FileNotFoundError:
+        raise OutputError(f"{os.fspath(out)}: no such gradebook") from None
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise OutputError(f"cannot read the gradebook {os.fspath(out)}: {err}") from None
+    if not table:
+        return [], []
+    header, body = table[0], table[1:]
+    if header[: len(_FIRST)] != _FIRST or header[-len(_LAST) :] != _LAST:
+        raise OutputError(
+            f"{os.fspath(out)} is not a gradebook of uio-teach (its header is not "
+            f"{','.join(_FIRST)},...,{','.join(_LAST)}); it is left alone"
+        )
+    return header, [row for row in body if len(row) == len(header)]
+
+
+def needs_a_look(status: str) -> bool:
+    """Whether a row of this status needs an instructor's look before its marks count.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.gradebook import needs_a_look
+    >>> needs_a_look("ok"), needs_a_look("check by hand")
+    (False, True)
+    """
+    return status not in _GOOD
+
+
 class Gradebook:
     """A gradebook CSV and its feedback folder, written row by row.
 
@@ -391,7 +604,15 @@ class Gradebook:
     resume : bool
         Keep the rows already there; :meth:`has` says which hand-ins have one.
     students : dict, optional
-        Group -> list of (student id, name), for the Canvas export.
+        Group -> list of (student id, name), for the Canvas export (none: no
+        Canvas export, which could match no student).
+    shard : (int, int), optional
+        ``(K, N)``: this gradebook holds the rows of shard K of N of the
+        class ``files`` (see :mod:`uio_teach.grading.merge`).
+    sources : dict, optional
+        What the grading read besides the hand-ins (the SHA-256 of the answer
+        key and of the roster), kept in the manifest so that shards of
+        different gradings are never merged.
 
     Raises
     ------
@@ -403,7 +624,7 @@ class Gradebook:
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from uio_teach.instructor.gradebook import Gradebook, Submission
+    >>> from uio_teach.grading.gradebook import Gradebook, Submission
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     out = pathlib.Path(tmp) / "grades.csv"
     ...     with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:
@@ -420,21 +641,43 @@ class Gradebook:
         *,
         resume: bool = False,
         students: dict[str, list[tuple[str, str]]] | None = None,
+        shard: tuple[int, int] | None = None,
+        sources: dict[str, Any] | None = None,
     ) -> None:
         self.out = Path(out)
         self.students = dict(students or {})
+        self.shard = shard
+        self.sources = dict(sources or {})
         self.subs: dict[str, Submission] = {}
         self.folder = feedback_folder(self.out)
         self.files = list(files)
         self.columns = list(columns)
         self.resume = resume
-        self.names = feedback_names(self.files)
+        self.names = _feedback_names(self.files)
         self.done: dict[str, list[str]] = {}
         self._lock = FolderLock(self.out)  # the file .<name>.lock beside the CSV
         self._csv: Any = None
 
     # opening ------------------------------------------------------------------------------
     def __enter__(self) -> Gradebook:
+        self.lock()
+        try:
+            self.open()
+        except BaseException:
+            self._unlock()
+            raise
+        return self
+
+    def lock(self) -> None:
+        """Take the gradebook's lock (first of all: before any notebook runs).
+
+        Raises
+        ------
+        uio_teach.instructor.output.OutputError
+            The CSV is a folder, or its feedback folder is not ours.
+        GradebookBusy
+            Another run holds the lock.
+        """
         check_gradebook_target(self.out)
         self.out.parent.mkdir(parents=True, exist_ok=True)
         try:
@@ -444,41 +687,59 @@ class Gradebook:
                 f"another grading run is writing {os.fspath(self.out)} (it holds "
                 f"{self._lock.path.name}); wait for it to end, or choose another gradebook"
             ) from None
-        try:
-            self._open()
-        except BaseException:
-            self._unlock()
-            raise
-        return self
 
     def _read_rows(self) -> tuple[list[str], list[list[str]]]:
-        try:
-            with open(self.out, newline="", encoding="utf-8") as fh:
-                table = list(csv.reader(fh))
-        except FileNotFoundError:
+        if not self.out.exists():
             return [], []
-        except (OSError, UnicodeDecodeError, csv.Error) as err:
-            raise OutputError(f"cannot read the gradebook {os.fspath(self.out)}: {err}") from None
-        if not table:
-            return [], []
-        header, body = table[0], table[1:]
-        if header[: len(_FIRST)] != _FIRST or header[-len(_LAST) :] != _LAST:
-            raise OutputError(
-                f"{os.fspath(self.out)} is not a gradebook of uio-teach (its header is not "
-                f"{','.join(_FIRST)},...,{','.join(_LAST)}); it is left alone"
-            )
-        # a row cut short by a kill has fewer fields: it is graded again
-        return header, [row for row in body if len(row) == len(header)]
+        return read_gradebook(self.out)  # a row cut short by a kill is graded again
 
-    def _open(self) -> None:
+    def _kept(self) -> tuple[list[str], list[list[str]]]:
+        """The header and the rows a resumed run keeps (none for a new grading)."""
+        if not self.resume:
+            return [], []
+        header, kept = self._read_rows()
+        manifest = read_manifest(self.folder) if self.folder.is_dir() else None
+        options = (manifest or {}).get("options") or {}
+        if kept and options:
+            earlier = options.get("shard")
+            if (tuple(earlier) if earlier else None) != self.shard:
+
+                def name(shard: Any) -> str:
+                    return f"shard {shard[0]}/{shard[1]}" if shard else "the whole class"
+
+                raise OutputError(
+                    f"{os.fspath(self.out)} holds the rows of {name(earlier)}, not of "
+                    f"{name(self.shard)}: resume it with the same --shard"
+                )
+            for what, digest in self.sources.items():
+                if options.get(what, digest) != digest:
+                    raise OutputError(
+                        f"{os.fspath(self.out)} was graded with another "
+                        f"{what.removesuffix('_sha256').replace('_', ' ')} (its {MANIFEST}): "
+                        "resume it with the same one, or grade afresh without --resume"
+                    )
+        wanted = {safe_cell(f) for f in self.files}
+        names = {safe_cell(f): n for f, n in self.names.items()}
+        # a row whose feedback text is lost is graded again
+        kept = [row for row in kept if row[0] in wanted and (self.folder / names[row[0]]).is_file()]
+        return header, kept
+
+    def prior(self) -> set[str]:
+        """The hand-ins whose rows a resumed run keeps (none for a new grading).
+
+        Returns
+        -------
+        set of str
+            Their files, as given.
+        """
+        cells = {row[0] for row in self._kept()[1]}
+        return {f for f in self.files if safe_cell(f) in cells}
+
+    def open(self) -> None:
+        """Start writing: a new gradebook, or the resumed one with the rows it keeps."""
         self.folder.mkdir(parents=True, exist_ok=True)
-        header: list[str] = []
-        kept: list[list[str]] = []
-        if self.resume:
-            header, kept = self._read_rows()
-            wanted = {safe_cell(f) for f in self.files}
-            kept = [row for row in kept if row[0] in wanted]
-        else:  # a new grading: the texts of the earlier one go
+        header, kept = self._kept()
+        if not self.resume:  # a new grading: the texts of the earlier one go
             for old in self.folder.iterdir():
                 if old.is_file() and (old.suffix in (".txt", ".html") or old.name == MANIFEST):
                     old.unlink()
@@ -488,11 +749,6 @@ class Gradebook:
             width = len(self.columns) - len(old_columns)
             kept = [row[: -len(_LAST)] + [""] * width + row[-len(_LAST) :] for row in kept]
         self.done = {row[0]: row for row in kept}
-        names = {safe_cell(f): n for f, n in self.names.items()}
-        for cell in list(self.done):  # a row whose feedback text is lost is graded again
-            if not (self.folder / names[cell]).is_file():
-                del self.done[cell]
-        kept = [row for row in kept if row[0] in self.done]
         _write_atomic(self.out, _csv_text([self._header(), *kept]))
         write_manifest(self.folder, command=COMMAND, config=self._config(), options=self._options())
         self._csv = open(self.out, "a", encoding="utf-8", newline="")
@@ -504,7 +760,15 @@ class Gradebook:
         return {"gradebook": self.out.name}
 
     def _options(self) -> dict[str, Any]:
-        return {"submissions": self.files}
+        options: dict[str, Any] = {
+            "submissions": [shown(f) for f in self.files],
+            "columns": list(self.columns),
+            "students": {g: [list(s) for s in v] for g, v in sorted(self.students.items())},
+            **self.sources,
+        }
+        if self.shard is not None:
+            options["shard"] = list(self.shard)
+        return options
 
     def has(self, file: str) -> bool:
         """Whether the hand-in ``file`` has its row already (kept by ``resume``, or added)."""
@@ -518,7 +782,7 @@ class Gradebook:
         ----------
         sub : Submission
         """
-        name = self.names.get(sub.file) or feedback_names([sub.file])[sub.file]
+        name = self.names.get(sub.file) or _feedback_names([sub.file])[sub.file]
         path = self.folder / name
         _write_atomic(path, sub.feedback())
         _write_atomic(path.with_suffix(".html"), sub.feedback_html())
@@ -537,47 +801,10 @@ class Gradebook:
         ]
         self._csv.close()
         _write_atomic(self.out, _csv_text([self._header(), *rows]))
-        by_group, canvas = self._exports(rows)
-        _write_atomic(export_path(self.out, "groups"), _csv_text(by_group))
-        _write_atomic(export_path(self.out, "canvas"), _csv_text(canvas))
+        write_exports(self.out, self._header(), rows, self.students)
         self._csv = open(self.out, "a", encoding="utf-8", newline="")
         config = {**self._config(), "gradebook_sha256": sha256_file(self.out)}
         write_manifest(self.folder, command=COMMAND, config=config, options=self._options())
-
-    def _exports(self, rows: list[list[str]]) -> tuple[list[list[str]], list[list[str]]]:
-        """The plain export keyed by group and Canvas's, from the final rows."""
-        header = self._header()
-        at = {name: i for i, name in enumerate(header)}
-        labs: dict[str, str] = {}
-        groups: dict[tuple[str, str], list[list[str]]] = {}
-        for row in rows:
-            lab, group = row[at["lab"]], row[at["group"]]
-            if lab:
-                labs.setdefault(lab, row[at["out_of"]])
-            if lab and group:
-                groups.setdefault((lab, group), []).append(row)
-        plain = [["group", "lab", "total", "out_of", "status", "reason", "file"]]
-        scores: dict[tuple[str, str], str] = {}
-        for (lab, group), same in sorted(groups.items(), key=lambda kv: (kv[0][1], kv[0][0])):
-            row = same[0]
-            status, reason = row[at["status"]], row[at["reason"]]
-            if len(same) > 1:
-                status, reason = "check by hand", "more than one hand-in"
-            score = row[at["total"]] if status in _GOOD else ""
-            scores[(lab, group)] = score
-            files = "; ".join(r[at["file"]] for r in same)
-            plain.append([group, lab, score, row[at["out_of"]], status, reason, files])
-        names = [f"{lab} (uio-teach)" for lab in labs]
-        canvas = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", *names]]
-        canvas.append(["Points Possible", "", "", "", "", *labs.values()])
-        for group in sorted({g for _, g in groups}):
-            marks = [scores.get((lab, group), "") for lab in labs]
-            for student, name in self.students.get(group, []) or [("", group)]:
-                canvas.append([name or student, "", student, "", group, *marks])
-        return (
-            [[safe_cell(c) for c in r] for r in plain],
-            [[safe_cell(c) for c in r] for r in canvas],
-        )
 
     def _unlock(self) -> None:
         self._lock.release()

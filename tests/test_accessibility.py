@@ -1,0 +1,254 @@
+"""Figures every reader can use: in words, apart without colour, readable on a phone.
+
+* colour vision: the simulation of Machado, Oliveira and Fernandes (2009) keeps greys grey and
+  confuses the pairs a dichromat confuses; the course's cycle is the Okabe-Ito palette with a
+  line style per colour, in the package and in the book's ``matplotlibrc``; no two curves of a
+  panel of an explorer differ by hue alone (every figure of the course: ``test_plotting.py``);
+* words: the course's drawing functions describe their figures from the numbers they draw
+  (what is plotted, and what the reader should see); a described figure is shown in a notebook
+  as HTML with its text alternative, its long description and its phone layout;
+* the phone layout stacks the panels in one column at the text size they were drawn with, and
+  puts the figure back as it was.
+
+The built pages are checked in a browser by ``test_book.py`` (axe-core, the pictures' text
+alternatives, the structure) and ``test_student_edition.py`` (the screen).
+"""
+
+from __future__ import annotations
+
+import html
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import uio_teach as ut
+from uio_teach import colour_vision, figure_text, plotting
+from uio_teach.experiments import PA9
+
+ROOT = Path(__file__).resolve().parents[1]
+OKABE_ITO = {"#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00", "#CC79A7", "#000000"}
+
+
+# --- colour vision -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("reader", colour_vision.DEFICIENCIES)
+def test_a_simulated_reader_sees_greys_as_greys(reader):
+    # each of Machado's matrices maps white to white (its rows sum to one), so greys stay grey
+    for level in (0.0, 0.2, 0.5, 0.8, 1.0):
+        seen = colour_vision.simulate((level, level, level), reader)
+        np.testing.assert_allclose(seen, level, atol=1e-3)
+
+
+def test_the_pairs_a_dichromat_confuses_are_found():
+    # matplotlib's default orange and green for a protanope, green and red for a deuteranope
+    assert colour_vision.colour_distance("#ff7f0e", "#2ca02c", "protanopia") < 10
+    assert colour_vision.colour_distance("#2ca02c", "#d62728", "deuteranopia") < 10
+    assert colour_vision.colour_distance("#ff7f0e", "#2ca02c") > 50  # apart for normal vision
+    with pytest.raises(ValueError, match="deficiency must be one of"):
+        colour_vision.simulate("red", "achromatopsia")
+
+
+def test_the_course_cycle_is_okabe_ito_with_a_line_style_per_colour():
+    assert set(plotting.COLORS) <= OKABE_ITO
+    assert "#F0E442" not in plotting.COLORS  # the yellow is too light on white
+    assert len(set(plotting.COLORS)) == len(plotting.COLORS) == len(plotting.LINESTYLES)
+    assert len({str(s) for s in plotting.LINESTYLES}) == len(plotting.LINESTYLES)
+    # any two channels stay apart for every reader: by style, whatever their colours
+    fig = plotting.new_figure()
+    ax = fig.subplots()
+    for i in range(len(plotting.COLORS)):
+        ax.plot([0, 1], [i, i], **plotting.channel_style(i), label=f"c{i}")
+    assert colour_vision.curves_apart_by_hue_alone(fig) == []
+
+
+def test_the_books_matplotlibrc_has_the_course_cycle():
+    import matplotlib as mpl
+
+    rc = mpl.rc_params_from_file(ROOT / "book" / "matplotlibrc", use_default_template=False)
+    cycle = rc["axes.prop_cycle"].by_key()
+    assert [c.upper() for c in cycle["color"]] == [c.upper() for c in plotting.COLORS]
+    assert [str(s) for s in cycle["linestyle"]] == [str(s) for s in plotting.LINESTYLES]
+
+
+def test_the_check_needs_a_style_or_a_colour_difference_every_reader_sees():
+    fig = plotting.new_figure()
+    ax = fig.subplots()
+    ax.plot([0, 1], [0, 1], color=plotting.COLORS[0], label="a")
+    ax.plot([0, 1], [1, 0], color=plotting.COLORS[2], label="b")  # blue, bluish green
+    found = colour_vision.curves_apart_by_hue_alone(fig)
+    assert [f[1:] for f in found] == [("a", "b", "tritanopia")]
+    ax.lines[1].set_marker("o")
+    assert colour_vision.curves_apart_by_hue_alone(fig) == []
+    # twenty runs of one series, drawn alike, are one series, not twenty curves to tell apart
+    ax.cla()
+    for k in range(20):
+        ax.plot([0, 1], [k, k + 1], color="C0", ls="-")
+    assert colour_vision.curves_apart_by_hue_alone(fig) == []
+
+
+@pytest.mark.slow  # every explorer drawn
+@pytest.mark.parametrize("narrow", [False, True])
+def test_no_two_curves_of_an_explorer_differ_by_hue_alone(narrow):
+    from uio_teach.explorers import compute_frame
+    from uio_teach.explorers._figure import ExplorerFigure
+    from uio_teach.explorers.scenarios import scenario_of
+
+    for name in ("pa9", "case_study", "missile", "quadruple_tank"):
+        sc = scenario_of(name)
+        fig = ExplorerFigure(sc, dpi=60, sticky=False, narrow=narrow, lmi=False)
+        fig.update(compute_frame(sc))
+        assert colour_vision.curves_apart_by_hue_alone(fig.fig) == [], name
+
+
+# --- figures in words --------------------------------------------------------------------------
+
+
+def test_a_response_figure_says_what_the_error_does():
+    plant = PA9.plant()
+    uio = PA9.simulate(ut.design_uio(plant, poles=PA9.poles), d=PA9.d_sine)
+    luen = PA9.simulate(ut.design_luenberger(plant, poles=PA9.poles), d=PA9.d_sine)
+    said = plotting.description(uio.plot(title="UIO"))
+    assert said.alt.startswith("UIO: against time, each state (x1, x2, x3)")
+    assert "The error decays to zero" in said.alt, said.alt
+    assert re.search(r"e2 \(vermillion, dashed\) decays to zero", said.details), said.details
+    # the Luenberger observer's error follows d: the words say so
+    said = plotting.description(luen.plot(title="Luenberger"))
+    assert "The error does not settle on zero" in said.alt, said.alt
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_an_input_figure_and_the_banks_figure_say_what_they_show():
+    plant = PA9.plant()
+    resp = PA9.simulate(ut.design_uio(plant, poles=PA9.poles), d=PA9.d_sine)
+    fig = ut.reconstruct_input(plant, resp).plot(symbol="v")
+    alt = plotting.description(fig).alt
+    assert "each unknown input (v1)" in alt and "decays to zero" in alt, alt
+    # the bank: which members raise an alarm in which run
+    sensors = ut.Plant(plant.A, np.eye(3), B=plant.B, E=plant.E)
+    bank = ut.design_uio_bank(sensors, "sensor", poles=[-2, -3, -4])
+    t = np.linspace(0, 4, 401)
+    detector = ut.design_uio(sensors, poles=[-1, -2, -3])
+    healthy = [ut.simulate_fault(sensors, detector, t, noise=0.01, seed=k) for k in range(20)]
+    ths = bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5)
+    fig = plotting.plot_bank_alarms(t, {"no fault": healthy[0]}, [bank], [ths])
+    said = plotting.description(fig)
+    assert said.alt.startswith("Alarms of the bank of UIOs, one panel per run")
+    assert said.details.startswith("Run no fault: ")
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_describe_wants_words():
+    fig = plotting.new_figure()
+    with pytest.raises(ValueError, match="alt must say what the figure shows"):
+        figure_text.describe(fig, "   ")
+    figure_text.describe(fig, "First words.", "Long.")
+    figure_text.describe(fig, "Second words.")  # keeps the long description
+    assert figure_text.description(fig) == figure_text.FigureDescription("Second words.", "Long.")
+    with pytest.raises(ValueError, match="no description"):
+        figure_text.figure_html(plotting.new_figure())
+
+
+def _drawn(fig) -> bytes:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=40)
+    return buffer.getvalue()
+
+
+def test_the_html_holds_the_words_and_the_phone_layout_and_leaves_the_figure_as_it_was():
+    resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles), d=PA9.d_sine)
+    fig = plotting.plot_response(resp, fig=plotting.new_figure(9, 6), title='UIO "PA9" <run>')
+    before = _drawn(fig)
+    text = figure_html_of(fig)
+    assert _drawn(fig) == before  # the phone layout was undone
+    said = plotting.description(fig)
+    assert f'alt="{html.escape(said.alt)}"' in text
+    ident = re.search(r'aria-describedby="([\w-]+)"', text).group(1)
+    assert f'<p id="{ident}">{html.escape(said.details)}</p>' in text
+    assert "<summary>What the figure shows, in words</summary>" in text
+    assert f'media="(max-width: {figure_text.NARROW_SCREEN_PX}px)"' in text
+    assert "data-hue-alone" not in text
+
+
+def figure_html_of(fig) -> str:
+    return figure_text.figure_html(fig)
+
+
+def test_the_phone_layout_is_one_column_with_the_text_as_drawn():
+    resp = PA9.simulate(ut.design_uio(PA9.plant(), poles=PA9.poles), d=PA9.d_sine)
+    fig = plotting.plot_response(resp, fig=plotting.new_figure(9, 6))
+    sizes = sorted({t.get_fontsize() for t in fig.findobj(lambda a: hasattr(a, "get_fontsize"))})
+    with figure_text.narrow_layout(fig):
+        columns = {ax.get_subplotspec().colspan.start for ax in fig.axes}
+        rows = [ax.get_subplotspec().rowspan.start for ax in fig.axes]
+        width = fig.get_size_inches()[0]
+        inside = sorted(
+            {t.get_fontsize() for t in fig.findobj(lambda a: hasattr(a, "get_fontsize"))}
+        )
+        legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+        above = all(
+            lg.get_bbox_to_anchor().y0 >= ax.bbox.y1 - 1
+            for ax, lg in zip(
+                [ax for ax in fig.axes if ax.get_legend() is not None], legends, strict=True
+            )
+        )
+    assert columns == {0} and sorted(rows) == list(range(len(fig.axes)))
+    assert width == figure_text.NARROW_WIDTH
+    assert inside == sizes  # the text keeps its size
+    assert above  # a legend beside a panel moves above it
+    # shown in a phone's column (358 CSS px of 390), the smallest text is at least 9 px
+    smallest_px = min(sizes) * fig.dpi / 72 * min(1.0, 358 / (figure_text.NARROW_WIDTH * fig.dpi))
+    assert smallest_px >= 9, smallest_px
+    assert {ax.get_subplotspec().colspan.start for ax in fig.axes} == {0, 1}  # put back
+
+
+def test_a_notebook_shows_a_described_figure_as_html():
+    from IPython.core.interactiveshell import InteractiveShell
+
+    shell = InteractiveShell.instance()
+    try:
+        fig = plotting.new_figure(4, 3)
+        fig.subplots().plot([0, 1], [1, 0])
+        data, meta = shell.display_formatter.format(fig)
+        assert "text/html" not in data  # not described: a plain picture
+        figure_text.describe(fig, "A line falling from 1 to 0.")
+        data, meta = shell.display_formatter.format(fig)
+        assert 'alt="A line falling from 1 to 0."' in data["text/html"]
+        assert meta["image/png"]["alt"] == "A line falling from 1 to 0."
+    finally:
+        InteractiveShell.clear_instance()
+
+
+def test_every_chapter_figure_is_described_in_its_cell():
+    """A chapter that draws a figure itself (plt.subplots, plt.figure) describes it in the cell
+    (``ut.plotting.describe``); the package's figures describe themselves."""
+    missing = []
+    for source in sorted((ROOT / "book").glob("*.md")):
+        text = source.read_text(encoding="utf-8")
+        for cell in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S):
+            drawn = re.search(r"plt\.(subplots|figure)\(", cell) and "plt.show()" in cell
+            by_package = re.search(r"\.plot\(\s*fig=", cell)  # a package figure: described
+            if drawn and not by_package and "describe(" not in cell:
+                missing.append(f"{source.name}: {cell.strip().splitlines()[0][:60]}")
+    assert not missing, f"figures drawn in a cell without a description: {missing}"
+
+
+def test_no_prose_points_at_the_left_or_the_right_of_a_figure_alone():
+    """On a phone a figure's panels are stacked: a sentence that names the left or the right
+    panels says where they are on a phone too (or names the panels by what they show)."""
+    found = []
+    for source in sorted((ROOT / "book").glob("*.md")):
+        for paragraph in re.split(r"\n\s*\n", source.read_text(encoding="utf-8")):
+            words = " ".join(paragraph.split())
+            for m in re.finditer(r"\b(on the (left|right)|Left:|Right:)", words):
+                around = words[max(0, m.start() - 80) : m.end() + 80]
+                if not re.search(r"phone|wide screen|side of|half-plane|\$", around):
+                    found.append(f"{source.name}: {around}")
+    assert not found, found

@@ -1,0 +1,397 @@
+"""What the grader reads before anything runs: hand-in names as students and LMSs write them,
+rosters and keys as spreadsheets save them, old notebooks, disguised copies, shards and merges.
+
+No kernel starts here: the gradebooks merged are written through the gradebook's own API."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from uio_teach.grading import copies, grade, merge
+from uio_teach.grading.gradebook import (
+    Gradebook,
+    Submission,
+    feedback_names,
+    safe_cell,
+    shown,
+)
+from uio_teach.grading.rosters import (
+    GradeError,
+    group_from_name,
+    read_answer_key,
+    read_roster,
+)
+from uio_teach.grading.runner import clean_notebook
+
+# names --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "name, expected",
+    [
+        ("pa9_g02.ipynb", ("pa9", "g02")),
+        ("pa9_g2.ipynb", ("pa9", "g02")),
+        ("PA9_G02.ipynb", ("pa9", "g02")),
+        ("name_48213_9920131_pa9_g02.ipynb", ("pa9", "g02")),  # Canvas's bulk download
+        ("name_LATE_48213_9920131_pa9_g02.ipynb", ("pa9", "g02")),
+        ("smith_john_48213_9920131_pa9_g02-1.ipynb", ("pa9", "g02")),  # a re-submission
+        ("Ann Example_123_assignsubmission_file_case_study_g11.ipynb", ("case_study", "g11")),
+        ("pa9_g02 (2).ipynb", ("pa9", "g02")),
+        ("x_missile_group_7.ipynb", ("missile", "g07")),
+        ("lab5_g03.ipynb", ("lab5", "g03")),  # another lab: graded as an unknown lab
+        ("lab_pa9.ipynb", ("", "")),
+        ("notebook (3).ipynb", ("", "")),
+        ("pa9.ipynb", ("", "")),
+    ],
+)
+def test_the_group_is_read_from_names_as_students_and_lmss_write_them(name, expected):
+    assert group_from_name(name) == expected
+    assert group_from_name(f"some/folder/{name}") == expected
+
+
+def test_names_of_any_legal_length_and_encoding_get_their_own_feedback_file(tmp_path):
+    files = [
+        "x" * 241 + "_pa9_g01.ipynb",  # 255 bytes
+        "x" * 241 + "_pa9_g02.ipynb",  # the same first 200 bytes
+        "é" * 118 + "_pa9_g03.ipynb",  # 255 bytes of two-byte characters
+        os.fsdecode(b"Jos\xe9_pa9_g04.ipynb"),  # Latin-1, not UTF-8
+    ]
+    assert all(len(os.fsencode(f)) <= 255 for f in files)
+    names = feedback_names([shown(f) for f in files])  # a name not UTF-8 is shown escaped
+    assert len(set(names.values())) == len(files)
+    for name in names.values():
+        assert len(os.fsencode(f".{name[:-4]}.html.part")) <= 255
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, files, ["pa9.design"]) as book:
+        for file in files:
+            book.add(Submission(file, "pa9", "g01", "ok", expected=("pa9.design",)))
+    table = list(csv.reader(out.open(encoding="utf-8")))
+    assert [r[0] for r in table[1:]] == [safe_cell(f) for f in files]
+    assert table[-1][0] == "Jos\\xe9_pa9_g04.ipynb"  # readable, distinct, valid UTF-8
+    texts = sorted(p for p in (tmp_path / "grades_feedback").iterdir() if p.suffix == ".txt")
+    assert len(texts) == len(files)
+    text = (tmp_path / "grades_feedback" / names[shown(files[-1])]).read_text("utf-8")
+    assert shown(files[-1]) in text
+
+
+# rosters and keys ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sep", [",", ";", "\t", "|"])
+@pytest.mark.parametrize("encoding", ["utf-8", "utf-8-sig", "utf-16", "cp1252"])
+def test_a_roster_is_read_whatever_separator_and_encoding_a_spreadsheet_chose(
+    tmp_path, sep, encoding
+):
+    lines = [["File", "Group", "Student", "Name"], ["x.ipynb", "g1", "s1", "Zoë Ärling"]]
+    lines += [["", "G02", "s2", "Bo, Jr."]]
+    path = tmp_path / "groups.csv"
+    with open(path, "w", newline="", encoding=encoding) as fh:
+        csv.writer(fh, delimiter=sep).writerows(lines)
+    files, students = read_roster(path)
+    assert files == {"x.ipynb": ("", "g01")}
+    assert students == {"g01": [("s1", "Zoë Ärling")], "g02": [("s2", "Bo, Jr.")]}
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ("group,student\ng01,s1\ng02,s1\n", ["student s1", "listed twice", "line 2"]),
+        ("group,student,name\ng01,s1,Ann\ng01,s1,Ann\n", ["s1 (Ann)", "listed twice"]),
+        ("group,file\ng01,a.ipynb\ng01,a.ipynb\n", ["a.ipynb", "listed twice"]),
+        ("group,file\ng01,a.ipynb\ng02,a.ipynb\n", ["a.ipynb", "two groups", "g01", "g02"]),
+        ("gruppa;navn\n1;Ann\n", ["no column 'group'", "semicolon", "'gruppa'"]),
+        ("group;name\ng01;Ann\n", ["'file' or 'student'"]),
+        ("", ["empty"]),
+    ],
+)
+def test_a_roster_that_cannot_be_used_is_refused_naming_the_row(tmp_path, text, words):
+    path = tmp_path / "groups.csv"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(GradeError) as info:
+        read_roster(path)
+    message = str(info.value)
+    assert message.startswith(str(path)) and "\n" not in message
+    for word in words:
+        assert word in message
+
+
+def test_an_answer_key_saved_again_by_a_spreadsheet_is_read_and_a_repeat_refused(tmp_path):
+    path = tmp_path / "answer_key.csv"
+    rows = [["lab", "group", "params"], ["pa9", "g1", json.dumps({"poles": [-1, -2, -3]})]]
+    with open(path, "w", newline="", encoding="utf-8-sig") as fh:
+        csv.writer(fh, delimiter=";").writerows(rows)
+    assert read_answer_key(path) == {("pa9", "g01"): {"poles": [-1, -2, -3]}}
+    with open(path, "a", newline="", encoding="utf-8") as fh:
+        csv.writer(fh, delimiter=";").writerow(["pa9", "g01", "{}"])
+    with pytest.raises(GradeError, match="lab pa9, group g01 is listed twice"):
+        read_answer_key(path)
+
+
+# notebook formats ----------------------------------------------------------------------------
+
+
+def _v3() -> dict:
+    cells = [
+        {"cell_type": "code", "input": "H = 1", "language": "python", "outputs": []},
+        {"cell_type": "heading", "level": 2, "source": "Requirement 1"},
+        {"cell_type": "markdown", "source": "text"},
+    ]
+    for cell in cells:
+        cell["metadata"] = {}
+    return {
+        "nbformat": 3,
+        "nbformat_minor": 0,
+        "metadata": {"name": ""},
+        "worksheets": [{"cells": cells, "metadata": {}}],
+    }
+
+
+def test_a_notebook_of_format_3_is_converted_and_says_so():
+    nb, notes = clean_notebook(_v3())
+    assert [(c.cell_type, c.source) for c in nb.cells] == [
+        ("code", "H = 1"),
+        ("markdown", "## Requirement 1"),
+        ("markdown", "text"),
+    ]
+    assert notes == ["a notebook of format 3 (nbformat 3), converted to format 4 to run"]
+    nbformat.validate(nb)
+
+
+@pytest.mark.parametrize(
+    "raw, words",
+    [
+        ({"nbformat": 2, "worksheets": []}, ["format 2", "too old", "save it again"]),
+        ({"nbformat": 1}, ["format 1"]),
+        ({"nbformat": 5, "cells": []}, ["format 5", "formats 4 and 3"]),
+        ({"nbformat": "4", "cells": []}, ["format '4'"]),
+        ({"cells": []}, ["no nbformat"]),
+        ({"nbformat": 3, "worksheets": 5}, ["format 3", "could not be converted"]),
+    ],
+)
+def test_other_formats_are_refused_naming_the_format(raw, words):
+    with pytest.raises(ValueError) as info:
+        clean_notebook(raw)
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_an_unreadable_format_is_the_rows_reason(tmp_path):
+    path = tmp_path / "pa9_g01.ipynb"
+    path.write_text(json.dumps({"nbformat": 2, "worksheets": []}))
+    handin = grade.read_handin(path)
+    assert handin.status == "unreadable" and handin.reason.startswith("a notebook of format 2")
+    path.write_text(json.dumps(_v3()))
+    handin = grade.read_handin(path)
+    assert handin.status == "" and "converted to format 4" in handin.notes[0]
+
+
+# copies ---------------------------------------------------------------------------------------
+
+ORIGINAL = [
+    "import numpy as np\nCE = C @ E\nH = E @ np.linalg.pinv(CE)  # eq. (8)\nT = np.eye(3) - H @ C",
+    "def place(a, poles):\n    return ct.place(a.T, C.T, poles).T\nK1 = place(T @ A, [-1, -2, -3])",
+]
+
+
+@pytest.mark.parametrize(
+    "disguised",
+    [
+        [  # other local names, comments, blank lines, another layout, a docstring
+            "import numpy as numpy_\n\nprod = C@E   # CE\n\n"
+            "H = E @ numpy_.linalg.pinv( prod )\nT = numpy_.eye(3) - (H @ C)",
+            'def gain(matrix, wanted):\n    """Place the poles."""\n'
+            "    return ct.place(matrix.T, C.T, wanted).T\n\n\nK1 = gain(T @ A, [-1, -2, -3])",
+        ],
+        [ORIGINAL[0] + "\n\n# done\n", ORIGINAL[1].replace("    ", "\t")],
+    ],
+)
+def test_a_copy_is_caught_after_normalisation(disguised):
+    keep = {"H", "T", "K1"}
+    assert copies.fingerprint(disguised, keep=keep) == copies.fingerprint(ORIGINAL, keep=keep)
+
+
+@pytest.mark.parametrize(
+    "changed",
+    [
+        [ORIGINAL[0].replace("np.eye(3) - H @ C", "np.eye(3) + H @ C"), ORIGINAL[1]],
+        [ORIGINAL[0], ORIGINAL[1].replace("[-1, -2, -3]", "[-1, -2, -4]")],
+        [ORIGINAL[0].replace("H = ", "H2 = ").replace("H @", "H2 @"), ORIGINAL[1]],  # an answer
+        [ORIGINAL[1], ORIGINAL[0]],  # the cells in another order
+    ],
+)
+def test_different_work_is_not_a_copy(changed):
+    keep = {"H", "T", "K1"}
+    assert copies.fingerprint(changed, keep=keep) != copies.fingerprint(ORIGINAL, keep=keep)
+
+
+def test_a_cell_that_is_not_python_is_compared_without_comments_and_spacing():
+    assert copies.fingerprint(["x = (1  # a\n"]) == copies.fingerprint(["x=(1"])
+    assert copies.fingerprint(["%matplotlib inline\ny = 2"]) == copies.fingerprint(["y = 2"])
+
+
+# shards and merges ----------------------------------------------------------------------------
+
+CLASS = [f"handed_in/pa9_g{i:02d}.ipynb" for i in range(1, 41)]
+
+
+def test_every_hand_in_is_in_exactly_one_shard_whatever_the_order():
+    for n in (1, 2, 3, 7):
+        first = {f: merge.shard_of(f, n) for f in CLASS}
+        again = {f: merge.shard_of(f, n) for f in reversed(CLASS)}
+        assert first == again
+        assert set(first.values()) <= set(range(1, n + 1))
+        moved = {f: merge.shard_of("/elsewhere/" + Path(f).name, n) for f in CLASS}
+        assert moved == first  # by the hand-in's name, not its folder
+    assert len({merge.shard_of(f, 3) for f in CLASS}) == 3  # all shards get hand-ins
+
+
+@pytest.mark.parametrize("text", ["0/2", "3/2", "2", "a/b", "1/0", "-1/2"])
+def test_a_shard_out_of_range_is_a_usage_error(text):
+    with pytest.raises(GradeError, match="shard"):
+        merge.parse_shard(text)
+
+
+def _book(out: Path, files, shard, *, students=None, sources=None, only=None) -> Path:
+    subs = []
+    for i, file in enumerate(files):
+        if shard is not None and merge.shard_of(file, shard[1]) != shard[0]:
+            continue
+        if only is not None and file not in only:
+            continue
+        results = {"pa9.design": {"passed": i % 2 == 0, "items": [], "title": "design"}}
+        subs.append(
+            Submission(
+                file,
+                "pa9",
+                f"g{i + 1:02d}",
+                "ok" if i % 3 else "error",
+                results=results,
+                expected=("pa9.design",),
+            )
+        )
+    with Gradebook(
+        out, files, ["pa9.design"], students=students or {}, shard=shard, sources=sources
+    ) as book:
+        for sub in subs:
+            book.add(sub)
+    return out
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def test_merged_shards_are_what_one_whole_run_writes(tmp_path):
+    files = CLASS[:12]
+    students = {"g01": [("s1", "Ann")], "g02": [("s2", "Bo"), ("s3", "Cy")]}
+    sources = {"answer_key_sha256": "k", "roster_sha256": "r"}
+    _book(tmp_path / "whole" / "grades.csv", files, None, students=students, sources=sources)
+    parts = [
+        _book(
+            tmp_path / "parts" / f"grades_{k}.csv",
+            files,
+            (k, 3),
+            students=students,
+            sources=sources,
+        )
+        for k in (1, 2, 3)
+    ]
+    merge.merge(parts[::-1], tmp_path / "merged" / "grades.csv")
+    assert _tree(tmp_path / "merged") == _tree(tmp_path / "whole")
+    assert (tmp_path / "merged" / "grades_canvas.csv").is_file()
+
+
+def test_shards_that_do_not_fit_together_are_refused_naming_them(tmp_path):
+    files = CLASS[:10]
+    one = _book(tmp_path / "a" / "g_1.csv", files, (1, 2))
+    two = _book(tmp_path / "a" / "g_2.csv", files, (2, 2))
+    out = tmp_path / "m" / "grades.csv"
+    with pytest.raises(merge.MergeError, match="shard 2/2 missing"):
+        merge.merge([one], out)
+    with pytest.raises(merge.MergeError, match="both shard 1/2"):
+        merge.merge([one, one], out)
+    other_split = _book(tmp_path / "b" / "g_1.csv", files, (1, 3))
+    with pytest.raises(merge.MergeError, match="different splits"):
+        merge.merge([one, two, other_split], out)
+    other_class = _book(tmp_path / "c" / "g_2.csv", CLASS[:11], (2, 2))
+    with pytest.raises(merge.MergeError, match="not shards of one grading: their submissions"):
+        merge.merge([one, other_class], out)
+    other_key = _book(tmp_path / "d" / "g_2.csv", files, (2, 2), sources={"answer_key_sha256": "x"})
+    with pytest.raises(merge.MergeError, match="their answer key differ"):
+        merge.merge([one, other_key], out)
+    # a whole run's gradebook and a shard overlap
+    whole = _book(tmp_path / "e" / "whole.csv", files, None)
+    with pytest.raises(merge.MergeError, match="different splits"):
+        merge.merge([whole, two], out)
+    with pytest.raises(merge.MergeError, match="one of the gradebooks"):
+        merge.merge([one, two], one)
+    assert not out.exists()
+
+
+def test_a_shard_whose_run_did_not_finish_is_refused(tmp_path):
+    files = CLASS[:10]
+    one = _book(tmp_path / "g_1.csv", files, (1, 2))
+    mine = [f for f in files if merge.shard_of(f, 2) == 2]
+    two = _book(tmp_path / "g_2.csv", files, (2, 2), only=mine[:-1])  # one row short
+    with pytest.raises(merge.MergeError, match="no row in any gradebook"):
+        merge.merge([one, two], tmp_path / "m.csv")
+    with open(two, "a", encoding="utf-8") as fh:  # a run killed mid-row: CSV and manifest differ
+        fh.write("x")
+    with pytest.raises(merge.MergeError, match="did not finish"):
+        merge.merge([one, two], tmp_path / "m.csv")
+
+
+def test_resuming_a_shard_with_another_shard_is_refused(tmp_path):
+    files = CLASS[:6]
+    out = _book(tmp_path / "g.csv", files, (1, 2))
+    with pytest.raises(Exception, match="resume it with the same --shard"):
+        with Gradebook(out, files, ["pa9.design"], resume=True, shard=(2, 2)):
+            pass
+
+
+# the summary ------------------------------------------------------------------------------------
+
+
+def test_the_summary_after_resume_counts_the_whole_gradebook(tmp_path, capsys):
+    from uio_teach.instructor import cli
+
+    folder = tmp_path / "handed_in"
+    folder.mkdir()
+    for group in ("g01", "g02"):
+        (folder / f"pa9_{group}.ipynb").write_text("{ not a notebook")
+    out = str(tmp_path / "grades.csv")
+    args = ["grade", str(folder), "--out", out, "--no-sandbox", "-q"]
+    assert cli.main(args) == 0
+    assert (
+        "2 rows need a look (2 unreadable) of the 2 rows in grades.csv" in capsys.readouterr().err
+    )
+    (folder / "pa9_g03.ipynb").write_text("[]")
+    assert cli.main([*args, "--resume"]) == 0
+    err = capsys.readouterr().err
+    assert "3 rows need a look (3 unreadable) of the 3 rows in grades.csv" in err
+    assert "no Canvas import written" not in err  # -q: only what needs a look
+    assert cli.main([*args[:-1], "--resume"]) == 0
+    assert "no Canvas import written: without --roster" in capsys.readouterr().err
+
+
+def test_shard_and_merge_usage_errors_are_one_line(tmp_path, capsys):
+    from uio_teach.instructor import cli
+
+    assert cli.main(["grade", str(tmp_path), "--out", "g.csv", "--shard", "3/2"]) == 2
+    assert "--shard: expected K/N with 1 <= K <= N, got 3/2" in capsys.readouterr().err
+    assert cli.main(["merge", str(tmp_path / "none.csv"), "--out", "g.csv"]) == 2
+    assert "no such gradebook" in capsys.readouterr().err
+    one = _book(tmp_path / "g_1.csv", CLASS[:4], (1, 2))
+    assert cli.main(["merge", str(one), "--out", str(tmp_path / "m.csv")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "shard 2/2 missing" in err

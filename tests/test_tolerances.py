@@ -1,0 +1,298 @@
+"""Every tolerance of ``uio_teach.tolerances`` pinned from both sides.
+
+Each tolerance has a pin: a case a tenth of the way inside what it must accept and a case ten
+times outside, both built from the declared value, judged by the package reading the live one.
+``test_tolerance_holds`` checks both at the declared value; ``test_tolerance_is_pinned`` sets it
+a hundred times looser and a hundred times tighter and checks that its pin then fails (a moved
+tolerance fails a named test). A new tolerance without a pin fails
+``test_every_tolerance_has_a_pin``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+import uio_teach as ut
+from uio_teach import tolerances as tols
+from uio_teach.balancing import _split_from_modes, modes_agree
+from uio_teach.existence import conditioning_condition, rank_condition, zero_condition
+from uio_teach.linalg import checked_zeros, is_stable, observability_decomposition, rank_decision
+from uio_teach.lmi import _meets_each
+from uio_teach.observers.projection import decoupled_gain
+from uio_teach.placement import strip_fixed
+from uio_teach.simulation import _check_discrete_grid
+from uio_teach.verify import (
+    DecouplingWarning,
+    check_decoupling,
+    check_identity,
+    check_poles,
+)
+
+DECLARED = dict(tols.ALL)
+EPS = tols.EPS
+PINS: dict[str, Callable[[], tuple[bool, bool]]] = {}
+
+
+def pin(name: str):
+    def register(fn):
+        PINS[name] = fn
+        return fn
+
+    return register
+
+
+def outcome(call) -> str:
+    """'ok', 'warned' or 'refused' (an error of the package)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            call()
+        except (ValueError, ut.UIOTeachError):
+            return "refused"
+    return "warned" if caught else "ok"
+
+
+# ranks ------------------------------------------------------------------------------------------
+@pin("RANK_MARGIN")
+def _():
+    thr = 2 * EPS  # the threshold of diag(1, s): max(shape) eps ||M||
+    m = DECLARED["RANK_MARGIN"]
+    clear = rank_decision(np.diag([1.0, 10 * m * thr]))
+    close = rank_decision(np.diag([1.0, m * thr / 10]))
+    return (not clear.marginal and clear.rank == 2), (close.marginal and close.rank == 2)
+
+
+@pin("DROP_MARGIN")
+def _():
+    thr = 2 * EPS
+    m = DECLARED["DROP_MARGIN"]
+    clear = rank_decision(np.diag([1.0, thr / (10 * m)]))
+    close = rank_decision(np.diag([1.0, thr / (m / 10)]))
+    return (not clear.marginal and clear.rank == 1), (close.marginal and close.rank == 1)
+
+
+@pin("RANK_RTOL")
+def _():
+    thr = DECLARED["RANK_RTOL"] * 2 * EPS  # n = 2, ||C|| ||E|| = 1
+    A = np.diag([-1.0, -2.0])
+
+    def holds(ce):
+        E = np.array([[ce], [1.0]])
+        E = E / np.linalg.norm(E)
+        return rank_condition(ut.Plant(A, [[1.0, 0.0]], E=E))[0].holds
+
+    return holds(10 * thr), not holds(thr / 10)
+
+
+@pin("STAIRCASE_RTOL")
+def _():
+    # (A, [1, c]): the second mode is unobservable when c is round-off of the staircase
+    thr = 2 * DECLARED["STAIRCASE_RTOL"] * EPS * 2  # max(shape) rtol eps max(||A||, ||C||)
+    A = np.diag([-1.0, -2.0])
+
+    def unobservable(c):
+        return observability_decomposition(A, [[1.0, c]]).Au.shape[0]
+
+    return unobservable(10 * thr) == 0, unobservable(thr / 10) == 1
+
+
+# zeros and stability ----------------------------------------------------------------------------
+def _near_axis(a: float) -> ut.Plant:
+    """G(s) = (s + a) / ((s + 1)(s + 2)): a zero at -a."""
+    return ut.Plant([[0.0, 1.0], [-2.0, -3.0]], [[a, 1.0]], E=[0.0, 1.0])
+
+
+_R0 = float(checked_zeros(_near_axis(0.0).A, _near_axis(0.0).E, _near_axis(0.0).C).radius[0])
+"""How far round-off moves the zero at the declared backward error (the zero at 0)."""
+
+
+@pin("ZERO_RTOL")
+def _():
+    def decided(a):
+        pl = _near_axis(a)
+        return checked_zeros(pl.A, pl.E, pl.C).decided
+
+    return decided(10 * _R0), not decided(_R0 / 10)
+
+
+@pin("STABILITY_MARGIN")
+def _():
+    m = DECLARED["STABILITY_MARGIN"]
+    inside = is_stable([-10 * m + 1j], discrete=False)[0] and is_stable([1 - 10 * m], True)[0]
+    edge = not is_stable([-m / 10 + 1j], discrete=False)[0] and not is_stable([1 - m / 10], True)[0]
+    return bool(inside), bool(edge)
+
+
+@pin("REAL_RTOL")
+def _():
+    r = DECLARED["REAL_RTOL"]
+    real = ut.linalg.sort_poles([-1 + r / 10 * 1j])[0].imag == 0
+    kept = ut.linalg.sort_poles([-1 + 10 * r * 1j, -1 - 10 * r * 1j])[0].imag != 0
+    return bool(real), bool(kept)
+
+
+@pin("MODES_RTOL")
+def _():
+    r = DECLARED["MODES_RTOL"]
+    return modes_agree([-1 - r / 10], [-1.0]), not modes_agree([-1 - 10 * r], [-1.0])
+
+
+@pin("SPAN_RTOL")
+def _():
+    # two unobservable modes whose eigenvectors are nearly parallel (an angle of about d)
+    r = DECLARED["SPAN_RTOL"]
+
+    def spanned(d):
+        A = np.array([[-1.0, 1.0], [0.0, -1.0 - d]])
+        return _split_from_modes(A, np.zeros((1, 2)), np.array([-1.0, -1.0 - d])) is not None
+
+    return spanned(10 * r * np.sqrt(2)), not spanned(r / 10 * np.sqrt(2))
+
+
+@pin("CLOSE_NOTE_RTOL")
+def _():
+    r = DECLARED["CLOSE_NOTE_RTOL"]  # against the spectral radius 2 of the plant
+
+    def noted(a):
+        pl = _near_axis(a)
+        return "the closest" in zero_condition(checked_zeros(pl.A, pl.E, pl.C)).reason
+
+    return noted(2 * r / 10), not noted(2 * r * 10)
+
+
+@pin("FIXED_POLE_RTOL")
+def _():
+    r = DECLARED["FIXED_POLE_RTOL"]
+    fixed = np.array([-2.0 + 0j])
+    same = strip_fixed(np.array([-1.0, -2.0 - 2 * r / 10]), fixed).size == 1
+    other = strip_fixed(np.array([-1.0, -2.0 - 2 * r * 10]), fixed).size == 2
+    return same, other
+
+
+# designs ----------------------------------------------------------------------------------------
+def _poles_off(e: float) -> str:
+    return outcome(lambda: check_poles(np.diag([-1.0, -2.0]), [-1.0 - e, -2.0]))
+
+
+@pin("POLE_RTOL")
+def _():
+    r = DECLARED["POLE_RTOL"]
+    return _poles_off(r / 10) == "ok", _poles_off(10 * r) == "warned"
+
+
+@pin("WARN_RTOL")
+def _():
+    r = DECLARED["WARN_RTOL"]
+    return _poles_off(r / 10) == "warned", _poles_off(10 * r) == "refused"
+
+
+@pin("IDENTITY_RTOL")
+def _():
+    r = DECLARED["IDENTITY_RTOL"]
+
+    def holds(x):
+        return outcome(lambda: check_identity("T E = 0", np.array([[x]]), 1.0)) == "ok"
+
+    return holds(r / 10), not holds(10 * r)
+
+
+# x1 is measured (xhat1 = y) and drives x2; the gain [0; 1 + off] leaks about off times c
+_A = np.array([[-1.0, 0.0], [1.0, -2.0]])
+_E, _C, _DY = np.array([[1.0], [0.0]]), np.array([[1.0, 0.0]]), np.array([[1.0], [0.0]])
+
+
+def _leak(off: float) -> str:
+    K = np.array([[0.0], [1.0 + off]])
+    return outcome(lambda: check_decoupling(_A, _E, _C, _A, K, np.eye(2), _DY))
+
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore", DecouplingWarning)
+    _K = np.array([[0.0], [1.0 + 1e-4]])
+    _PER_OFF = check_decoupling(_A, _E, _C, _A, _K, np.eye(2), _DY).bound / 1e-4
+
+
+@pin("LEAK_RTOL")
+def _():
+    r = DECLARED["LEAK_RTOL"] / _PER_OFF
+    return _leak(r / 10) == "ok", _leak(10 * r) == "warned"
+
+
+@pin("LEAK_REFUSE")
+def _():
+    r = DECLARED["LEAK_REFUSE"] / _PER_OFF
+    return _leak(r / 10) == "warned", _leak(10 * r) == "refused"
+
+
+@pin("AMPLIFICATION_LIMIT")
+def _():
+    limit = DECLARED["AMPLIFICATION_LIMIT"]
+    A = np.diag([-1.0, -2.0])
+
+    def holds(amp):
+        E = np.array([[1.0 / amp], [1.0]])
+        return conditioning_condition(ut.Plant(A, [[1.0, 0.0]], E=E / np.linalg.norm(E))).holds
+
+    return holds(limit / 10), not holds(limit * 10)
+
+
+_GAIN_PLANT = ut.Plant([[-1.0]], [[1.0], [1.0]], D=[[1.0], [0.0]])
+
+
+def _gain(r: float) -> str:
+    return outcome(lambda: decoupled_gain("K1", _GAIN_PLANT, [[r, 1.0]]))
+
+
+@pin("GAIN_EXACT_RTOL")
+def _():
+    r = DECLARED["GAIN_EXACT_RTOL"]
+    return _gain(r / 10) == "ok", _gain(10 * r) == "warned"
+
+
+@pin("GAIN_ROUNDED_RTOL")
+def _():
+    r = DECLARED["GAIN_ROUNDED_RTOL"]
+    return _gain(r / 10) == "warned", _gain(10 * r) == "refused"
+
+
+@pin("DECAY_RTOL")
+def _():
+    r = DECLARED["DECAY_RTOL"]
+    meets = _meets_each(np.array([-1 + r / 10 + 0j]), False, 1.0)[0]
+    misses = not _meets_each(np.array([-1 + 10 * r + 0j]), False, 1.0)[0]
+    return bool(meets), bool(misses)
+
+
+@pin("TIME_GRID_RTOL")
+def _():
+    r = DECLARED["TIME_GRID_RTOL"]
+    plant = ut.Plant([[0.5]], [[1.0]], dt=1.0)
+
+    def on_grid(e):
+        return outcome(lambda: _check_discrete_grid(plant, np.arange(11) * (1 + e))) == "ok"
+
+    return on_grid(r / 10), not on_grid(10 * r)
+
+
+# the tests --------------------------------------------------------------------------------------
+def test_every_tolerance_has_a_pin():
+    assert set(PINS) == set(tols.ALL)
+
+
+@pytest.mark.parametrize("name", sorted(tols.ALL))
+def test_tolerance_holds(name):
+    inside, outside = PINS[name]()
+    assert inside, f"{name}: a case a tenth inside is not accepted"
+    assert outside, f"{name}: a case ten times outside is not refused"
+
+
+@pytest.mark.parametrize("factor", [100.0, 0.01], ids=["looser", "tighter"])
+@pytest.mark.parametrize("name", sorted(tols.ALL))
+def test_tolerance_is_pinned(name, factor, monkeypatch):
+    monkeypatch.setattr(tols, name, DECLARED[name] * factor)
+    inside, outside = PINS[name]()
+    assert not (inside and outside), f"{name} x {factor:g} passes its pin: it is not pinned"
