@@ -236,8 +236,14 @@ async () => {
 # The page on paper: hidden cells and notes open; links to other pages of the site (which would
 # point at this local server) printed as text, links inside the page and to the web kept.
 PREPARE_JS = """
-(opts) => {
+async (opts) => {
   for (const d of document.querySelectorAll('details')) d.open = true;
+  // a figure's picture for narrow screens gives way to its full-size one, as in the whole book
+  const sources = [...document.querySelectorAll('picture > source[media]')];
+  for (const s of sources) s.remove();
+  if (sources.length) {
+    await Promise.all([...document.images].map((img) => img.decode().catch(() => null)));
+  }
   for (const e of document.querySelectorAll('.toggle-hidden')) e.classList.remove('toggle-hidden');
   if (opts.title) document.title = opts.title;
   if (!opts.keepLinks) {
