@@ -351,7 +351,7 @@ class MissileParams(LabParams):
     --------
     >>> from uio_teach.worked.missile import MissileParams
     >>> MissileParams().to_params()["pmo_poles"]
-    [-100.0, -120.0]
+    [-90.0, -140.0]
     """
 
     @classmethod

@@ -342,7 +342,7 @@ class PA9Params(LabParams):
     --------
     >>> from uio_teach.worked.pa9 import PA9Params
     >>> PA9Params().to_params()["sine"]
-    {'amplitude': 1.0, 'frequency': 2.0}
+    {'amplitude': 1.5, 'frequency': 1.5}
     """
 
     @classmethod
