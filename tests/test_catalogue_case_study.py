@@ -209,7 +209,7 @@ CATALOGUE = {
     ),
     "another initial state": (
         lambda: simulation(sim(x0=[0.0, 1.0, 0.0])),
-        "but the exercise asks for [1, -2, 3]",
+        "but the exercise asks for [2, 1, -1]",
     ),
     "an observer designed for another E": (
         lambda: simulation(

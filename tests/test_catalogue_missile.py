@@ -129,7 +129,7 @@ CATALOGUE = {
     "F = A1 + LC": (lambda: pmo(f=A1 + L @ C), "the sign of LC is flipped"),
     "poles other than asked": (
         lambda: pmo(gain=L_A, f=A1 - L_A @ C),
-        "but the exercise asks for -100, -120",
+        "but the exercise asks for -90, -140",
     ),
     "L = 0": (lambda: pmo(gain=np.zeros((n, p)), f=A1), "but the exercise asks for"),
     # the g-inverse observer ------------------------------------------------------------------

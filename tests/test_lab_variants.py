@@ -159,7 +159,7 @@ def test_the_checks_follow_the_config_poles():
     A, C, E = plant.A, plant.C, plant.E
     H = E @ np.linalg.pinv(C @ E)
     T = np.eye(3) - H @ C
-    K1 = ct.place((T @ A).T, C.T, [-1, -2, -3]).T
+    K1 = ct.place((T @ A).T, C.T, PA9Params().poles).T
     F = T @ A - K1 @ C
     term = PA9Params(poles=(-2.0, -3.0, -4.0)).to_params()
     assert checks.pa9_design(H, T, K1, F, F @ H, poles=PA9Params().to_params()["poles"]).passed

@@ -383,11 +383,16 @@ class FigureConfig(Mapping[str, Any]):
     ----------
     source : str
         Where the values came from.
+    given : frozenset of str
+        The keys the source set (the rest are defaults); a lab takes only
+        these from the config, and its own numbers for the rest.
 
     Examples
     --------
     >>> from uio_teach.instructor.config import FigureConfig
     >>> cfg = FigureConfig.from_dict({"pa9": {"sine": {"amplitude": 3}}})
+    >>> sorted(cfg.given)
+    ['pa9.sine.amplitude']
     >>> cfg["pa9.sine.amplitude"], cfg["pa9.sine.frequency"]
     (3.0, 2.0)
     >>> [p.real for p in cfg["pa9.poles"]]
@@ -401,6 +406,7 @@ class FigureConfig(Mapping[str, Any]):
         merged.update(values or {})
         self._values = MappingProxyType(merged)
         self.source = source
+        self.given = frozenset(values or {})
 
     @classmethod
     def from_dict(

@@ -56,7 +56,7 @@ from . import ExplorerOptions, FigureEntry, LabEntry, WorkedExample
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-__all__ = ["PA9Experiment", "PA9", "PA9Params"]
+__all__ = ["PA9Experiment", "PA9", "PA9_LAB", "PA9Params"]
 
 
 @dataclass(frozen=True)
@@ -325,9 +325,24 @@ def _pa9_luenberger(runs: Any) -> Figure:
 # the lab ---------------------------------------------------------------------------------------
 
 
-@lab_params_of(PA9)
+PA9_LAB = PA9.with_values(
+    poles=(-1.5, -2.5, -4.0),
+    initial_state=(0.5, 1.0, -1.0),
+    sine_amplitude=1.5,
+    sine_frequency=1.5,
+    switch_times=(0.0, 1.5, 4.0, 8.0),
+    switch_values=(-1.0, 2.0, 0.5, -1.5),
+)
+"""The lab's own numbers: the chapter's plant and grid, other poles, start and disturbances.
+
+The chapters print the results of :data:`PA9` (``K1``, the errors, ...); the
+lab asks for the same computations on these numbers, so no page of the book
+gives its answers away."""
+
+
+@lab_params_of(PA9_LAB)
 class PA9Params(LabParams):
-    """The numbers of the PA9 lab (the fields of :data:`PA9` for the lab).
+    """The numbers of the PA9 lab (the fields of :data:`PA9_LAB`: not the chapter's run).
 
     Attributes
     ----------
@@ -360,7 +375,7 @@ class PA9Params(LabParams):
     --------
     >>> from uio_teach.worked.pa9 import PA9Params
     >>> PA9Params().to_params()["sine"]
-    {'amplitude': 1.0, 'frequency': 2.0}
+    {'amplitude': 1.5, 'frequency': 1.5}
     """
 
     @classmethod
