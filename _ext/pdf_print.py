@@ -239,6 +239,12 @@ PREPARE_JS = """
 async (opts) => {
   for (const d of document.querySelectorAll('details')) d.open = true;
   // a figure's picture for narrow screens gives way to its full-size one, as in the whole book
+  // the image is the PDF's figure, with its text alternative; an HTML <figure> around it is a
+  // box only (tagged as a figure of its own it would be one without a text alternative, and a
+  // reader of the PDF would skip what it holds, the description in words included)
+  for (const f of document.querySelectorAll('figure')) {
+    if (f.querySelector('img[alt]') && !f.hasAttribute('role')) f.setAttribute('role', 'none');
+  }
   const sources = [...document.querySelectorAll('picture > source[media]')];
   for (const s of sources) s.remove();
   if (sources.length) {
