@@ -180,7 +180,7 @@ CATALOGUE = {
     "K2 = K1 - FH": (lambda: design(k2=K1 - F @ H), "Your K2 is K1 - FH"),
     "K1 placing -4, -5, -6": (
         lambda: design(k1=K1_FAST, f=T @ A - K1_FAST @ C, k2=(T @ A - K1_FAST @ C) @ H),
-        "but the exercise asks for -3, -2, -1",
+        "but the exercise asks for -4, -2.5, -1.5",
     ),
     "K1 placed for A instead of TA": (
         lambda: design(k1=K1_A, f=T @ A - K1_A @ C, k2=(T @ A - K1_A @ C) @ H),
@@ -204,7 +204,7 @@ CATALOGUE = {
     ),
     "another initial state": (
         lambda: simulation(sim(x0=[0.0, 1.0, 0.0])),
-        "the plant starts from x(0) = [0, 1, 0], but the exercise asks for [1, -1, 0.5]",
+        "the plant starts from x(0) = [0, 1, 0], but the exercise asks for [0.5, 1, -1]",
     ),
     "a zero initial state": (
         lambda: simulation(sim(x0=[0.0, 0.0, 0.0])),
@@ -217,7 +217,7 @@ CATALOGUE = {
     ),
     "an observer with other poles": (
         lambda: simulation(sim(ut.design_uio(PLANT, poles=[-4, -5, -6]))),
-        "the simulated observer has the poles -6, -5, -4, not the -1, -2, -3 of the exercise",
+        "the simulated observer has the poles -6, -5, -4, not the -1.5, -2.5, -4 of the exercise",
     ),
     "a valid other H, but design_uio(K1=K1) simulated": (
         lambda: simulation(sim(ut.design_uio(PLANT, K1=K1_OTHER)), h=H_OTHER, k1=K1_OTHER),

@@ -33,7 +33,7 @@ def expected_files(names: list[str], fmt: str = "png") -> set[str]:
         if figures.FIGURES[name].table:
             out |= {f"{name}.csv", f"{name}.md"}
         else:
-            out.add(f"{name}.{fmt}")
+            out |= {f"{name}.{fmt}", f"{name}.txt"}  # the picture and its words
     return out
 
 

@@ -21,7 +21,7 @@ Examples
 --------
 >>> from uio_teach.worked.pa9 import PA9Params
 >>> PA9Params().to_params()["poles"]
-[-1.0, -2.0, -3.0]
+[-1.5, -2.5, -4.0]
 >>> PA9Params.from_params(PA9Params().to_params()) == PA9Params()
 True
 """
@@ -296,16 +296,23 @@ class LabParams:
     def from_config(cls, config: Mapping[str, Any] | None) -> LabParams:
         """The parameters of a term config (:func:`uio_teach.instructor.config.load_config`).
 
-        Every field with a config key takes the config's value (the defaults
-        are the same experiments, so a config with no key gives the defaults).
+        Every field whose config key the config sets takes the config's value;
+        the others keep the lab's own defaults, which are not the chapters'
+        runs (the figures' defaults), so that no chapter prints a lab's answer.
+        A config that says which keys it was given (``given``, as
+        ``FigureConfig`` does) sets those; a plain mapping sets every key it has.
         """
         if config is None:
             return cls()
+        given = getattr(config, "given", None)
         kwargs = {}
         for name, spec in cls.declared():
             key = spec.config_key(cls.lab, name)
-            if key is not None and key in config and config[key] is not None:
-                kwargs[name] = lab_value(spec, config[key])
+            if key is None or key not in config or config[key] is None:
+                continue
+            if given is not None and key not in given:
+                continue
+            kwargs[name] = lab_value(spec, config[key])
         return cls(**kwargs)
 
     @classmethod

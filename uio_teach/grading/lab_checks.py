@@ -22,9 +22,9 @@ Examples
 >>> pa9 = lab_checks("pa9")
 >>> pa9.checks[0].check_id, pa9.checks[0].names
 ('pa9.design', ('H', 'T', 'K1', 'F', 'K2'))
->>> obs = ut.design_uio(ut.examples.pa9(), poles=[-1, -2, -3])
->>> answers = {"H": obs.H, "T": obs.T, "K1": obs.K1, "F": obs.F, "K2": obs.K2}
 >>> params = pa9.default_params()
+>>> obs = ut.design_uio(ut.examples.pa9(), poles=params["poles"])
+>>> answers = {"H": obs.H, "T": obs.T, "K1": obs.K1, "F": obs.F, "K2": obs.K2}
 >>> grade_answers(pa9, answers, params)[0].passed
 True
 >>> answers["K1"] = Missing("K1", cell=4, ename="LinAlgError", evalue="Singular matrix")
