@@ -699,7 +699,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
             raise PrintError(f"the whole book: math not typeset: {bad[:3]}")
         await tab.emulate_media(media="print")
         await tab.evaluate(FONTS_JS)
-        prepared = await tab.evaluate(PREPARE_JS, {"title": job.book_title, "keepLinks": True})
+        prepared = await tab.evaluate(PREPARE_JS, {"title": _running_head(job), "keepLinks": True})
 
         targets = await tab.evaluate(
             "() => [...document.querySelectorAll('.print-toc-page')].map(e => e.dataset.target)"
@@ -734,7 +734,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
         target = job.out / f"{job.book_name}.pdf"
         target.write_bytes(pdf)
         headings = [h["text"] for h in prepared["headings"]]
-        finish_pdf(target, job.book_title, prepared["author"], headings)
+        finish_pdf(target, _running_head(job), prepared["author"], headings)
         return target, prepared["overflow"]
     finally:
         await tab.close()
