@@ -239,6 +239,12 @@ PREPARE_JS = """
 async (opts) => {
   for (const d of document.querySelectorAll('details')) d.open = true;
   // a figure's picture for narrow screens gives way to its full-size one, as in the whole book
+  // the image is the PDF's figure, with its text alternative; an HTML <figure> around it is a
+  // box only (tagged as a figure of its own it would be one without a text alternative, and a
+  // reader of the PDF would skip what it holds, the description in words included)
+  for (const f of document.querySelectorAll('figure')) {
+    if (f.querySelector('img[alt]') && !f.hasAttribute('role')) f.setAttribute('role', 'none');
+  }
   const sources = [...document.querySelectorAll('picture > source[media]')];
   for (const s of sources) s.remove();
   if (sources.length) {
@@ -693,7 +699,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
             raise PrintError(f"the whole book: math not typeset: {bad[:3]}")
         await tab.emulate_media(media="print")
         await tab.evaluate(FONTS_JS)
-        prepared = await tab.evaluate(PREPARE_JS, {"title": job.book_title, "keepLinks": True})
+        prepared = await tab.evaluate(PREPARE_JS, {"title": _running_head(job), "keepLinks": True})
 
         targets = await tab.evaluate(
             "() => [...document.querySelectorAll('.print-toc-page')].map(e => e.dataset.target)"
@@ -728,7 +734,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
         target = job.out / f"{job.book_name}.pdf"
         target.write_bytes(pdf)
         headings = [h["text"] for h in prepared["headings"]]
-        finish_pdf(target, job.book_title, prepared["author"], headings)
+        finish_pdf(target, _running_head(job), prepared["author"], headings)
         return target, prepared["overflow"]
     finally:
         await tab.close()
