@@ -8,6 +8,7 @@ parametrisations, with no other edit anywhere.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import subprocess
 import sys
@@ -18,7 +19,7 @@ import pytest
 
 from uio_teach.instructor import cli, figures
 from uio_teach.instructor.config import FigureConfig, config_schema
-from uio_teach.worked import WORKED, discover
+from uio_teach.worked import WORKED, RegistryError, discover
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -196,3 +197,18 @@ def test_the_tests_parametrise_over_it(motor_package):
     assert "test_every_declared_field_reaches_the_config_the_lab_and_the_explorer[dc_motor]" in ids
     assert "test_every_config_key_changes_an_output[dc_motor.inertia]" in ids
     assert "[dc_motor]" in ids.split("test_explorers.py", 1)[1]
+
+
+def test_a_figure_name_taken_twice_is_refused(motor_package):
+    """Two figures of one name would leave one of them out of ``uio-teach figures`` unseen."""
+    module = sys.modules["extra_examples.dc_motor"]
+    (entry,) = module.EXAMPLES
+    clash = dataclasses.replace(entry.figures[0], name="pa9_sine", description="another pa9_sine")
+    module.EXAMPLES = (dataclasses.replace(entry, figures=(clash,)),)
+    with pytest.raises(RegistryError, match="figures declared twice: pa9_sine"):
+        discover()
+    module.EXAMPLES = ({"name": "not an entry"},)
+    with pytest.raises(RegistryError, match=r"extra_examples.dc_motor.EXAMPLES holds \{"):
+        discover()
+    module.EXAMPLES = (entry,)
+    assert discover()[-1] == "dc_motor"

@@ -497,12 +497,19 @@ class _Registry(RegistryView):
             for path, prefix in self._packages:
                 for info in pkgutil.iter_modules(path):
                     module = importlib.import_module(f"{prefix}.{info.name}")
-                    found += list(getattr(module, "EXAMPLES", ()))
+                    for entry in getattr(module, "EXAMPLES", ()):
+                        if not isinstance(entry, WorkedExample):
+                            raise RegistryError(
+                                f"{module.__name__}.EXAMPLES holds {entry!r}, not a WorkedExample"
+                            )
+                        found.append(entry)
             found.sort(key=lambda e: (e.order, e.name))
             names = [e.name for e in found]
-            twice = sorted({n for n in names if names.count(n) > 1})
-            if twice:
-                raise RegistryError(f"worked examples declared twice: {', '.join(twice)}")
+            figures = [f.name for e in found for f in e.figures]
+            for what, seen in (("worked examples", names), ("figures", figures)):
+                twice = sorted({n for n in seen if seen.count(n) > 1})
+                if twice:
+                    raise RegistryError(f"{what} declared twice: {', '.join(twice)}")
             self._entries = {e.name: e for e in found}
         return self._entries
 
