@@ -159,7 +159,11 @@ class StudentEdition(SphinxTransform):
             if isinstance(section.parent, nodes.section):  # a section of a page: dropped whole
                 self._drop(section)
                 continue
-            # the page itself (the instructors' page, in the table of contents): a stub
+            # the page itself (the instructors' page, in the table of contents): a stub; its
+            # sections go with their labels (a reference to one reads as its title)
+            for nested in list(section.findall(nodes.section))[1:]:
+                if self._attached(nested):
+                    self._drop(nested)
             title = section.next_node(nodes.title)
             for child in list(section.children):
                 if child is not title:
