@@ -161,7 +161,8 @@ class StudentEdition(SphinxTransform):
                 continue
             # the page itself (the instructors' page, in the table of contents): a stub; its
             # sections go with their labels (a reference to one reads as its title)
-            for nested in list(section.findall(nodes.section))[1:]:
+            # last first: a section's label may close the section before it, still in place
+            for nested in reversed(list(section.findall(nodes.section))[1:]):
                 if self._attached(nested):
                     self._drop(nested)
             title = section.next_node(nodes.title)

@@ -629,6 +629,7 @@ STUB_BOOK = {
     "See {ref}`sec-demo-grading` and {ref}`the grading <sec-demo-grading>`.\n\n"
     "## Work\n\nText.\n\n(sec-demo-tutors)=\n## Instructor notes\n\nSECRET-NOTE.\n",
     "instructors.md": "(sec-demo-instructors)=\n# For instructors\n\nSECRET-STUB.\n\n"
+    "## Handing out\n\nSECRET-HANDOUT.\n\n"
     "(sec-demo-grading)=\n## Grading\n\nSECRET-GRADING.\n",
 }
 
