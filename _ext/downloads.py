@@ -76,14 +76,15 @@ def _sources_digest(root: Path) -> str:
     return digest.hexdigest()
 
 
-def build_wheel(root: Path, target: Path) -> Path:
+def build_wheel(root: Path, target: Path, stamps: Path) -> Path:
     """Build the package's wheel from a copy of the sources into ``target``; no network.
 
     Nothing is written into the sources (setuptools builds in the copy), and a wheel that is
-    already there, built from the same sources, is kept.
+    already there, built from the same sources (their digest is kept in ``stamps``, outside the
+    site), is kept.
     """
     name = wheel_name(root)
-    wheel, stamp = target / name, target / f".{name}.sha256"
+    wheel, stamp = target / name, stamps / f"{name}.sha256"
     digest = _sources_digest(root)
     if wheel.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
         return wheel
@@ -108,6 +109,7 @@ def build_wheel(root: Path, target: Path) -> Path:
         for old in target.glob("*.whl"):
             old.unlink()
         shutil.move(built, wheel)
+    stamps.mkdir(parents=True, exist_ok=True)
     stamp.write_text(digest + "\n")
     return wheel
 
@@ -223,7 +225,7 @@ def print_pages(app: Sphinx, exception: Exception | None) -> None:
     if exception is not None or app.builder.format != "html":
         return
     outdir = Path(app.outdir)
-    wheel = build_wheel(project_root(app), outdir / DOWNLOADS)
+    wheel = build_wheel(project_root(app), outdir / DOWNLOADS, Path(app.doctreedir))
     logger.info(f"the package's wheel: {wheel.relative_to(outdir)}")
     site_pdfs = outdir / PDF_DIR
     if not app.config.uio_teach_pdf:

@@ -236,8 +236,14 @@ async () => {
 # The page on paper: hidden cells and notes open; links to other pages of the site (which would
 # point at this local server) printed as text, links inside the page and to the web kept.
 PREPARE_JS = """
-(opts) => {
+async (opts) => {
   for (const d of document.querySelectorAll('details')) d.open = true;
+  // a figure's picture for narrow screens gives way to its full-size one, as in the whole book
+  const sources = [...document.querySelectorAll('picture > source[media]')];
+  for (const s of sources) s.remove();
+  if (sources.length) {
+    await Promise.all([...document.images].map((img) => img.decode().catch(() => null)));
+  }
   for (const e of document.querySelectorAll('.toggle-hidden')) e.classList.remove('toggle-hidden');
   if (opts.title) document.title = opts.title;
   if (!opts.keepLinks) {
@@ -328,6 +334,7 @@ async (book) => {
     }
     for (const img of source.querySelectorAll('img[src]')) {
       img.setAttribute('src', new URL(img.getAttribute('src'), url).href);
+      img.removeAttribute('loading');  // every image loaded before printing, not when seen
     }
     for (const s of source.querySelectorAll('source[srcset]')) s.remove();
     for (const a of source.querySelectorAll('a[href]')) {
@@ -349,12 +356,16 @@ async (book) => {
       for (const e of copy.querySelectorAll('[id]')) e.removeAttribute('id');
       return copy.innerHTML;
     };
+    // the contents point at the headings themselves: a section's box may begin at the foot of
+    // the sheet before the one its heading is printed on
     const h1 = chapter.querySelector('h1');
-    const sections = [...chapter.querySelectorAll('h2')].map((h) => ({
-      id: h.closest('section[id]') ? h.closest('section[id]').id : '',
-      html: inner(h),
-    }));
-    parts.push({page, chapter, h1: h1 ? inner(h1) : page.title, sections});
+    if (h1 && !h1.id) h1.id = `${page.name}--title`;
+    const sections = [...chapter.querySelectorAll('h2')].map((h, i) => {
+      if (!h.id) h.id = `${page.name}--heading-${i + 1}`;
+      return {id: h.id, html: inner(h)};
+    });
+    parts.push({page, chapter, h1: h1 ? inner(h1) : page.title, h1id: h1 ? h1.id : chapter.id,
+                sections});
   }
   // the title page and the contents
   const cover = document.createElement('section');
@@ -378,18 +389,33 @@ async (book) => {
     const entry = (id, inner, level) =>
       `<li class="print-toc-${level}"><a href="#${id}"><span class="print-toc-text">` +
       `${inner}</span><span class="print-toc-page" data-target="${id}">000</span></a></li>`;
-    list += entry(`${p.page.name}--top`, p.h1, 'chapter');
+    list += entry(p.h1id, p.h1, 'chapter');
     const subs = p.sections.filter((s) => s.id).map((s) => entry(s.id, s.html, 'section'));
     if (subs.length) list += `<li class="print-toc-sections"><ol>${subs.join('')}</ol></li>`;
   }
   list += '</ol>';
   toc.innerHTML = list;
   article.replaceChildren(cover, toc, ...parts.map((p) => p.chapter));
+  // the layout, and so the page numbers, are final only once every image has its size
+  await Promise.all([...document.images].map((img) => img.complete ? null :
+    new Promise((resolve) => { img.addEventListener('load', resolve);
+                               img.addEventListener('error', resolve); })));
+  const broken = [...document.images].filter((img) => !img.naturalWidth).map((img) => img.src);
+  if (broken.length) throw new Error(`images that do not load: ${broken.slice(0, 3)}`);
   document.title = book.title;
   for (const e of document.querySelectorAll('#jb-print-docs-body, .bd-sidebar-secondary')) {
     e.remove();
   }
   return parts.length;
+}
+"""
+
+# Every font the page declares loaded (MathJax's are loaded as glyphs first appear: a cell opened
+# for printing may need one that the screen did not, and a late font changes the layout).
+FONTS_JS = """
+async () => {
+  await Promise.all([...document.fonts].map((f) => f.load().catch(() => null)));
+  await document.fonts.ready;
 }
 """
 
@@ -444,6 +470,11 @@ FOOTER = (
     '<div style="font-size:8pt;color:#333;width:100%;text-align:center;font-family:sans-serif">'
     '<span class="pageNumber"></span> / <span class="totalPages"></span></div>'
 )
+
+
+def _running_head(job: Job) -> str:
+    """The book's name at the top of a page's sheets, with its edition when it has one."""
+    return f"{job.book_title} \u2014 {job.subtitle}" if job.subtitle else job.book_title
 
 
 def _page_title(title: str, book: str) -> str:
@@ -623,12 +654,13 @@ async def print_page(context, job: Job, page: Page) -> tuple[Path, list[str]]:  
     try:
         title = _page_title(await tab.title(), job.book_title)
         await tab.emulate_media(media="print")
+        await tab.evaluate(FONTS_JS)
         prepared = await tab.evaluate(PREPARE_JS, {"title": title, "keepLinks": False})
 
         target = job.out / f"{page.name}.pdf"
         await tab.pdf(
             path=target,
-            header_template=_header(job.book_title, title),
+            header_template=_header(_running_head(job), title),
             footer_template=FOOTER,
             **PDF_OPTIONS,
         )
@@ -660,6 +692,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
         if bad:
             raise PrintError(f"the whole book: math not typeset: {bad[:3]}")
         await tab.emulate_media(media="print")
+        await tab.evaluate(FONTS_JS)
         prepared = await tab.evaluate(PREPARE_JS, {"title": job.book_title, "keepLinks": True})
 
         targets = await tab.evaluate(
@@ -670,8 +703,13 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
             footer_template=FOOTER,
             **PDF_OPTIONS,
         )
-        numbers: dict[str, int] = {}
-        for _ in range(3):  # the numbers take the placeholders' room: one more printing suffices
+        # Print until the sheets the headings land on are those the contents say. Chromium's
+        # layout of a long document can alternate between two printings (a heading by a page
+        # break goes to one sheet or the next): the contents are changed only when two
+        # printings in a row agree, and the first printing that matches them is kept.
+        numbers: dict[str, int] | None = None
+        previous: dict[str, int] | None = None
+        for _ in range(6):
             pdf = await tab.pdf(**options)
             found = destination_pages(pdf, targets)
             missing = sorted(set(targets) - set(found))
@@ -679,10 +717,14 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
                 raise PrintError(f"the whole book: no destination for {missing[:5]}")
             if found == numbers:
                 break
-            numbers = found
-            await tab.evaluate(SET_TOC_PAGES_JS, numbers)
+            if numbers is None or found == previous:
+                numbers = found
+                await tab.evaluate(SET_TOC_PAGES_JS, numbers)
+            previous = found
         else:
-            raise PrintError("the whole book: the contents' page numbers do not settle")
+            moved = {k: (numbers[k], v) for k, v in found.items() if numbers[k] != v}
+            some = dict(list(moved.items())[:5])
+            raise PrintError(f"the whole book: the contents' page numbers do not settle: {some}")
         target = job.out / f"{job.book_name}.pdf"
         target.write_bytes(pdf)
         headings = [h["text"] for h in prepared["headings"]]

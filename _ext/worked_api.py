@@ -8,6 +8,7 @@ example is one new module of :mod:`uio_teach.worked`; the API page lists it with
 
 from __future__ import annotations
 
+import importlib
 import inspect
 from typing import Any
 
@@ -17,24 +18,21 @@ from sphinx.application import Sphinx
 from sphinx.util.docutils import SphinxDirective
 
 
-def worked_modules() -> list[str]:
-    """The modules of the registry's worked examples, in the book's order, each once."""
+def worked_modules() -> dict[str, str]:
+    """The modules of the registry's worked examples and their titles, in the book's order."""
     from uio_teach.worked import WORKED
 
-    modules: list[str] = []
+    modules: dict[str, str] = {}
     for entry in WORKED.values():
-        module = entry.experiment.partition(":")[0]
-        if module not in modules:
-            modules.append(module)
+        modules.setdefault(entry.experiment.partition(":")[0], entry.title)
     return modules
 
 
-def module_lines(name: str) -> list[str]:
-    """The reStructuredText of one worked example's module."""
-    import importlib
-
+def module_lines(name: str, title: str = "") -> list[str]:
+    """The reStructuredText of one worked example's module (under a rubric: its title)."""
     module = importlib.import_module(name)
-    lines = [f".. automodule:: {name}", "   :no-members:", ""]
+    lines = [f".. rubric:: {title}", ""] if title else []
+    lines += [f".. automodule:: {name}", "   :no-members:", ""]
     for member in getattr(module, "__all__", ()):
         obj = getattr(module, member)
         if inspect.isclass(obj):
@@ -53,8 +51,8 @@ class WorkedExamples(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         lines: list[str] = []
-        for name in worked_modules():
-            lines += module_lines(name)
+        for name, title in worked_modules().items():
+            lines += module_lines(name, title)
         container = nodes.container()
         self.state.nested_parse(StringList(lines, source="worked-examples"), 0, container)
         return container.children

@@ -26,7 +26,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import colour_vision, figure_text, plotting
-from uio_teach.experiments import PA9
+from uio_teach.worked.pa9 import PA9
 
 ROOT = Path(__file__).resolve().parents[1]
 OKABE_ITO = {"#E69F00", "#56B4E9", "#009E73", "#F0E442", "#0072B2", "#D55E00", "#CC79A7", "#000000"}

@@ -657,3 +657,68 @@ def test_landing_page_and_readme_list_the_chapters_in_reading_order() -> None:
     named = re.findall(r"`(\w+)\.md`", readme)
     in_order = [name for name in dict.fromkeys(named) if name in chapters]
     assert in_order == chapters, f"README.md lists {in_order}, the contents say {chapters}"
+
+
+# --- the instructor edition --------------------------------------------------------------------
+
+INSTRUCTOR = ROOT / "_build" / "instructor"  # as `make book-instructor` writes it
+
+
+@pytest.mark.slow  # a second build of the book, every page opened at two widths
+@pytest.mark.browser
+def test_the_instructor_edition_meets_wcag_21_aa(built_book: Path, browser) -> None:
+    """The instructor edition (the labs' solutions, the tutors' notes, the instructors' page) at
+    1280 and 390 px: no WCAG 2.1 A or AA violation, every picture described.
+
+    Both editions execute the same notebooks (``_ext/editions.py``), so the build reads the
+    execution cache of the student edition built for this run (``built_book``): no chapter runs
+    again, and the build costs the writing of the pages only.
+    """
+    import functools
+    import shutil
+    import subprocess
+    import threading
+    from http.server import ThreadingHTTPServer
+
+    from conftest import _QuietHandler, jupyter_book
+
+    cache = INSTRUCTOR / "_build" / ".jupyter_cache"
+    shutil.rmtree(cache, ignore_errors=True)
+    shutil.copytree(ROOT / "_build" / ".jupyter_cache", cache)
+    command = [jupyter_book(), "build", ".", "--all", "-W", "-n", "--keep-going"]
+    proc = subprocess.run(
+        [*command, "--path-output", str(INSTRUCTOR)],
+        cwd=ROOT,
+        env={**os.environ, "UIO_TEACH_EDITION": "instructor"},
+        capture_output=True,
+        text=True,
+        timeout=BUILD_TIMEOUT,
+    )
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    html = INSTRUCTOR / "_build" / "html"
+    handler = functools.partial(_QuietHandler, directory=str(html))
+    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    found = {}
+    try:
+        base = f"http://127.0.0.1:{server.server_address[1]}"
+        for page in PAGES:
+            for width in (1280, 390):
+                context, tab = _open_local(browser, base, page, width)
+                try:
+                    tab.evaluate(
+                        "document.querySelectorAll('main details').forEach(d => d.open = true)"
+                    )
+                    violations = axe_violations(tab)
+                    pictures = tab.evaluate(_STRUCTURE_JS)["pictures"]
+                finally:
+                    context.close()
+                silent = [p["src"] for p in pictures if _NAMELESS.search(p["alt"].strip())]
+                if violations or silent:
+                    found[f"{page} at {width} px"] = [
+                        f"{v['id']} ({v['count']}): {v['where']}" for v in violations
+                    ] + [f"picture without words: {s}" for s in silent]
+    finally:
+        server.shutdown()
+        server.server_close()
+    assert not found, "instructor edition: " + "\n".join(f"{k}: {v}" for k, v in found.items())

@@ -33,7 +33,7 @@ def expected_files(names: list[str], fmt: str = "png") -> set[str]:
         if figures.FIGURES[name].table:
             out |= {f"{name}.csv", f"{name}.md"}
         else:
-            out.add(f"{name}.{fmt}")
+            out |= {f"{name}.{fmt}", f"{name}.txt"}  # the picture and its words
     return out
 
 
@@ -178,7 +178,8 @@ def test_only_restricts_and_progress_lines_and_summary(tmp_path, capsys):
     assert lines[0].startswith("[1/2] case_error: ") and lines[0].endswith(" s)")
     assert lines[1].startswith("[2/2] missile_table2: ")
     assert lines[2].startswith(
-        f"2 of 2 figures (3 files) and {figures.MANIFEST} written to {tmp_path} in "
+        f"2 of 2 figures ({len(expected_files(['case_error', *TABLES])) - 1} files) and "
+        f"{figures.MANIFEST} written to {tmp_path} in "
     )
 
 

@@ -126,3 +126,70 @@ def test_a_key_declared_twice_differently_is_refused():
                 **{k: v for k, v in experiments.EXPERIMENTS.items() if k != "pa9"},
             }
         )
+
+
+# a configured value is never replaced by a default unseen -----------------------------------------
+
+
+@dataclasses.dataclass(frozen=True)
+class PA9WithPhase(PA9Experiment):
+    """PA9 with the sine's phase: one line, and every group of a term gets its configured value."""
+
+    phase: float = param(0.0, "float", "phase of the sinusoid", unit="rad", key="sine.phase")
+
+
+@pytest.fixture
+def with_phase(monkeypatch):
+    experiment = PA9WithPhase(name="pa9", timepts=PA9.timepts)
+    monkeypatch.setattr(pa9, "PA9", experiment)
+
+    @lab_params_of(experiment)
+    class PhaseParams(PA9Params):
+        pass
+
+    return PhaseParams
+
+
+def test_a_configured_field_the_draw_does_not_vary_reaches_every_group(with_phase, tmp_path):
+    from uio_teach.instructor.lab_registry import Lab
+    from uio_teach.instructor.variants import draw_variants
+
+    term = tmp_path / "term.toml"
+    term.write_text("seed = 11\n[pa9]\nduration = 12.0\n[pa9.sine]\nphase = 0.7\n")
+    base = with_phase.from_config(load_config(term))
+    assert base.phase == 0.7
+    lab = Lab("pa9", "lab_pa9.md", with_phase, LABS["pa9"].check_ids)
+    variants = draw_variants(lab, 3, seed=2027, base=base)
+    for variant in variants:
+        assert variant.phase == 0.7 and variant.to_params()["sine"]["phase"] == 0.7
+        assert variant.duration == 12.0 and variant.seed == 11  # configured, not drawn
+    # what the draw varies is drawn per group
+    assert len({v.poles for v in variants}) == 3
+
+
+@pytest.mark.parametrize("name", list(LABS))
+def test_a_group_keeps_every_field_its_lab_does_not_draw(name):
+    """Whatever fields a lab has, the draw replaces only those its class draws (``vary``)."""
+    import numpy as np
+
+    params = LABS[name].params
+    base = params()
+    drawn = params.vary(np.random.default_rng(1), base)
+    variant = params.draw(np.random.default_rng(1), base)
+    for field in dataclasses.fields(variant):
+        if field.name not in drawn:
+            assert getattr(variant, field.name) == getattr(base, field.name), field.name
+    assert set(drawn) < {f.name for f in dataclasses.fields(variant)}
+
+
+def test_params_with_an_unknown_or_a_missing_entry_are_refused():
+    from uio_teach.lab_params import LabParamsError
+
+    params = PA9Params().to_params()
+    with pytest.raises(LabParamsError, match=r"unknown entry 'sine.phase'; expected some of"):
+        PA9Params.from_params({**params, "sine": {**params["sine"], "phase": 0.7}})
+    with pytest.raises(LabParamsError, match=r"unknown entry 'noise_level'"):
+        PA9Params.from_params({**params, "noise_level": 0.1})
+    del params["poles"]
+    with pytest.raises(LabParamsError, match=r"'poles' is missing \(UIO poles"):
+        PA9Params.from_params(params)

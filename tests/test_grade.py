@@ -36,7 +36,7 @@ import nbformat
 import pytest
 
 from uio_teach.grading import grade, sandbox
-from uio_teach.grading.gradebook import safe_cell
+from uio_teach.grading.gradebook import file_cell
 from uio_teach.grading.sandbox import Limits, sandbox_problem
 from uio_teach.instructor import cli
 from uio_teach.instructor.labs import LABS
@@ -422,7 +422,7 @@ def graded(labs, tmp_path_factory) -> dict:
     feedback = out.parent / "grades_feedback"
     by_name = {}
     for name, path in subs.items():
-        cell = safe_cell(str(path))
+        cell = file_cell(str(path))
         by_name[name] = table.get(cell)
     texts = {}
     for name, path in subs.items():
@@ -836,7 +836,9 @@ def test_grade_usage_errors(tmp_path, capsys):
 
 
 def test_without_a_sandbox_grading_is_refused_unless_asked(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(grade, "_self_test", lambda limits: "bubblewrap (bwrap) is not installed")
+    monkeypatch.setattr(
+        grade, "_self_test", lambda limits, stop=None: "bubblewrap (bwrap) is not installed"
+    )
     nb = small(tmp_path / "pa9_g01.ipynb", "g01", design=False)
     out = tmp_path / "grades.csv"
     assert cli.main(["grade", str(nb), "--out", str(out)]) == 2

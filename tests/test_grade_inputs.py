@@ -18,7 +18,7 @@ from uio_teach.grading.gradebook import (
     Gradebook,
     Submission,
     feedback_names,
-    safe_cell,
+    file_cell,
     shown,
 )
 from uio_teach.grading.rosters import (
@@ -60,6 +60,8 @@ def test_names_of_any_legal_length_and_encoding_get_their_own_feedback_file(tmp_
         "x" * 241 + "_pa9_g01.ipynb",  # 255 bytes
         "x" * 241 + "_pa9_g02.ipynb",  # the same first 200 bytes
         "é" * 118 + "_pa9_g03.ipynb",  # 255 bytes of two-byte characters
+        "a\nb_pa9_g05.ipynb",  # a line break is legal in a name
+        "a b_pa9_g05.ipynb",  # and this is another hand-in
         os.fsdecode(b"Jos\xe9_pa9_g04.ipynb"),  # Latin-1, not UTF-8
     ]
     assert all(len(os.fsencode(f)) <= 255 for f in files)
@@ -72,7 +74,8 @@ def test_names_of_any_legal_length_and_encoding_get_their_own_feedback_file(tmp_
         for file in files:
             book.add(Submission(file, "pa9", "g01", "ok", expected=("pa9.design",)))
     table = list(csv.reader(out.open(encoding="utf-8")))
-    assert [r[0] for r in table[1:]] == [safe_cell(f) for f in files]
+    assert [r[0] for r in table[1:]] == [file_cell(f) for f in files]
+    assert len({r[0] for r in table[1:]}) == len(files)  # every hand-in its own row
     assert table[-1][0] == "Jos\\xe9_pa9_g04.ipynb"  # readable, distinct, valid UTF-8
     texts = sorted(p for p in (tmp_path / "grades_feedback").iterdir() if p.suffix == ".txt")
     assert len(texts) == len(files)

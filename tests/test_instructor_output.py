@@ -120,7 +120,13 @@ def test_a_good_run_over_last_term_leaves_only_this_terms_files(tmp_path, last_t
     config.write_text("seed = 11\n[missile]\npmo_poles = [-90, -140]\n")
     assert make(last_term, "--config", str(config)) == 0
     names = {p.name for p in last_term.iterdir()}
-    assert names == {"case_error.png", "missile_table2.csv", "missile_table2.md", output.MANIFEST}
+    assert names == {
+        "case_error.png",
+        "case_error.txt",
+        "missile_table2.csv",
+        "missile_table2.md",
+        output.MANIFEST,
+    }
     assert sorted(os.listdir(tmp_path)) == ["figures", "term.toml"]  # no temporary left
     manifest = json.loads((last_term / output.MANIFEST).read_text())
     assert manifest["config"]["seed"] == 11
@@ -396,9 +402,9 @@ def test_folders_get_the_users_usual_permissions(tmp_path, mask):
         assert stat.S_IMODE(folder.stat().st_mode) == expected, folder
 
 
-# steps of figures_argv: case_error.png (1), missile_table2.csv and .md (2, 3), the manifest
-# (4), before the swap (5), after it (6)
-@pytest.mark.parametrize("kill_at", [1, 3, 4, 5, 6])
+# steps of figures_argv: case_error.png and its words case_error.txt (1, 2), missile_table2.csv
+# and .md (3, 4), the manifest (5), before the swap (6), after it (7)
+@pytest.mark.parametrize("kill_at", [1, 2, 4, 5, 6, 7])
 @pytest.mark.subprocess
 def test_figures_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, kill_at):
     sets = {}
@@ -414,7 +420,7 @@ def test_figures_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, k
     assert cli.main(old) == 0
     proc = uio_teach(*new, kill_at=kill_at)
     assert proc.returncode == -signal.SIGKILL, proc.stderr
-    assert snapshot(out) == (sets[2] if kill_at == 6 else sets[1])
+    assert snapshot(out) == (sets[2] if kill_at == 7 else sets[1])
     assert cli.main(new) == 0
     assert snapshot(out) == sets[2] and leftovers(run) == []
 

@@ -177,6 +177,35 @@ def test_numbers_that_make_no_fair_lab_are_a_usage_error(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_configured_value_the_groups_do_not_keep_is_said(tmp_path, capsys):
+    """Each group draws its own poles: the term's poles are not silently dropped, they are named."""
+    config = tmp_path / "term.toml"
+    config.write_text("[pa9]\npoles = [-2.0, -3.0, -4.0]\n[pa9.sine]\nfrequency = 2.5\n")
+    args = ["labs", "--out", str(tmp_path / "out"), "--config", str(config), "-q"]
+    assert cli.main(args) == 0
+    assert "note" not in capsys.readouterr().err  # one notebook per lab: every value is kept
+    assert cli.main([*args, "--groups", "2", "--seed", "4"]) == 0
+    err = capsys.readouterr().err
+    assert "note: pa9.poles = [-2, -3, -4] is not kept: each group's variant" in err, err
+    assert "note: pa9.sine.frequency = 2.5 is not kept" in err, err
+    assert "missile" not in err and "case_study" not in err  # nothing of theirs was set
+
+
+def test_a_configured_value_the_notebooks_do_not_read_is_said():
+    cfg = load_config_text("[pa9]\nnoise = 0.05\n")
+    (note,) = labs.config_notes(labs.LABS["pa9"], cfg, groups=False)
+    assert note.startswith("pa9.noise of the term config reaches the pa9 lab's PARAMS, but its")
+    assert labs.config_notes(labs.LABS["missile"], cfg, groups=True) == []
+
+
+def load_config_text(text: str):
+    import tomllib
+
+    from uio_teach.instructor.config import FigureConfig
+
+    return FigureConfig.from_dict(tomllib.loads(text))
+
+
 # variants per group ---------------------------------------------------------------------------
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from tolerance import assert_same_run
@@ -155,9 +157,13 @@ def test_bank_figure_draws_every_member_over_its_threshold_with_legible_text():
 
 
 @pytest.mark.slow  # every course figure drawn
-def test_no_legend_of_a_course_figure_covers_a_curve():
+def test_every_course_figure_is_clear_of_its_legends_described_and_apart_without_colour():
+    """No legend covers a curve; the figure says in words what it shows (not a file name, and
+    what the reader should see: how the error ends); no two curves of a panel differ by hue
+    alone for a reader with deuteranopia, protanopia or tritanopia."""
     import matplotlib
 
+    from uio_teach.colour_vision import curves_apart_by_hue_alone
     from uio_teach.instructor import figures
 
     config = figures.FigureConfig()
@@ -169,6 +175,12 @@ def test_no_legend_of_a_course_figure_covers_a_curve():
             fig = figures.FIGURES[name].draw(runs)
         assert any(ax.get_legend() for ax in fig.axes) or fig.legends or name.endswith("zeros")
         assert plotting.covered_curves(fig) == [], name
+        said = plotting.description(fig)
+        assert said is not None and len(said.alt.split()) >= 20, (name, said)
+        assert name not in said.alt and ".png" not in said.alt, said.alt
+        if not name.endswith("zeros"):
+            assert re.search(r"decays to zero|does not settle|zero to rounding", said.alt), said
+        assert curves_apart_by_hue_alone(fig) == [], name
 
 
 def test_the_legend_check_sees_a_legend_over_a_curve():

@@ -12,12 +12,13 @@ import matplotlib.style
 import pytest
 from tolerance import assert_rounding_close
 
-from uio_teach.experiments import EXPERIMENTS, LAB_PLANTS, experiment_params, pole_text
+from uio_teach.experiments import EXPERIMENTS, LAB_PLANTS, experiment_params, param, pole_text
 from uio_teach.explorers import compute_frame
+from uio_teach.explorers.scenarios import plant_controls
 from uio_teach.instructor import figures
 from uio_teach.instructor.config import OBSERVER_KEYS, FigureConfig, config_schema
 from uio_teach.instructor.lab_registry import LABS
-from uio_teach.worked import WORKED, run_from_config
+from uio_teach.worked import WORKED, ExplorerOptions, RegistryError, run_from_config
 
 BOOK = Path(__file__).resolve().parent.parent / "book"
 SCHEMA = config_schema()
@@ -109,8 +110,7 @@ def test_every_declared_field_reaches_the_config_the_lab_and_the_explorer(name):
             assert key in SCHEMA, (name, field)
         if spec.lab and entry.lab:
             assert field in lab_fields, (name, field)
-        if spec.control == "plant":
-            assert field in type(experiment).plant_fields, (name, field)
+        if spec.range is not None and not spec.control:  # a slider of its own
             assert sliders[field].limits == spec.range
             assert sliders[field].value == getattr(experiment, field)
         elif spec.control:
@@ -118,18 +118,46 @@ def test_every_declared_field_reaches_the_config_the_lab_and_the_explorer(name):
             assert lo_hi == spec.range, (name, field)
             if default is not None:
                 assert default == getattr(experiment, field), (name, field)
-    assert set(sliders) <= set(type(experiment).plant_fields)
+    own = {f for f, spec in experiment_params(experiment) if spec.range and not spec.control}
+    assert set(sliders) == own
 
 
-def test_a_plant_slider_remakes_the_plant_and_the_verdict():
+def test_a_slider_of_its_own_remakes_the_run_and_a_plant_slider_the_plant():
     for name, entry in WORKED.items():
         scenario = entry.make_scenario()
+        plant_fields = type(entry.run()).plant_fields
         for control in scenario.plant_controls:
             lo, hi = control.limits
-            other = scenario.rebuild(**{control.name: lo if control.value != lo else hi})
-            assert other.plant != scenario.plant, (name, control.name)
+            value = lo if control.value != lo else hi
+            other = scenario.rebuild(**{control.name: value})
+            assert [c.value for c in other.plant_controls if c.name == control.name] == [value]
+            if control.name in plant_fields:
+                assert other.plant != scenario.plant, (name, control.name)
             frame = compute_frame(other)
             assert frame.scenario is other
+
+
+def test_a_declared_range_gives_a_slider_whatever_the_field():
+    """The set of controls is not closed: a new field with a range is a slider of its own."""
+
+    @dataclasses.dataclass(frozen=True)
+    class Later(type(WORKED["pa9"].run())):
+        start: float = param(1.0, "float", "when d starts", unit="s", range=(0.0, 5.0))
+
+    later = Later(name="pa9", timepts=WORKED["pa9"].run().timepts)
+    (slider,) = plant_controls(later)
+    assert (slider.name, slider.limits, slider.value) == ("start", (0.0, 5.0), 1.0)
+    with pytest.raises(ValueError, match="control must be one of"):
+        param(1.0, "float", "x", range=(0.0, 1.0), control="plant")
+    with pytest.raises(ValueError, match="needs an int or float field"):
+        param((1.0,), "floats", "x", range=(0.0, 1.0))
+
+
+def test_a_slider_value_for_a_field_without_one_is_refused():
+    with pytest.raises(RegistryError, match=r"no slider 'gamma3'; its sliders: gamma1, gamma2"):
+        WORKED["quadruple_tank"].make_scenario(gamma3=0.5)
+    with pytest.raises(RegistryError, match=r"the pa9 explorer has no slider 'poles'"):
+        WORKED["pa9"].make_scenario(poles=(-1.0, -2.0, -3.0))
 
 
 @pytest.mark.slow
@@ -160,3 +188,75 @@ def test_the_figures_run_is_the_config_through_the_declared_fields():
     # gamma1 k1 / A1: two roundings on each side of the comparison.
     assert_rounding_close(run.plant().E[0, 0], 0.8 * 3.33 / 28, terms=2)
     assert run_from_config("case_study", cfg).seed == 9
+
+
+# the explorer's options: a typed object, every mistake named -------------------------------------
+
+REQUIRED = {
+    "period": 1.0,
+    "pole_limits": (-10.0, 1.0),
+    "frequency_limits": (0.0, 10.0),
+    "period_limits": (0.1, 5.0),
+    "static_values": (-1.0, -2.0),
+}
+
+
+@pytest.mark.parametrize("missing", sorted(REQUIRED))
+def test_a_missing_explorer_option_is_named(missing):
+    given = {k: v for k, v in REQUIRED.items() if k != missing}
+    with pytest.raises(RegistryError, match=rf"explorer option '{missing}' is missing"):
+        ExplorerOptions(**given)
+
+
+def test_an_unknown_or_malformed_explorer_option_is_named():
+    with pytest.raises(RegistryError, match=r"unknown explorer option 'noise_limit' \(did you"):
+        ExplorerOptions(**REQUIRED, noise_limit=(0.0, 0.1))
+    with pytest.raises(RegistryError, match=r"'pole_limits' must have low < high"):
+        ExplorerOptions(**{**REQUIRED, "pole_limits": (1.0, -10.0)})
+    with pytest.raises(RegistryError, match=r"'d_channels': each channel is \(gain, speed\)"):
+        ExplorerOptions(**REQUIRED, d_channels=((1.0,),))
+    with pytest.raises(RegistryError, match=r"'static_control' must be 'pole', 'amplitude'"):
+        ExplorerOptions(**REQUIRED, static_control="valve")
+    with pytest.raises(RegistryError, match=r"explorer must be ExplorerOptions, got dict"):
+        dataclasses.replace(WORKED["pa9"], explorer=dict(REQUIRED))
+
+
+def test_an_option_that_a_declared_field_sets_is_refused(monkeypatch):
+    """PA9 declares its noise range: a noise_limits option beside it would be set twice."""
+    entry = dataclasses.replace(
+        WORKED["pa9"],
+        explorer=dataclasses.replace(WORKED["pa9"].explorer, noise_limits=(0.0, 1.0)),
+    )
+    monkeypatch.setitem(WORKED._load(), "pa9", entry)
+    with pytest.raises(RegistryError, match=r"the field 'noise' sets the noise control"):
+        entry.make_scenario()
+
+
+def test_every_worked_example_has_typed_explorer_options():
+    for name, entry in WORKED.items():
+        assert isinstance(entry.explorer, ExplorerOptions), name
+        assert entry.make_scenario().title == (entry.explorer.title or entry.title)
+
+
+def test_a_time_grid_given_twice_is_refused():
+    run = WORKED["pa9"].run()
+    with pytest.raises(ValueError, match="either as timepts or as samples/duration"):
+        run.with_values(timepts=[0.0, 1.0], samples=11)
+    with pytest.raises(ValueError, match=r"has no field 'sine_phase'"):
+        run.with_values(sine_phase=0.7)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"poles": (-5.0, -6.0, -7.0)}, r"its experiment sets the starting poles"),
+        ({"static_control": "plant:gamma1"}, r"static_control 'plant:gamma1' names no slider"),
+    ],
+)
+def test_an_explorer_option_that_would_be_ignored_is_refused(monkeypatch, change, message):
+    entry = dataclasses.replace(
+        WORKED["pa9"], explorer=dataclasses.replace(WORKED["pa9"].explorer, **change)
+    )
+    monkeypatch.setitem(WORKED._load(), "pa9", entry)
+    with pytest.raises(RegistryError, match=message):
+        entry.make_scenario()

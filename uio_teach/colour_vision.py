@@ -63,7 +63,7 @@ _MACHADO = {
     ),
 }
 DEFICIENCIES = ("normal", *_MACHADO)
-"""The readers a figure is checked for: normal colour vision and the three dichromacies."""
+"""The readers a figure is checked for, normal colour vision and the three dichromacies."""
 
 MIN_DISTANCE = 20.0
 """The least colour difference (CIE76 Delta E*ab) at which two thin curves of one panel are

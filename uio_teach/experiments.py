@@ -40,10 +40,11 @@ import numpy as np
 from ._validation import as_matrix
 from .plant import Plant
 from .simulation import UIOResponse, simulate
-from .worked import WORKED
+from .worked import WORKED, RegistryView
 
 __all__ = [
     "Experiment",
+    "ContinuousExperiment",
     "EXPERIMENTS",
     "Param",
     "param",
@@ -55,8 +56,9 @@ __all__ = [
 
 PARAM_KINDS = ("int", "float", "floats", "poles", "str", "style", "matrices")
 """The kinds of value a :class:`Param` declares."""
-CONTROLS = ("amplitude", "frequency", "noise", "plant")
-"""The explorer controls a declared field can set (:attr:`Param.control`)."""
+CONTROLS = ("amplitude", "frequency", "noise")
+"""The explorer's own controls that a declared field can set (:attr:`Param.control`); a
+field with a ``range`` and none of these gets a slider of its own."""
 
 
 @dataclass(frozen=True)
@@ -104,12 +106,15 @@ class Param:
     omit_default : bool
         Left out of ``PARAMS`` while it has its default value.
     range : (float, float), optional
-        The range a student explores (the explorers' sliders).
+        The range a student explores: the field gets a slider in the
+        explorer (of its own, or the control that ``control`` names). Only
+        for ``"int"`` and ``"float"`` fields.
     control : str
-        The explorer's control that the field sets, with ``range``:
+        The explorer's own control that the field sets, with ``range``:
         ``"amplitude"``, ``"frequency"`` or ``"noise"`` (the disturbance and
-        measurement controls), or ``"plant"`` (a slider of its own for a
-        physical parameter, a field of ``plant_fields``).
+        measurement controls); empty: a slider of its own, which remakes the
+        explorer's run with the field's new value (a physical parameter of
+        the plant, a time, ...).
 
     Examples
     --------
@@ -139,13 +144,18 @@ class Param:
     def __post_init__(self) -> None:
         if self.kind not in PARAM_KINDS:
             raise ValueError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
-        if (self.range is None) != (not self.control) or (
-            self.control and self.control not in CONTROLS
-        ):
+        if self.control and (self.control not in CONTROLS or self.range is None):
             raise ValueError(
-                f"a Param with a range names its explorer control (one of {CONTROLS}) and "
-                f"a control needs a range; got range={self.range!r}, control={self.control!r}"
+                f"a Param's control must be one of {CONTROLS} and comes with a range; got "
+                f"range={self.range!r}, control={self.control!r}"
             )
+        if self.range is not None:
+            lo, hi = self.range
+            if self.kind not in ("int", "float") or not lo < hi:
+                raise ValueError(
+                    "a Param's range (a slider) needs an int or float field and low < high; "
+                    f"got kind={self.kind!r}, range={self.range!r}"
+                )
 
     def config_key(self, section: str, name: str = "") -> str | None:
         """The key of the term config (``None``: not in the config).
@@ -444,7 +454,18 @@ class Experiment:
         """
         samples, duration = values.pop("samples", None), values.pop("duration", None)
         if samples is not None or duration is not None:
-            values.setdefault("timepts", self.grid(samples=samples, duration=duration))
+            if "timepts" in values:
+                raise ValueError(
+                    "give the time grid either as timepts or as samples/duration, not both "
+                    "(one of them would be dropped)"
+                )
+            values["timepts"] = self.grid(samples=samples, duration=duration)
+        names = {f.name for f in fields(self) if f.init}
+        unknown = sorted(set(values) - names)
+        if unknown:
+            raise ValueError(
+                f"the experiment {self.name!r} has no field {', '.join(map(repr, unknown))}"
+            )
         return replace(self, **values)
 
     # the run ------------------------------------------------------------------------------------
@@ -541,38 +562,39 @@ class Experiment:
         return simulate(self.plant(), observer, timepts, **kwargs)
 
 
-class _FromRegistry(Mapping):
-    """A view of the worked examples' registry (:data:`uio_teach.worked.WORKED`), read on use."""
+@dataclass(frozen=True)
+class ContinuousExperiment(Experiment):
+    """A continuous-time experiment: its length (s) and number of time points are config keys.
 
-    def __init__(self, what: str) -> None:
-        self._what = what
+    Examples
+    --------
+    >>> from uio_teach.experiments import ContinuousExperiment, experiment_params
+    >>> spec = dict(experiment_params(ContinuousExperiment))["duration"]
+    >>> spec.unit, spec.config_key("pa9", "duration")
+    ('s', 'pa9.duration')
+    """
 
-    def _items(self) -> dict[str, Any]:
-        if self._what == "experiments":
-            return {name: entry.run() for name, entry in WORKED.items()}
-        return {name: entry.plant_factory() for name, entry in WORKED.items() if entry.lab}
-
-    def __getitem__(self, name: str) -> Any:
-        return self._items()[name]
-
-    def __iter__(self):
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"{self._what.upper()}({', '.join(self)})"
+    duration: float = param(
+        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
+    )
+    samples: int = param(
+        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
+    )
 
 
-EXPERIMENTS: Mapping[str, Experiment] = _FromRegistry("experiments")
+EXPERIMENTS: Mapping[str, Experiment] = RegistryView(
+    "EXPERIMENTS", lambda worked: {name: entry.run() for name, entry in worked.items()}
+)
 """The experiment of every worked example, by name.
 
 The names are the tables of the term config; the values the experiments of the worked
 examples' modules (a view of :data:`uio_teach.worked.WORKED`)."""
 
 
-LAB_PLANTS: Mapping[str, Callable[[], Plant]] = _FromRegistry("lab plants")
+LAB_PLANTS: Mapping[str, Callable[[], Plant]] = RegistryView(
+    "LAB_PLANTS",
+    lambda worked: {name: entry.plant_factory() for name, entry in worked.items() if entry.lab},
+)
 """The course's plant of each lab, as a factory (the worked examples of
 :data:`uio_teach.worked.WORKED` that have a lab)."""
 

@@ -53,7 +53,7 @@ __all__ = [
 ]
 
 NARROW_WIDTH = 3.6
-"""Width (inches) of a figure's phone version: 360 px at 100 dpi, a phone's column."""
+"""Width (inches) of a figure's phone version, 360 px at 100 dpi (a phone's column)."""
 NARROW_SCREEN_PX = 600
 """Screens up to this width (CSS px) get the phone version of a figure."""
 _PANEL_HEIGHT = 2.4  # inches per panel of the phone version
@@ -378,11 +378,10 @@ def _mimebundle(fig: Figure) -> tuple[dict, dict] | None:
 
 def _install_display() -> None:
     """Show described figures as :func:`figure_html` in IPython (once per kernel)."""
-    if "IPython" not in sys.modules:
+    ipython = sys.modules.get("IPython")  # running inside IPython: it is loaded already
+    if ipython is None or not hasattr(ipython, "get_ipython"):
         return
-    from IPython import get_ipython  # deferred: only inside IPython
-
-    shell = get_ipython()
+    shell = ipython.get_ipython()
     if shell is None or not hasattr(shell, "display_formatter"):
         return
     from matplotlib.figure import Figure  # deferred: only when a figure was described

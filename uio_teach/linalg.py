@@ -599,7 +599,7 @@ class ZeroSet(NamedTuple):
 
     @property
     def undecided(self) -> np.ndarray:
-        """For each zero: round-off of the data can move it across the boundary (or infinity)."""
+        """For each zero, whether round-off of the data can move it across the boundary."""
         return self.unresolved | (self.radius >= self.distance)
 
     @property

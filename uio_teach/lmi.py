@@ -299,10 +299,10 @@ def _meets_each(z: np.ndarray, discrete: bool, decay: float | None) -> np.ndarra
     z = np.asarray(z, complex)
     if decay is None:
         return is_stable(z, discrete)
-    tol = tols.DECAY_RTOL * max(1.0, decay)
     if discrete:
-        return np.abs(z) <= decay + tol
-    return z.real <= -decay + tol * np.maximum(1.0, np.abs(z))
+        return np.abs(z) <= decay + tols.DECAY_RTOL * max(1.0, decay)
+    # relative to the decay rate and the pole's own size: the same in any unit of time
+    return z.real <= -decay + tols.DECAY_RTOL * np.maximum(decay, np.abs(z))
 
 
 def _meets(z: np.ndarray, discrete: bool, decay: float | None) -> bool:

@@ -167,10 +167,12 @@ def strip_fixed(poles: np.ndarray, fixed: np.ndarray) -> np.ndarray:
     [-1.0, -3.0]
     """
     rest = list(poles)
+    # relative to the set's own scale (the largest value), the same in any unit of time
+    scale = float(np.max(np.abs(np.concatenate([poles, fixed])), initial=0.0)) or 1.0
     for f in fixed:
         dist = [abs(p - f) for p in rest]
         i = int(np.argmin(dist))
-        if dist[i] > tols.FIXED_POLE_RTOL * max(1.0, abs(f)):
+        if dist[i] > tols.FIXED_POLE_RTOL * max(scale, abs(f)):
             return poles  # not a superset: let the count check complain
         rest.pop(i)
     return np.array(rest)
@@ -380,8 +382,9 @@ def place_pair_poles(
             else ""
         )
         raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
+    scale = float(np.max(np.abs(np.concatenate([poles, fixed])), initial=0.0)) or 1.0
     for z in fixed:
-        close = np.abs(poles - z) <= tols.FIXED_POLE_RTOL * max(1.0, abs(z))
+        close = np.abs(poles - z) <= tols.FIXED_POLE_RTOL * max(scale, abs(z))
         if np.any(close):
             raise ValueError(
                 f"poles: {format_complex(poles[close][0])} is requested on the fixed mode "

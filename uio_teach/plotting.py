@@ -38,6 +38,7 @@ so a symbol or a label is written in one place.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -71,6 +72,8 @@ __all__ = [
     "covered_curves",
     "legend_beside",
     "channel_style",
+    "marker_style",
+    "how_it_ends",
     "residual_channels",
     "describe",
     "description",
@@ -80,12 +83,12 @@ __all__ = [
 ]
 
 COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
-"""The course's colour cycle: the Okabe-Ito palette (blue, vermillion, bluish green, reddish
+"""The course's colour cycle, the Okabe-Ito palette (blue, vermillion, bluish green, reddish
 purple, orange, sky blue, black) without its yellow, which is too light on white. The book's
 ``matplotlibrc`` sets the same cycle, with :data:`LINESTYLES`."""
 LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2)), (0, (1, 1)))
-"""The line style of each colour of :data:`COLORS`: curves stay apart in grey print and for a
-reader who sees two of the colours as one."""
+"""The line style of each colour of :data:`COLORS`, so that curves stay apart in grey print
+and for a reader who sees two of the colours as one."""
 
 UNIT = "model units"
 """The unit of states, inputs and disturbances: the course's models give no physical units."""
@@ -584,8 +587,6 @@ _SETTLED = 0.02
 
 def _plain(name: str) -> str:
     """A mathtext name in words for a text alternative: ``$\\hat{x}_{2}$`` -> ``x-hat 2``."""
-    import re
-
     text = re.sub(r"\\hat\{(\w+)\}", r"\1-hat", name)
     text = re.sub(r"_\{(\w+)\}", r" \1", text)
     return text.replace("$", "").replace("\\", "").replace("{", "").replace("}", "")
@@ -595,14 +596,49 @@ def _when(t: float, dt: float | bool | None) -> str:
     return f"step {t:g}" if time_label(dt) == "step k" else f"t = {t:.3g} s"
 
 
-def _settles(t: np.ndarray, values: np.ndarray, scale: float, dt: float | bool | None) -> str:
-    """How the rows of ``values`` end: zero to rounding, settled on zero (and from when), or not."""
+def how_it_ends(
+    t: Any, values: Any, scale: float | None = None, dt: float | bool | None = None
+) -> str:
+    """How signals end, in words: zero to rounding, settled on zero (and from when), or not.
+
+    For the text alternative of a figure: what the reader should see of its curves.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        The time points.
+    values : array_like, shape (N,) or (k, N)
+        The signals (an error, a residual, a gap between a signal and its estimate).
+    scale : float, optional
+        The size of the signals they derive from (the states for an error): below a
+        billionth of it they are zero to rounding. By default their own peak.
+    dt : None, True or float, optional
+        The plant's ``dt``: ``"step k"`` or ``"t = ... s"`` in the words.
+
+    Returns
+    -------
+    str
+        A phrase to follow "the error", e.g. ``"decays to zero (below 2% of its peak from
+        t = 2.87 s on)"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.plotting import how_it_ends
+    >>> t = np.linspace(0, 10, 1001)
+    >>> how_it_ends(t, np.exp(-t))
+    'decays to zero (below 2% of its peak from t = 3.92 s on)'
+    >>> how_it_ends(t, np.sin(t))
+    'does not settle on zero: at the end it is still 54% of its peak'
+    """
+    t = np.asarray(t, dtype=float)
     values = np.atleast_2d(np.asarray(values, dtype=float))
     finite = np.where(np.isfinite(values), np.abs(values), np.inf)
     worst = finite.max(axis=0) if values.size else np.zeros(0)
     peak = float(worst[np.isfinite(worst)].max()) if np.isfinite(worst).any() else np.inf
     if not np.isfinite(peak):
         return "grows without bound (the simulation overflowed)"
+    scale = peak if scale is None else scale
     if peak <= _ROUNDING * max(scale, 1e-300):
         return "is zero to rounding throughout"
     above = np.flatnonzero(worst > _SETTLED * peak)
@@ -613,13 +649,50 @@ def _settles(t: np.ndarray, values: np.ndarray, scale: float, dt: float | bool |
     return f"decays to zero (below {_SETTLED:.0%} of its peak from {_when(t[last + 1], dt)} on)"
 
 
+def marker_style(i: int, samples: int) -> dict[str, Any]:
+    """Markers that tell channel ``i`` apart where colour and line style cannot.
+
+    For a panel whose line style already means something else (solid: one run, dashed:
+    another): channel ``i`` gets its own marker, about eight along the curve, offset from
+    the other channels' so that they do not sit on each other.
+
+    Parameters
+    ----------
+    i : int
+        The channel, from 0.
+    samples : int
+        The number of points of the curve.
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``Axes.plot``: ``marker``, ``markevery``, ``markersize``.
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import marker_style
+    >>> marker_style(1, 801)
+    {'marker': 's', 'markevery': (12, 100), 'markersize': 5}
+    """
+    step = max(1, int(samples) // 8)
+    offset = (int(i) * max(1, int(samples) // 64)) % step
+    return {
+        "marker": _MARKERS[int(i) % len(_MARKERS)],
+        "markevery": (offset, step),
+        "markersize": 5,
+    }
+
+
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+
+
 def _describe_response(fig: Figure, response: UIOResponse, title: str) -> None:
     plant = response.plant
     t = np.asarray(response.time, dtype=float)
     n = plant.n
     states = ", ".join(f"x{i + 1}" for i in range(n))
-    error = _settles(t, response.error, _size(response.states), plant.dt)
-    residual = _settles(t, response.residual, _size(response.outputs), plant.dt)
+    error = how_it_ends(t, response.error, _size(response.states), plant.dt)
+    residual = how_it_ends(t, response.residual, _size(response.outputs), plant.dt)
     alt = (
         f"{title}: against time, each state ({states}) drawn solid with its estimate dashed "
         f"in black, then the estimation error e = x - x-hat and the output residual r = y - C "
@@ -634,7 +707,7 @@ def _describe_response(fig: Figure, response: UIOResponse, title: str) -> None:
         "Error panel: "
         + "; ".join(
             f"e{i + 1} ({_look(i)}) "
-            + _settles(t, response.error[i], _size(response.states), plant.dt)
+            + how_it_ends(t, response.error[i], _size(response.states), plant.dt)
             for i in range(n)
         )
         + "."
@@ -644,7 +717,7 @@ def _describe_response(fig: Figure, response: UIOResponse, title: str) -> None:
         "Residual panel: "
         + "; ".join(
             f"r{i + 1} ({_look(j)}) "
-            + _settles(t, response.residual[i], _size(response.outputs), plant.dt)
+            + how_it_ends(t, response.residual[i], _size(response.outputs), plant.dt)
             for i, j in enumerate(channels)
         )
         + "."
@@ -678,7 +751,7 @@ def _describe_input_estimate(fig: Figure, estimate: InputEstimate, title: str, l
         gap = np.asarray(estimate.estimates[i], dtype=float) - estimate.actual[i]
         scale = _size(estimate.actual[i])
         parts.append(
-            f"the gap between {name} and its reconstruction " + _settles(t, gap, scale, dt)
+            f"the gap between {name} and its reconstruction " + how_it_ends(t, gap, scale, dt)
         )
     inputs = ", ".join(f"{letter}{i + 1}" for i in range(q))
     said = "; ".join(parts)

@@ -44,8 +44,8 @@ the rounding of the compressions adds up over up to ``n`` steps."""
 # zeros and stability ----------------------------------------------------------------------------
 
 ZERO_RTOL = 10.0
-"""Backward error of the invariant zeros: the computed zeros are those of a plant within
-``ZERO_RTOL * (n + p) * eps`` (relative, in balanced units) of the data (the orthogonal staircase
+"""The computed invariant zeros are those of a plant within ``ZERO_RTOL * (n + p) * eps``
+(relative, in balanced units) of the data, their backward error (the orthogonal staircase
 is backward stable with a constant of that order). A zero is decided when no plant that close
 has a zero on the stability boundary."""
 
@@ -56,8 +56,9 @@ margin relative to the value, so it is the same in any unit of time. Also the ma
 the LMI certifies."""
 
 REAL_RTOL = 1e-10
-"""``sort_poles``: an imaginary part below this fraction of the value's size is round-off of a
-real value (a real pole computed as ``-2 + 1e-15j``)."""
+"""An imaginary part below this fraction of a value's size is round-off of a real
+value (``sort_poles``: a real pole computed as ``-2 + 1e-15j``), and two requested poles within
+this fraction of their size are one pole requested twice (``check_poles``)."""
 
 MODES_RTOL = 1e-5
 """The fixed modes (unobservable modes of the designs' pair) agree with the invariant zeros when
@@ -98,8 +99,9 @@ LEAK_REFUSE = 1e-3
 """A design whose bound on that leak exceeds this fraction is refused."""
 
 AMPLIFICATION_LIMIT = 1e6
-"""Above this, a UIO amplifies round-off notably: ``||E|| ||C|| / sigma_min(C E)`` (the size of
-``H``) or ``||K|| ||C|| / ||A||`` (the size of the gain) is named as the cause of a leak."""
+"""Above this, ``||E|| ||C|| / sigma_min(C E)`` (the size of ``H``) or ``||K|| ||C|| / ||A||``
+(the size of the gain) says that a UIO amplifies round-off notably, and is named as the cause
+of a leak."""
 
 GAIN_EXACT_RTOL = 1e-9
 """An explicit gain with ``L D`` below this fraction of its largest entry meets ``L D = 0``: it

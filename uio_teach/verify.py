@@ -86,8 +86,37 @@ def _condition_numbers(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return w, kappa
 
 
+def _clusters(req: np.ndarray, zeros=None, radius=None) -> np.ndarray:
+    """Labels of the clusters of the requested values.
+
+    Values equal to ``REAL_RTOL`` of their own size are one (a pole requested several times), and so
+    are values within twice the round-off radius of one invariant zero (a repeated or defective
+    fixed mode, whose computed values scatter by that radius).
+    """
+    n = req.size
+    label = np.arange(n)
+    for i in range(n):
+        for j in range(i + 1, n):
+            if abs(req[i] - req[j]) <= tols.REAL_RTOL * max(abs(req[i]), abs(req[j])):
+                label[label == label[j]] = label[i]
+    if zeros is not None and radius is not None and len(zeros) and len(radius) == len(zeros):
+        zeros = np.asarray(zeros, complex)
+        reach = 2 * np.where(np.isfinite(radius), np.asarray(radius, float), 0.0)
+        for k, z in enumerate(zeros):
+            near = np.flatnonzero(np.abs(req - z) <= reach[k])
+            if near.size > 1:
+                label[np.isin(label, label[near])] = label[near[0]]
+    return np.unique(label, return_inverse=True)[1].ravel()
+
+
 def check_poles(
-    F: np.ndarray, requested, *, what: str = "the observer", stacklevel: int = 3
+    F: np.ndarray,
+    requested,
+    *,
+    what: str = "the observer",
+    stacklevel: int = 3,
+    zeros=None,
+    radius=None,
 ) -> np.ndarray:
     """Compare ``eig(F)`` with the requested poles; warn or raise beyond the tolerance.
 
@@ -101,6 +130,11 @@ def check_poles(
         How the design is called in messages.
     stacklevel : int
         Passed to ``warnings.warn``.
+    zeros, radius : array_like, optional
+        The plant's invariant zeros and how far round-off moves each
+        (:class:`uio_teach.linalg.ZeroSet`): fixed modes of a repeated or defective zero are
+        verified as one cluster (its centre to round-off, its members within the Hoelder
+        radius), not one by one.
 
     Returns
     -------
@@ -142,24 +176,35 @@ def check_poles(
     kap = kappa[cols[np.argsort(rows)]]
     normF = float(np.linalg.norm(F, 2))
     err = np.abs(obtained - req)
-    size = np.maximum(1.0, np.abs(req))
+    # relative to each pole's own size (a slow pole is judged at its own scale, in any unit of
+    # time); a pole requested at 0 (deadbeat) against ||F||, the only scale it has
+    size = np.where(req != 0, np.abs(req), normF if normF > 0 else 1.0)
     round_off = n * _EPS * normF * np.where(np.isfinite(kap), kap, 1e300)
-    tight = err <= tols.POLE_RTOL * size
+    tight = err <= tols.POLE_RTOL * np.abs(req)
     # a pole requested m times forms a Jordan block: a perturbation delta of F moves it by about
     # (delta ||F||^(m-1))^(1/m), far more than kappa (computed from nearby eigenvectors) says;
     # the gain of such a design (Ackermann's formula) is itself accurate to about 100 n eps ||F||
     with np.errstate(all="ignore"):  # huge poles overflow the rounding: they are not repeated
-        _, inverse, mult = np.unique(np.round(req, 9), return_inverse=True, return_counts=True)
-        m = mult[inverse.ravel()].astype(float)
         scale = np.maximum(normF, np.abs(req))
+        label = _clusters(req, zeros, radius)
+        m = np.bincount(label)[label].astype(float)
         holder = (100 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m) / 10
     round_off = np.where(m > 1, np.maximum(round_off, holder), round_off)
     explained = err <= 10 * round_off
+    # a cluster (a repeated pole, a defective fixed mode) is verified by what it promises: its
+    # centre, well conditioned, to round-off, and its members within the Hoelder radius
+    for c in np.unique(label[m > 1]):
+        members = label == c
+        centre = complex(np.mean(req[members]))
+        moved = abs(complex(np.mean(obtained[members])) - centre)
+        if moved <= tols.POLE_RTOL * abs(centre) + 10 * n * _EPS * normF:
+            size = np.where(members, np.maximum(size, 10 * holder / tols.WARN_RTOL), size)
     for i in np.flatnonzero(~tight & ~explained & (err <= tols.WARN_RTOL * size)):
         # backward check: is the requested value an eigenvalue of a matrix close to F?
         smin = np.linalg.svd(F - req[i] * np.eye(n), compute_uv=False)[-1]
         explained[i] = smin <= 10 * n * _EPS * max(normF, abs(req[i]))
-    ok = tight | (explained & (err <= tols.WARN_RTOL * size))
+    # an error at the round-off of F's eigenvalues themselves is no error, whatever the pole
+    ok = tight | (explained & (err <= tols.WARN_RTOL * size)) | (err <= 10 * n * _EPS * normF)
     if np.all(ok):
         return obtained
     bad = ~ok
@@ -328,7 +373,9 @@ def check_fixed_modes(values, fixed, *, what: str = "the observer") -> None:
     else:
         cost = np.abs(z[:, None] - w[None, :])
         rows, cols = linear_sum_assignment(cost)
-        err = cost[rows, cols] / np.maximum(1.0, np.abs(z[rows]))
+        # relative to the larger of the mode and the observer's own scale (its largest pole)
+        scale = float(np.max(np.abs(w))) or 1.0
+        err = cost[rows, cols] / np.maximum(np.abs(z[rows]), scale)
         bad = err > tols.WARN_RTOL
         missing, nearest = z[rows[bad]], w[cols[bad]]
     if missing.size:

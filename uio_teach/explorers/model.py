@@ -108,7 +108,7 @@ class Channel:
 
 @dataclass(frozen=True)
 class PlantControl:
-    """A slider of a physical parameter of the plant (a valve, a gain): moving it remakes the plant.
+    """A slider of a declared field of the experiment (a valve, a gain): moving it remakes the run.
 
     Attributes
     ----------
@@ -269,7 +269,8 @@ class Scenario:
         The symbol of the unknown input in the figure (``"d"``, or ``"v"`` for
         the missile paper).
     plant_controls : tuple of PlantControl
-        Sliders of physical parameters of the plant (empty: the plant is fixed).
+        Sliders of the experiment's own fields, each declared with a range (a valve of
+        the plant, ...); empty: the run is fixed.
     rebuild : callable or None
         ``rebuild(**values)``: the scenario with other values of the plant
         controls (the explorer swaps its scenario when one moves).

@@ -78,7 +78,13 @@ def _range(experiment: Any, control: str) -> tuple[float, float]:
 
 
 def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
-    """The sliders of an experiment's physical parameters: its ``plant_fields`` with a range.
+    """The sliders of an experiment's own fields: each declared field with a range and no control.
+
+    A field declared with a ``range`` and no ``control`` (none of the
+    explorer's own amplitude, frequency and noise controls) gets a slider of
+    its own, whatever it is: a physical parameter of the plant (a field of
+    ``plant_fields``), a time, a gain. Moving it remakes the scenario with the
+    field's new value (``Scenario.rebuild``).
 
     Parameters
     ----------
@@ -105,8 +111,8 @@ def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
             limits=specs[name].range,
             value=float(getattr(experiment, name)),
         )
-        for name in type(experiment).plant_fields
-        if name in specs and specs[name].control == "plant"
+        for name, spec in specs.items()
+        if spec.range is not None and not spec.control
     )
 
 
@@ -289,13 +295,16 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     entry = WORKED[name]
     opts = entry.explorer
     run = entry.run()
-    fields = {f for f, _ in experiment_params(run)}
+    fields = {f for f, spec in experiment_params(run) if spec.range and not spec.control}
     unknown = sorted(set(values) - fields)
     if unknown:
         raise RegistryError(
             f"the {name} explorer has no slider {', '.join(map(repr, unknown))}; "
-            f"its experiment declares {', '.join(sorted(fields))}"
+            f"its sliders: {', '.join(sorted(fields)) or 'none'}"
         )
+    specs = dict(experiment_params(run))
+    # a slider gives floats: an integer field takes its nearest integer
+    values = {f: round(v) if specs[f].kind == "int" else v for f, v in values.items()}
     run = run.with_values(**values)
     plant = run.plant()
     declared = {spec.control: f for f, spec in experiment_params(run) if spec.control}
@@ -318,6 +327,20 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
             raise RegistryError(
                 f"the {name} explorer: no field declares the {control} control, so the options "
                 f"{control!r} and '{option}_limits' are required"
+            )
+
+    if opts.poles is not None and run.poles is not None:
+        raise RegistryError(
+            f"the {name} explorer: its experiment sets the starting poles {run.poles}; "
+            "drop the option poles (it is for an experiment without poles, an LMI gain)"
+        )
+    sliders = plant_controls(run)
+    if opts.static_control.startswith("plant:"):
+        wanted = opts.static_control.split(":", 1)[1]
+        if wanted not in {c.name for c in sliders}:
+            raise RegistryError(
+                f"the {name} explorer: static_control {opts.static_control!r} names no slider; "
+                f"its sliders: {', '.join(c.name for c in sliders) or 'none'}"
             )
 
     def value(control: str, default: float) -> float:
@@ -362,7 +385,7 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
         static_values=opts.static_values,
         static_control=opts.static_control,
         input_symbol=opts.input_symbol,
-        plant_controls=plant_controls(run),
+        plant_controls=sliders,
         rebuild=functools.partial(experiment_scenario, name),
         note=resolve(opts.note)(**physical) if opts.note else "",
     )

@@ -9,8 +9,10 @@
    notebook's metadata says is only compared with it; a clean copy of its
    cells is made (``uio_teach.grading.runner.clean_notebook``);
 2. compares the class (``_identity_notes``): a notebook that disagrees
-   with its name, a group handing in twice, the same code from two groups or
-   no group at all is "check by hand", never ``ok``;
+   with its name, a group handing in twice, the same code from two groups
+   (once comments, layout and the names of its own variables are set aside:
+   ``uio_teach.grading.copies``) or no group at all is "check by hand",
+   never ``ok``;
 3. makes a copy with every stored output cleared (a stored ✓ counts for
    nothing), the ``parameters`` cell set to the group's parameters from the
    answer key, and small cells added that write the answer variables out as
@@ -22,8 +24,9 @@
    loops is recorded and the next cells still run;
 5. checks the answers in a child process with limits of time and memory
    (``uio_teach.grading.checking``): answers over the size caps are not
-   rebuilt, the rest are rebuilt as genuine objects and checked with **the
-   answer key's parameters** (``uio_teach.grading.lab_checks``). The verdicts
+   rebuilt, the rest are rebuilt as genuine objects and checked by the lab
+   chapter's own check cells with **the answer key's parameters**
+   (``uio_teach.grading.lab_checks``). The verdicts
    the check cells printed count for nothing, and nothing the notebook
    defines (``PARAMS``, a patched class, a patched module) reaches the
    checks: only right values pass;
@@ -33,8 +36,11 @@
 
 Whatever fails on one hand-in (reading, preparing, running, reading back,
 checking, or the grader itself) becomes that row's status with a one-line
-reason; the run goes on. ``jobs`` hand-ins run at a time. Before the first,
-the sandbox is tested with the real interpreter and a one-cell notebook. The
+reason; the run goes on. ``jobs`` hand-ins run at a time, from the start:
+the sandbox is tested with the real interpreter and a one-cell notebook
+beside the first ones, and no row is written before that test has passed.
+With ``shard=(K, N)`` only shard K of N is graded (every hand-in still read:
+copies are caught across shards), for ``uio_teach.grading.merge``. The
 temporary folders of a run are removed when it ends; those of runs that were
 killed are removed by the next.
 
@@ -66,6 +72,7 @@ from typing import Any
 import nbformat
 
 from ..errors import UIOTeachWarning
+from ..instructor.output import sha256_file
 from .checking import check_in_child
 from .copies import fingerprint
 from .gradebook import (
@@ -81,7 +88,6 @@ from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks, cou
 from .merge import check_shard, shard_of
 from .rosters import (
     GradeError,
-    file_sha256,
     group_from_name,
     group_id,
     is_late,
@@ -781,8 +787,8 @@ def grade(
         raise GradeError(f"cannot read the labs' check cells: {err}") from None
     files_roster, students = read_roster(roster) if roster is not None else ({}, {})
     sources = {
-        "answer_key_sha256": file_sha256(answer_key) if answer_key is not None else None,
-        "roster_sha256": file_sha256(roster) if roster is not None else None,
+        "answer_key_sha256": sha256_file(answer_key) if answer_key is not None else None,
+        "roster_sha256": sha256_file(roster) if roster is not None else None,
     }
     if shard is not None:
         shard = check_shard(shard)

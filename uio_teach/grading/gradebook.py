@@ -62,6 +62,7 @@ __all__ = [
     "feedback_names",
     "export_path",
     "safe_cell",
+    "file_cell",
     "shown",
     "exports",
     "read_gradebook",
@@ -80,6 +81,7 @@ COMMAND = "uio-teach grade"
 """The command recorded in the feedback folder's manifest."""
 _FIRST = ["file", "lab", "group", "status", "reason"]
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]+")
+_ONE_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 _NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$")
 _GOOD = ("ok", "error", "timeout")  # rows whose marks stand as they are
 _LAST = ["total", "out_of"]
@@ -226,7 +228,7 @@ class Submission:
         """The CSV row under the check columns ``columns`` (empty for a check of another lab)."""
         verdicts = self.verdicts()
         marks = ["" if c not in verdicts else (PASS if verdicts[c] else FAIL) for c in columns]
-        first = [self.file, self.lab, self.group, self.status, self.reason]
+        first = [file_cell(self.file), self.lab, self.group, self.status, self.reason]
         return [*first, *marks, self.total, len(verdicts)]
 
 
@@ -284,6 +286,28 @@ def safe_cell(value: Any) -> str:
     if text[:1] in ("=", "+", "-", "@") and not _NUMBER.match(text):
         text = "'" + text
     return text
+
+
+def file_cell(file: str) -> str:
+    """A hand-in's name as its gradebook cell: :func:`safe_cell` of :func:`shown`, and every
+    control character (a line break is legal in a file name) as ``\\x0a``, so that two names
+    never share a cell.
+
+    Parameters
+    ----------
+    file : str
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.grading.gradebook import file_cell
+    >>> print(file_cell("a\\nb.ipynb"), file_cell("a b.ipynb"))
+    a\\x0ab.ipynb a b.ipynb
+    """
+    return safe_cell(_ONE_CONTROL.sub(lambda m: f"\\x{ord(m[0]):02x}", shown(file)))
 
 
 def feedback_folder(out: str | os.PathLike[str]) -> Path:
@@ -718,8 +742,8 @@ class Gradebook:
                         f"{what.removesuffix('_sha256').replace('_', ' ')} (its {MANIFEST}): "
                         "resume it with the same one, or grade afresh without --resume"
                     )
-        wanted = {safe_cell(f) for f in self.files}
-        names = {safe_cell(f): n for f, n in self.names.items()}
+        wanted = {file_cell(f) for f in self.files}
+        names = {file_cell(f): n for f, n in self.names.items()}
         # a row whose feedback text is lost is graded again
         kept = [row for row in kept if row[0] in wanted and (self.folder / names[row[0]]).is_file()]
         return header, kept
@@ -733,7 +757,7 @@ class Gradebook:
             Their files, as given.
         """
         cells = {row[0] for row in self._kept()[1]}
-        return {f for f in self.files if safe_cell(f) in cells}
+        return {f for f in self.files if file_cell(f) in cells}
 
     def open(self) -> None:
         """Start writing: a new gradebook, or the resumed one with the rows it keeps."""
@@ -772,7 +796,7 @@ class Gradebook:
 
     def has(self, file: str) -> bool:
         """Whether the hand-in ``file`` has its row already (kept by ``resume``, or added)."""
-        return safe_cell(file) in self.done
+        return file_cell(file) in self.done
 
     # writing ------------------------------------------------------------------------------
     def add(self, sub: Submission) -> None:
@@ -797,7 +821,7 @@ class Gradebook:
     def finish(self) -> None:
         """Rewrite the CSV in the submissions' order and write the feedback manifest."""
         rows = [
-            self.done[c] for c in dict.fromkeys(safe_cell(f) for f in self.files) if c in self.done
+            self.done[c] for c in dict.fromkeys(file_cell(f) for f in self.files) if c in self.done
         ]
         self._csv.close()
         _write_atomic(self.out, _csv_text([self._header(), *rows]))

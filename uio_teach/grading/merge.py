@@ -41,9 +41,9 @@ from .gradebook import (
     check_gradebook_target,
     feedback_folder,
     feedback_names,
+    file_cell,
     header_of,
     read_gradebook,
-    safe_cell,
     write_exports,
     write_table,
 )
@@ -272,7 +272,7 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
                 )
             rows[cell] = [row[at[c]] if c in at else "" for c in header]
             owner[cell] = part
-    cells = [safe_cell(f) for f in files]
+    cells = [file_cell(f) for f in files]
     absent = [c for c in cells if c not in rows]
     if absent:
         raise MergeError(

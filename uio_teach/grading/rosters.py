@@ -23,7 +23,6 @@ Examples
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
 import json
 import os
@@ -42,7 +41,6 @@ __all__ = [
     "read_table",
     "read_roster",
     "read_answer_key",
-    "file_sha256",
     "DELIMITERS",
     "MAX_TABLE_BYTES",
 ]
@@ -157,33 +155,6 @@ def group_from_name(
             return match["lab"].lower(), group_id(match["group"])
     match = _GENERIC.match(stem)
     return (match["lab"], group_id(match["group"])) if match else ("", "")
-
-
-def file_sha256(path: str | os.PathLike[str]) -> str:
-    """The SHA-256 of a file's bytes (what a gradebook records of its key and roster).
-
-    Parameters
-    ----------
-    path : str or path-like
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> from uio_teach.grading.rosters import file_sha256
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     _ = (pathlib.Path(tmp) / "a.csv").write_bytes(b"")
-    ...     file_sha256(pathlib.Path(tmp) / "a.csv")[:12]
-    'e3b0c44298fc'
-    """
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def _decode(data: bytes, name: str) -> str:

@@ -674,15 +674,25 @@ def _labs(args: argparse.Namespace) -> int:
             )
 
     try:
-        results = labs.write_labs(
-            args.out,
-            args.source,
-            book_dir=args.book,
-            progress=progress,
-            config=config,
-            groups=args.groups,
-            seed=args.seed or 0,
-        )
+        with warnings.catch_warnings(record=True) as notes:
+            warnings.simplefilter("always", labs.ConfigNotKeptWarning)
+            results = labs.write_labs(
+                args.out,
+                args.source,
+                book_dir=args.book,
+                progress=progress,
+                config=config,
+                groups=args.groups,
+                seed=args.seed or 0,
+            )
+        # a configured value the labs do not keep is said, never dropped unseen
+        for note in notes:
+            if issubclass(note.category, labs.ConfigNotKeptWarning):
+                _say(f"{PROG} labs: note: {note.message}", sys.stderr)
+            else:
+                warnings.showwarning(
+                    note.message, note.category, note.filename, note.lineno, note.file, note.line
+                )
     except ImportError as err:
         missing = err.name or str(err)
         _error(

@@ -44,7 +44,7 @@ from ..experiments import (
     pole_text,
 )
 from ..observers import design_pmo, design_uio
-from ..worked import WORKED, run_from_config
+from ..worked import WORKED, RegistryView, run_from_config
 
 __all__ = [
     "ConfigError",
@@ -709,31 +709,13 @@ def default_config_toml() -> str:
     return "\n".join(lines) + "\n"
 
 
-class _ObserverKeys(Mapping[str, str]):
-    """The config keys that set an observer's poles, and their worked example (the registry)."""
-
-    def _items(self) -> dict[str, str]:
-        out = {}
-        for name, entry in WORKED.items():
-            key = entry.poles_key()
-            if key is not None:
-                out[key] = name
-        return out
-
-    def __getitem__(self, key: str) -> str:
-        return self._items()[key]
-
-    def __iter__(self):
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"OBSERVER_KEYS({self._items()})"
+def _observer_keys(worked: Mapping[str, Any]) -> dict[str, str]:
+    """The config keys that set an observer's poles, and their worked example."""
+    keys = {name: entry.poles_key() for name, entry in worked.items()}
+    return {key: name for name, key in keys.items() if key is not None}
 
 
-OBSERVER_KEYS: Mapping[str, str] = _ObserverKeys()
+OBSERVER_KEYS: Mapping[str, str] = RegistryView("OBSERVER_KEYS", _observer_keys)
 """The keys that set an observer's poles, and the worked example each belongs to: the
 ``poles`` field of each experiment of :data:`uio_teach.worked.WORKED`."""
 

@@ -17,7 +17,8 @@ level, seed, matplotlib style) live in a TOML file read by :func:`load_config`;
 
 The same configuration gives byte-identical files: the noise is seeded, and
 the time stamps and software names that matplotlib would write into PNG, PDF
-and SVG files are left out (:func:`save_figure`).
+and SVG files are left out (:func:`save_figure`). Each picture has its words beside it: what
+it shows, in a text file of the same name (``pa9_sine.txt``), and in the file's own metadata.
 
 Examples
 --------
@@ -28,7 +29,7 @@ True
 >>> with tempfile.TemporaryDirectory() as tmp:
 ...     results = figures.generate(tmp, ["pa9_sine"], fmt="svg", dpi=50)
 ...     [path.name for path in results[0].paths]
-['pa9_sine.svg']
+['pa9_sine.svg', 'pa9_sine.txt']
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from typing import Any
 
 import matplotlib.style
 
-from ..worked import WORKED, resolve, run_from_config
+from ..worked import WORKED, RegistryView, resolve, run_from_config
 from .config import (
     ConfigError,
     FigureConfig,
@@ -58,6 +59,7 @@ from .output import (
     OutputError,
     StagedFolder,
     prepare_output_dir,
+    save_description,
     save_figure,
     write_manifest,
 )
@@ -140,30 +142,16 @@ class FigureSpec:
     table: bool = False
 
 
-class _Figures(Mapping):
-    """The figures of every worked example of the registry, in its order (read on use)."""
-
-    def _items(self) -> dict[str, FigureSpec]:
-        out = {}
-        for entry in WORKED.values():
-            for fig in entry.figures:
-                out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
-        return out
-
-    def __getitem__(self, name: str) -> FigureSpec:
-        return self._items()[name]
-
-    def __iter__(self):
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"FIGURES({', '.join(self)})"
+def _figures(worked: Mapping[str, Any]) -> dict[str, FigureSpec]:
+    """The figures of every worked example of the registry, in its order."""
+    out = {}
+    for entry in worked.values():
+        for fig in entry.figures:
+            out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
+    return out
 
 
-FIGURES: Mapping[str, FigureSpec] = _Figures()
+FIGURES: Mapping[str, FigureSpec] = RegistryView("FIGURES", _figures)
 """Every output of ``uio-teach figures``, by name, in the order they are made."""
 
 
@@ -283,7 +271,9 @@ def generate(
                         made = tuple(spec.draw(runs, folder))
                     else:
                         fig = spec.draw(runs)
-                        made = (save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi),)
+                        picture = save_figure(fig, folder / f"{name}.{fmt}", fmt, dpi)
+                        words = save_description(fig, picture)  # its text alternative
+                        made = (picture,) if words is None else (picture, words)
                 for _ in made:
                     stage.written()
                 paths = tuple(target / path.name for path in made)

@@ -20,12 +20,13 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from ..errors import UIOTeachError
-from ..worked import WORKED
+from ..worked import RegistryView
 
 __all__ = ["LABS", "Lab", "LabError", "LabUsageError", "lab_of"]
 
@@ -66,30 +67,16 @@ class Lab:
     check_ids: tuple[str, ...]
 
 
-class _Labs(Mapping):
-    """The labs of the worked examples of the registry that have one (read on use)."""
-
-    def _items(self) -> dict[str, Lab]:
-        return {
-            name: Lab(name, entry.lab.source, entry.lab.params, entry.lab.check_ids)
-            for name, entry in WORKED.items()
-            if entry.lab is not None
-        }
-
-    def __getitem__(self, name: str) -> Lab:
-        return self._items()[name]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._items())
-
-    def __len__(self) -> int:
-        return len(self._items())
-
-    def __repr__(self) -> str:
-        return f"LABS({', '.join(self)})"
+def _labs(worked: Mapping[str, Any]) -> dict[str, Lab]:
+    """The labs of the worked examples that have one."""
+    return {
+        name: Lab(name, entry.lab.source, entry.lab.params, entry.lab.check_ids)
+        for name, entry in worked.items()
+        if entry.lab is not None
+    }
 
 
-LABS: Mapping[str, Lab] = _Labs()
+LABS: Mapping[str, Lab] = RegistryView("LABS", _labs)
 """The labs of the course, by id (each a :class:`Lab`), from :data:`uio_teach.worked.WORKED`."""
 
 

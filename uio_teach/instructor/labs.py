@@ -27,13 +27,18 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from ..errors import UIOTeachWarning
 from . import lab_registry
 from .book import BookIndex, default_book_dir
+from .config import config_schema
 from .lab_notebook import (
     LAB_PATTERN,
     TODO_TAG,
@@ -58,6 +63,8 @@ __all__ = [
     "LabUsageError",
     "BookIndex",
     "LabResult",
+    "ConfigNotKeptWarning",
+    "config_notes",
     "draw_variants",
     "lab_of",
     "params_source",
@@ -101,6 +108,83 @@ class UnreadKeys:
 
 COMMAND = "uio-teach labs"
 """The command recorded in the manifest of a labs folder."""
+
+
+class ConfigNotKeptWarning(UIOTeachWarning):
+    """A value of the term config that the labs do not keep: drawn per group, or never read."""
+
+
+def config_notes(lab: Lab, config: Mapping[str, Any], groups: bool) -> list[str]:
+    """What the labs do with the values of ``config`` that differ from the course's, when not kept.
+
+    A value is kept when it reaches every notebook of the lab as configured. It
+    is not kept when the lab's notebooks do not read it (``UNREAD_CONFIG_KEYS``)
+    or, with ``groups``, when each group's variant draws the field anew (the
+    fields of ``lab.params.vary``): then it is said, one line per key, never
+    dropped unseen.
+
+    Parameters
+    ----------
+    lab : Lab
+        The lab.
+    config : mapping
+        The term config.
+    groups : bool
+        Whether the labs are drawn per group.
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import FigureConfig
+    >>> from uio_teach.instructor.labs import LABS, config_notes
+    >>> cfg = FigureConfig.from_dict({"pa9": {"poles": [-2, -3, -4]}})
+    >>> print(config_notes(LABS["pa9"], cfg, groups=True)[0])
+    pa9.poles = [-2, -3, -4] is not kept: each group's variant of the pa9 lab draws its own
+    """
+    schema = config_schema()
+    course = lab.params()
+    base = lab.params.from_config(config)
+    set_keys = {}
+    for name, spec in lab.params.declared():
+        key = spec.config_key(lab.id, name)
+        if key is not None and key in config and getattr(base, name) != getattr(course, name):
+            set_keys[key] = name
+    for key in ("seed", "style"):  # shared keys that a lab may not declare
+        if key in config and key in schema and config[key] != schema[key].default:
+            set_keys.setdefault(key, key)
+    notes = []
+    if groups:
+        drawn = set(lab.params.vary(np.random.default_rng(0), base))
+        for key, name in set_keys.items():
+            if name in drawn:
+                notes.append(
+                    f"{key} = {_shown(config[key])} is not kept: each group's variant of the "
+                    f"{lab.id} lab draws its own"
+                )
+    for entry in UNREAD_CONFIG_KEYS:
+        if lab.id in entry.labs:
+            given = [k for k in entry.keys if k in set_keys]
+            if given:
+                verb, them = ("reach", "them") if len(given) > 1 else ("reaches", "it")
+                notes.append(
+                    f"{' and '.join(given)} of the term config {verb} the {lab.id} lab's "
+                    f"PARAMS, but its notebooks do not read {them}: {entry.why}"
+                )
+    return notes
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    if isinstance(value, complex):
+        return f"{value.real:g}" if value.imag == 0 else f"{value:g}"
+    if isinstance(value, float):
+        return f"{value:g}"
+    return repr(value) if isinstance(value, str) else str(value)
+
 
 LABS: Mapping[str, Lab] = lab_registry.LABS
 """The labs of the course, by id (``uio_teach.instructor.lab_registry.LABS``, also here)."""
@@ -260,6 +344,9 @@ def write_labs(
     for path in paths:
         lab = lab_of(path)
         base = lab.params.from_config(config) if lab is not None else None
+        if lab is not None and config is not None:
+            for note in config_notes(lab, config, groups is not None):
+                warnings.warn(ConfigNotKeptWarning(note), stacklevel=2)
         if lab is not None and base.problems():
             raise LabUsageError(
                 f"the {lab.id} lab cannot be made with these numbers: " + "; ".join(base.problems())

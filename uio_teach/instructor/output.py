@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 
 from .. import __version__
 from ..errors import UIOTeachError
+from ..figure_text import description, description_text
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -60,6 +61,7 @@ __all__ = [
     "FolderLock",
     "clean_leftovers",
     "save_figure",
+    "save_description",
     "prepare_output_dir",
     "write_manifest",
     "read_manifest",
@@ -132,9 +134,50 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], fmt: str, dpi: int = 
         "pdf": {"CreationDate": None, "ModDate": None},
         "svg": {"Date": None},
     }[fmt]
+    said = description(fig)
+    if said is not None:  # the text alternative travels inside the file too
+        metadata[{"png": "Description", "pdf": "Subject", "svg": "Description"}[fmt]] = said.alt
     with matplotlib.rc_context({"svg.hashsalt": _SVG_HASHSALT}):
         fig.savefig(path, format=fmt, dpi=dpi, metadata=metadata)
     return Path(path)
+
+
+def save_description(fig: Figure, path: str | os.PathLike[str]) -> Path | None:
+    """Write what a figure shows, in words, beside its picture: ``<stem>.txt``.
+
+    The text alternative (what is plotted and what the reader should see), then the long
+    description, as :func:`uio_teach.figure_text.description_text` gives them: for the alt
+    text of a handout, a slide or a learning platform.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or path-like
+        The picture's file; the text goes to the same name with ``.txt``.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The text file, or ``None`` for a figure without a description.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from matplotlib.figure import Figure
+    >>> from uio_teach.figure_text import describe
+    >>> from uio_teach.instructor.output import save_description
+    >>> fig = describe(Figure(), "An error that decays to zero.")
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     save_description(fig, pathlib.Path(tmp) / "a.png").read_text()
+    'An error that decays to zero.\\n'
+    """
+    text = description_text(fig)
+    if not text:
+        return None
+    target = Path(path).with_suffix(".txt")
+    target.write_text(text, encoding="utf-8")
+    return target
 
 
 def prepare_output_dir(out: str | os.PathLike[str]) -> Path:

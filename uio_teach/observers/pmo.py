@@ -197,6 +197,13 @@ def design_pmo(
     obs = PMO(plant, dec.M, L, Mv, certificate)
     verify_projection(obs, "the PMO", report.fixed_modes)
     if requested is not None:
-        check_poles(obs.F, requested, what="the PMO", stacklevel=3)
+        check_poles(
+            obs.F,
+            requested,
+            what="the PMO",
+            stacklevel=3,
+            zeros=report.invariant_zeros,
+            radius=report.zero_radius,
+        )
     obs.warn_if_unstable()
     return obs

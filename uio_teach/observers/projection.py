@@ -141,7 +141,7 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
     G = as_matrix(name, gain, plant.n, plant.p, what="n x p")
     if not plant.nv:
         return G
-    scale = max(1.0, float(np.abs(G).max()))
+    scale = float(np.abs(G).max()) if G.size else 0.0  # the gain's own size, in any units
     GD = G @ plant.D
     residual = float(np.abs(GD).max())
     if residual <= tols.GAIN_EXACT_RTOL * scale:

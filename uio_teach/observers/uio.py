@@ -136,6 +136,13 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     obs = UIO(plant, dec.M, K1)
     verify_projection(obs, "the UIO", report.fixed_modes)
     if requested is not None:
-        check_poles(obs.F, requested, what="the UIO", stacklevel=3)
+        check_poles(
+            obs.F,
+            requested,
+            what="the UIO",
+            stacklevel=3,
+            zeros=report.invariant_zeros,
+            radius=report.zero_radius,
+        )
     obs.warn_if_unstable()
     return obs

@@ -55,6 +55,7 @@ __all__ = [
     "LabEntry",
     "ExplorerOptions",
     "RegistryError",
+    "RegistryView",
     "WORKED",
     "discover",
     "resolve",
@@ -175,13 +176,18 @@ class ExplorerOptions:
         The starting poles, when the experiment has none (an LMI gain).
     disturbance : str
         The starting disturbance type.
-    amplitude, frequency : float or None
-        The starting amplitude and frequency, for an experiment that declares
-        no field for them (then ``amplitude_limits`` and
-        ``disturbance_frequency_limits`` are required too).
-    amplitude_limits, disturbance_frequency_limits, noise_limits : (float, float) or None
-        The ranges of controls that no declared field sets (given while a
+    amplitude : float or None
+        The starting amplitude, for an experiment that declares no field for
+        it (then ``amplitude_limits`` is required too).
+    frequency : float or None
+        The starting frequency, likewise (with ``disturbance_frequency_limits``).
+    amplitude_limits : (float, float) or None
+        The amplitude's range, when no declared field sets it (given while a
         field declares one: an error, the value would be set twice).
+    disturbance_frequency_limits : (float, float) or None
+        The frequency's range, likewise.
+    noise_limits : (float, float) or None
+        The noise's range, likewise (default: 0 to 0.5).
     decay : float
         The starting LMI bound.
     decay_limits : (float, float) or None
@@ -190,16 +196,19 @@ class ExplorerOptions:
         The starting time constant of the input reconstruction's filter.
     tau_limits : (float, float) or None
         Its range (``None``: the inputs are not reconstructed).
-    d_channels, v_channels : tuple of tuple
-        How each channel of ``d`` (``v``) follows the disturbance controls:
+    d_channels : tuple of tuple
+        How each channel of ``d`` follows the disturbance controls:
         ``(gain, speed)`` or ``(gain, speed, decay, kind)`` per channel
-        (``d_channels`` empty: ``(1, 1)`` for each unknown input).
+        (empty: ``(1, 1)`` for each unknown input).
+    v_channels : tuple of tuple
+        The same for the measurement disturbance ``v`` (empty: none).
     static_control : str
         The static book's main control: ``"pole"``, ``"amplitude"`` or
         ``"plant:<field>"`` (a field's own slider).
     note : str or None
-        ``"module:function"`` called with the fields that have sliders: a
-        sentence on this plant (``None``: none).
+        ``"module:function"`` called with the plant's physical parameters
+        (the experiment's ``plant_fields``): a sentence on this plant
+        (``None``: none).
     input_symbol : str
         The unknown input's symbol in the figure.
 
@@ -422,10 +431,54 @@ class WorkedExample:
         return None if spec is None else spec.config_key(self.name, "poles")
 
 
-class _Registry(Mapping):
+class RegistryView(Mapping):
+    """A read-only mapping made from the registry each time it is read.
+
+    What the package derives from the worked examples (the experiments by
+    name, the figures, the labs, the poles keys of the term config) is a view:
+    it follows the registry, a worked example found later included
+    (:func:`discover`), and nothing keeps a copy that could go stale.
+
+    Parameters
+    ----------
+    name : str
+        How it prints (``"FIGURES"``, ...).
+    items : callable
+        ``items(WORKED) -> dict``: the mapping, made from the registry.
+
+    Examples
+    --------
+    >>> from uio_teach.worked import RegistryView
+    >>> titles = RegistryView("TITLES", lambda worked: {n: e.title for n, e in worked.items()})
+    >>> titles["missile"], len(titles) >= 4
+    ('The missile autopilot', True)
+    """
+
+    def __init__(self, name: str, items: Callable[[Mapping[str, WorkedExample]], dict]) -> None:
+        self._name = name
+        self._make = items
+
+    def _items(self) -> dict:
+        return self._make(WORKED)
+
+    def __getitem__(self, key: Any) -> Any:
+        return self._items()[key]
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(self._items())
+
+    def __len__(self) -> int:
+        return len(self._items())
+
+    def __repr__(self) -> str:
+        return f"{self._name}({', '.join(map(str, self))})"
+
+
+class _Registry(RegistryView):
     """The worked examples by name, found in the modules of the packages read on first use."""
 
     def __init__(self) -> None:
+        super().__init__("WORKED", lambda _worked: self._load())
         self._entries: dict[str, WorkedExample] | None = None
         self._packages: list[tuple[list[str], str]] = [(list(__path__), __name__)]
 
@@ -452,18 +505,6 @@ class _Registry(Mapping):
                 raise RegistryError(f"worked examples declared twice: {', '.join(twice)}")
             self._entries = {e.name: e for e in found}
         return self._entries
-
-    def __getitem__(self, name: str) -> WorkedExample:
-        return self._load()[name]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._load())
-
-    def __len__(self) -> int:
-        return len(self._load())
-
-    def __repr__(self) -> str:
-        return f"WORKED({', '.join(self)})"
 
 
 WORKED: Mapping[str, WorkedExample] = _Registry()

@@ -32,7 +32,12 @@ from .. import examples, signals
 from .._display import format_poles
 from ..examples import MISSILE_PUBLISHED
 from ..existence import check_existence
-from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_SEED, MAX_VALUE, Experiment, param
+from ..experiments import (
+    MAX_SEED,
+    MAX_VALUE,
+    ContinuousExperiment,
+    param,
+)
 from ..lab_params import (
     MIN_INITIAL_ERROR,
     LabParams,
@@ -52,7 +57,7 @@ __all__ = ["MissileExperiment", "MISSILE", "MISSILE_LAB", "MissileParams"]
 
 
 @dataclass(frozen=True)
-class MissileExperiment(Experiment):
+class MissileExperiment(ContinuousExperiment):
     """The missile autopilot: the paper's ``x0`` and ``v1, v2``, the PMO started at ``xhat(0) = 0``.
 
     The unknown inputs are the paper's damped sinusoids
@@ -85,12 +90,6 @@ class MissileExperiment(Experiment):
         "poles",
         "PMO poles (the paper's are not given; see chapter 5)",
         key="pmo_poles",
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
     )
     v_parameters: tuple[tuple[float, float, float, str], ...] = examples.MISSILE_INPUTS
     noise_sigma: float = param(
@@ -191,7 +190,16 @@ def _runs(runs: Any) -> dict[str, Any]:
 
 def _missile_states(runs: Any, name: str, label: str, figs: str) -> Figure:
     # deferred: the registry is read without matplotlib, which the plotting module loads
-    from ..plotting import finish_panel, new_figure, symbol, time_label, with_unit
+    from ..plotting import (
+        COLORS,
+        describe,
+        finish_panel,
+        how_it_ends,
+        new_figure,
+        symbol,
+        time_label,
+        with_unit,
+    )
 
     m = _runs(runs)
     resp, free = m[name]["response"], m["free"]
@@ -199,16 +207,31 @@ def _missile_states(runs: Any, name: str, label: str, figs: str) -> Figure:
     axes = fig.subplots(2, 2, sharex=True)
     t = resp.time
     for i, ax in enumerate(axes.flat):
-        ax.plot(t, resp.states[i], color="tab:red", label=f"{symbol('x', i)} with $v$")
-        ax.plot(t, free.states[i], color="tab:green", label=f"{symbol('x', i)} without $v$")
+        ax.plot(t, resp.states[i], color=COLORS[1], label=f"{symbol('x', i)} with $v$")
+        ax.plot(t, free.states[i], color=COLORS[0], ls="--", label=f"{symbol('x', i)} without $v$")
         hat = symbol("x", i, hat=True)
         ax.plot(t, resp.estimates[i], color="k", linestyle=":", lw=2, label=hat)
         finish_panel(ax, with_unit(symbol("x", i)))
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
-    fig.suptitle(
+    title = (
         f"Missile autopilot, {label} (poles {format_poles(m[name]['observer'].poles(), 4)}); "
         f"the paper's {figs}"
+    )
+    fig.suptitle(title)
+    size = float(np.max(np.abs(resp.states)))
+    describe(
+        fig,
+        f"{title}: one panel per state x1 to x4 against time, the state with the unknown "
+        "inputs v (vermillion, solid), without them (blue, dashed) and the observer's estimate "
+        "(black, dotted). The unknown inputs move the states far from the run without them, "
+        f"and the estimate follows the state with v: the estimation error "
+        f"{how_it_ends(t, resp.error, size, m['plant'].dt)}.",
+        " ".join(
+            f"x{i + 1}: with v it ends at {resp.states[i, -1]:.3g}, without v at "
+            f"{free.states[i, -1]:.3g}; the error {how_it_ends(t, resp.error[i], size)}."
+            for i in range(resp.states.shape[0])
+        ),
     )
     return fig
 
@@ -223,7 +246,15 @@ def _missile_ginverse(runs: Any) -> Figure:
 
 def _missile_error(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib (see the first figure)
-    from ..plotting import finish_panel, new_figure, time_label, with_unit, zero_to_rounding
+    from ..plotting import (
+        describe,
+        finish_panel,
+        how_it_ends,
+        new_figure,
+        time_label,
+        with_unit,
+        zero_to_rounding,
+    )
 
     m = _runs(runs)
     fig = new_figure(9.0, 6.0)
@@ -241,12 +272,35 @@ def _missile_error(runs: Any) -> Figure:
     for ax in axes[1]:
         ax.set_xlabel(time_label(m["plant"].dt))
     fig.suptitle("Missile autopilot: estimation error of both observers")
+    pmo, gin = m["pmo"]["response"], m["ginverse"]["response"]
+    size = float(np.max(np.abs(pmo.states)))
+    describe(
+        fig,
+        "Missile autopilot: the estimation error e1 to e4 of the PMO (solid) and of the "
+        "g-inverse observer (dashed) against time, one panel per state: "
+        + "; ".join(
+            f"e{i + 1} {how_it_ends(pmo.time, pmo.error[i], size, m['plant'].dt)}"
+            for i in range(pmo.error.shape[0])
+        )
+        + f". The two observers' errors differ by up to "
+        f"{float(np.max(np.abs(pmo.error - gin.error))):.2g} at the start, errors of up to "
+        f"{float(np.max(np.abs(pmo.error))):.2g}.",
+    )
     return fig
 
 
 def _missile_inputs(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib (see the first figure)
-    from ..plotting import finish_panel, new_figure, symbol, time_label, with_unit
+    from ..plotting import (
+        COLORS,
+        describe,
+        finish_panel,
+        how_it_ends,
+        new_figure,
+        symbol,
+        time_label,
+        with_unit,
+    )
 
     m = _runs(runs)
     fig = new_figure(9.0, 5.5)
@@ -254,7 +308,7 @@ def _missile_inputs(runs: Any) -> Figure:
     t = m["time"]
     actual = m["pmo"]["response"].inputs.d
     for i, ax in enumerate(axes):
-        ax.plot(t, actual[i], color="tab:red", lw=2.5, alpha=0.6, label=symbol("v", i))
+        ax.plot(t, actual[i], color=COLORS[1], lw=2.5, alpha=0.6, label=symbol("v", i))
         for name, label, style in (("pmo", "PMO", "-"), ("ginverse", "g-inverse", ":")):
             est = m[name]["inputs"].estimates[i]
             hat = symbol("v", i, hat=True)
@@ -266,6 +320,18 @@ def _missile_inputs(runs: Any) -> Figure:
     fig.suptitle(
         r"Missile autopilot: unknown inputs and their reconstructions "
         r"$\hat{v} = E^+(\dot{\hat{x}} - A\hat{x})$ (Fig. 4.5-4.6, 4.11-4.12)"
+    )
+    said = []
+    for i in range(actual.shape[0]):
+        gap = m["pmo"]["inputs"].estimates[i] - actual[i]
+        scale = float(np.max(np.abs(actual[i])))
+        said.append(f"for v{i + 1} the gap {how_it_ends(t, gap, scale, m['plant'].dt)}")
+    describe(
+        fig,
+        "Missile autopilot: the unknown inputs v1 and v2 (wide pale vermillion lines) and their "
+        "reconstructions by the PMO (black, solid) and the g-inverse observer (black, dotted) "
+        "against time, one panel per input. After a short start the reconstructions lie on the "
+        "inputs: " + "; ".join(said) + ".",
     )
     return fig
 

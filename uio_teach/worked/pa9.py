@@ -35,12 +35,10 @@ from .. import signals
 from .._display import format_poles
 from ..existence import check_existence
 from ..experiments import (
-    MAX_DURATION,
-    MAX_SAMPLES,
     MAX_SEED,
     MAX_VALUE,
     SEED_DOC,
-    Experiment,
+    ContinuousExperiment,
     param,
     plant_from_params,
 )
@@ -62,7 +60,7 @@ __all__ = ["PA9Experiment", "PA9", "PA9_LAB", "PA9Params"]
 
 
 @dataclass(frozen=True)
-class PA9Experiment(Experiment):
+class PA9Experiment(ContinuousExperiment):
     """Practical Assignment 9: the decoupling UIO, a sinusoidal and a piecewise-constant ``d``.
 
     Attributes
@@ -112,12 +110,6 @@ class PA9Experiment(Experiment):
     )
     seed: int | None = param(
         4, "int", SEED_DOC, config="seed", minimum=0, maximum=MAX_SEED, omit_default=True
-    )
-    duration: float = param(
-        None, "float", "simulated time", unit="s", init=False, positive=True, maximum=MAX_DURATION
-    )
-    samples: int = param(
-        None, "int", "number of time points", init=False, minimum=2, maximum=MAX_SAMPLES
     )
     sine_amplitude: float = param(
         1.0,
@@ -211,7 +203,9 @@ def _runs(runs: Any) -> dict[str, Any]:
 def _pa9_disturbance(runs: Any, which: str) -> Figure:
     # deferred: the registry is read without matplotlib, which the plotting module loads
     from ..plotting import (
+        describe,
         finish_panel,
+        how_it_ends,
         new_figure,
         plot_error,
         plot_residual,
@@ -232,7 +226,17 @@ def _pa9_disturbance(runs: Any, which: str) -> Figure:
     plot_residual(ax_r, resp)
     ax_r.set_xlabel(time_label(resp.plant.dt))
     kind = "sinusoidal" if which == "sine" else "piecewise-constant"
-    fig.suptitle(f"PA9: UIO with a {kind} disturbance (poles {format_poles(r['uio'].poles(), 4)})")
+    title = f"PA9: UIO with a {kind} disturbance (poles {format_poles(r['uio'].poles(), 4)})"
+    fig.suptitle(title)
+    size = float(np.max(np.abs(resp.states)))
+    describe(
+        fig,
+        f"{title}: against time, the disturbance d (black), the UIO's estimation error e1, "
+        "e2, e3 and its residual r1, r2, each channel in its own colour and line style. The "
+        f"error {how_it_ends(t, resp.error, size, resp.plant.dt)}, whatever d does; the "
+        f"residual {how_it_ends(t, resp.residual, float(np.max(np.abs(resp.outputs))))}.",
+        f"The disturbance d(t) = {formula}.",
+    )
     return fig
 
 
@@ -256,7 +260,17 @@ def _pa9_states(runs: Any) -> Figure:
 
 def _pa9_luenberger(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib (see the first figure)
-    from ..plotting import finish_panel, new_figure, residual_colors, symbol, time_label
+    from ..plotting import channel_style as look
+    from ..plotting import (
+        describe,
+        finish_panel,
+        how_it_ends,
+        marker_style,
+        new_figure,
+        residual_channels,
+        symbol,
+        time_label,
+    )
 
     r = _runs(runs)
     fig = new_figure(9.0, 5.5)
@@ -271,20 +285,39 @@ def _pa9_luenberger(runs: Any) -> Figure:
         ):
             ax = axes[row, col]
             values = getattr(sine, what)
-            colors = (
-                residual_colors(sine.plant.C)
+            channels = (
+                residual_channels(sine.plant.C)
                 if what == "residual"
-                else [f"C{i}" for i in range(values.shape[0])]
+                else list(range(values.shape[0]))
             )
-            for i in range(values.shape[0]):
-                ax.plot(sine.time, values[i], color=colors[i], label=symbol(sym, i))
-                ax.plot(steps.time, getattr(steps, what)[i], color=colors[i], linestyle="--")
+            for i, j in enumerate(channels):
+                # the line style says which disturbance: a colour and a marker per channel
+                style = {"color": look(j)["color"], **marker_style(j, sine.time.size)}
+                ax.plot(sine.time, values[i], **style, label=symbol(sym, i))
+                ax.plot(steps.time, getattr(steps, what)[i], **style, linestyle="--")
             finish_panel(ax, label)
         axes[0, col].set_title(name)
         axes[1, col].set_xlabel(time_label(r["plant"].dt))
     fig.suptitle(
         f"PA9, poles {format_poles(r['uio'].poles(), 4)}: solid sinusoidal d, "
         "dashed piecewise-constant d"
+    )
+    words = []
+    for name, sine, steps in pairs:
+        gap = float(np.max(np.abs(sine.error - steps.error)))
+        size = float(np.max(np.abs(sine.states)))
+        same = "lie on top of each other" if gap <= 1e-6 * size else f"differ by up to {gap:.2g}"
+        words.append(
+            f"{name}: the errors for the two disturbances {same}; with the sinusoid the "
+            f"error {how_it_ends(sine.time, sine.error, size, sine.plant.dt)}"
+        )
+    describe(
+        fig,
+        "The estimation error and the residual of the UIO and of a Luenberger observer with "
+        "the same poles on PA9, each for a sinusoidal (solid) and a piecewise-constant "
+        "(dashed) disturbance; each channel has its own colour and marker. "
+        + ". ".join(words)
+        + ".",
     )
     return fig
 

@@ -118,7 +118,6 @@ class QuadrupleTankExperiment(Experiment):
         minimum=0.0,
         maximum=0.99,
         range=(0.0, 0.95),
-        control="plant",
     )
     gamma2: float = param(
         0.60,
@@ -127,7 +126,6 @@ class QuadrupleTankExperiment(Experiment):
         minimum=0.0,
         maximum=0.99,
         range=(0.0, 0.95),
-        control="plant",
     )
     step_size: float = param(
         0.5, "float", "size of the step", unit="V", key="pump1.step", maximum=MAX_VALUE
@@ -392,14 +390,24 @@ def _run(runs: Any) -> dict[str, Any]:
 
 def _figure_error(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib, which the plotting module loads
-    from ..plotting import finish_panel, new_figure, plot_error, symbol, time_label, with_unit
+    from ..plotting import (
+        channel_style,
+        describe,
+        finish_panel,
+        how_it_ends,
+        new_figure,
+        plot_error,
+        symbol,
+        time_label,
+        with_unit,
+    )
 
     r = _run(runs)
     resp, luen = r["uio_run"], r["luen_run"]
     fig = new_figure(8.0, 7.0)
     ax_d, ax_e, ax_l = fig.subplots(3, 1, sharex=True)
     for i in range(resp.inputs.d.shape[0]):
-        ax_d.plot(resp.time, resp.inputs.d[i], label=symbol("d", i))
+        ax_d.plot(resp.time, resp.inputs.d[i], **channel_style(i), label=symbol("d", i))
     finish_panel(ax_d, with_unit("pump deviations $d$", "V"))
     plot_error(ax_e, resp)
     ax_e.set_title(
@@ -409,15 +417,23 @@ def _figure_error(runs: Any) -> Figure:
     ax_l.set_title("Luenberger observer with the same poles, from the same start", fontsize=9)
     ax_l.set_xlabel(time_label(r["plant"].dt))
     run = r["run"]
-    fig.suptitle(
-        f"Quadruple tank, gamma = {run.gamma1:g}, {run.gamma2:g}: the UIO ignores the pumps"
+    title = f"Quadruple tank, gamma = {run.gamma1:g}, {run.gamma2:g}: the UIO ignores the pumps"
+    fig.suptitle(title)
+    size = float(np.max(np.abs(resp.states)))
+    t = resp.time
+    describe(
+        fig,
+        f"{title}. Three panels against time: the pumps' unknown deviations d1, d2; the UIO's "
+        f"estimation error, which {how_it_ends(t, resp.error, size, resp.plant.dt)}; the "
+        "Luenberger observer's error with the same poles, which "
+        f"{how_it_ends(t, luen.error, size, luen.plant.dt)}.",
     )
     return fig
 
 
 def _figure_zeros(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib, which the plotting module loads
-    from ..plotting import finish_panel, new_figure
+    from ..plotting import COLORS, describe, finish_panel, new_figure
 
     run = _run(runs)["run"]
     ratio = run.gamma2 / run.gamma1
@@ -434,15 +450,15 @@ def _figure_zeros(runs: Any) -> Figure:
     total = g1 * (1 + ratio)
     fig = new_figure(8.0, 4.5)
     ax = fig.subplots()
-    ax.plot(total, zeros[:, 0], color="C0", label="faster zero")
-    ax.plot(total, zeros[:, 1], color="C3", label="slower zero")
+    ax.plot(total, zeros[:, 0], color=COLORS[0], label="faster zero")
+    ax.plot(total, zeros[:, 1], color=COLORS[1], ls="--", label="slower zero")
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.axvline(1.0, color="0.5", lw=0.8, ls=":")
     mine = np.sort(check_existence(run.plant()).invariant_zeros.real)
     here = run.gamma1 + run.gamma2
     ax.plot([here, here], mine, "ko", mfc="none", label="this run's valves")
-    ax.axvspan(total[0], 1.0, color="C3", alpha=0.08, lw=0)
-    ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="C3")
+    ax.axvspan(total[0], 1.0, color=COLORS[1], alpha=0.08, lw=0)
+    ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="0.15")
     lim = 2.5 * max(float(np.max(np.abs(mine))), 0.02)
     ax.set_ylim(-lim, 0.6 * lim)
     ax.set_xlabel(
@@ -451,6 +467,15 @@ def _figure_zeros(runs: Any) -> Figure:
     )
     finish_panel(ax, "invariant zero (1/s)")
     ax.set_title("Quadruple tank: the zeros move with the valves and cross 0 at 1")
+    describe(
+        fig,
+        "The two invariant zeros of the quadruple tank against gamma1 + gamma2 (valves moved "
+        f"together, gamma2 = {ratio:.3g} gamma1): the faster zero (blue, solid) stays "
+        "negative; the slower one (vermillion, dashed) rises through zero at gamma1 + gamma2 "
+        "= 1 and is positive below it, where no UIO exists (the shaded band). This run's "
+        f"valves, gamma1 + gamma2 = {here:.3g}, give the zeros {mine[0]:.3g} and "
+        f"{mine[1]:.3g} (open circles).",
+    )
     return fig
 
 
