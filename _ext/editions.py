@@ -159,7 +159,12 @@ class StudentEdition(SphinxTransform):
             if isinstance(section.parent, nodes.section):  # a section of a page: dropped whole
                 self._drop(section)
                 continue
-            # the page itself (the instructors' page, in the table of contents): a stub
+            # the page itself (the instructors' page, in the table of contents): a stub; its
+            # sections go with their labels (a reference to one reads as its title)
+            # last first: a section's label may close the section before it, still in place
+            for nested in reversed(list(section.findall(nodes.section))[1:]):
+                if self._attached(nested):
+                    self._drop(nested)
             title = section.next_node(nodes.title)
             for child in list(section.children):
                 if child is not title:
@@ -174,15 +179,25 @@ class StudentEdition(SphinxTransform):
         parent = section.parent
         ids = set(section.get("ids", []))
         names = set(section.get("names", []))
+        labels = []  # its labels: the internal targets right in front of it
         k = parent.index(section) - 1
-        while k >= 0:  # its labels: the internal targets right in front of it
-            sib = parent.children[k]
-            if not isinstance(sib, nodes.target) or sib.get("refuri"):
-                break
-            names |= set(sib.get("names", []))
-            ids |= set(sib.get("ids", []))
-            parent.remove(sib)
+        while k >= 0 and _is_label(parent.children[k]):
+            labels.append((parent, parent.children[k]))
             k -= 1
+        # a label written before a heading can also close the section before it (MyST)
+        node = parent.children[k] if k >= 0 else None
+        while isinstance(node, nodes.section) and node.children:
+            last = node.children[-1]
+            if _is_label(last):
+                labels.append((node, last))
+                node.remove(last)
+                continue
+            node = last
+        for owner, target in labels:
+            names |= set(target.get("names", []))
+            ids |= set(target.get("ids", []))
+            if target.parent is owner and any(c is target for c in owner.children):
+                owner.remove(target)
         parent.remove(section)
         dropped = _dropped(self.env)
         for name in names:  # no label of the page leads there any more
@@ -191,6 +206,11 @@ class StudentEdition(SphinxTransform):
             dropped[name] = (self.env.docname, text)
         for i in ids:
             self.document.ids.pop(i, None)
+
+
+def _is_label(node: nodes.Node) -> bool:
+    """An internal target (a ``(label)=`` line), not a link to elsewhere."""
+    return isinstance(node, nodes.target) and not node.get("refuri")
 
 
 def _dropped(env: Any) -> dict[str, tuple[str, str]]:

@@ -628,3 +628,49 @@ def test_labs_and_figures_never_replace_each_others_folders(tmp_path, capsys):
         capsys.readouterr().err
     )
     assert snapshot(tmp_path) == before
+
+
+STUB_BOOK = {
+    "index.md": "# Book\n\n```{toctree}\ninstructors\n```\n\n"
+    "See {ref}`sec-demo-grading` and {ref}`the grading <sec-demo-grading>`.\n\n"
+    "## Work\n\nText.\n\n(sec-demo-tutors)=\n## Instructor notes\n\nSECRET-NOTE.\n",
+    "instructors.md": "(sec-demo-instructors)=\n# For instructors\n\nSECRET-STUB.\n\n"
+    "## Handing out\n\nSECRET-HANDOUT.\n\n"
+    "(sec-demo-grading)=\n## Grading\n\nSECRET-GRADING.\n",
+}
+
+
+@pytest.mark.parametrize("edition", ["student", "instructor"])
+@pytest.mark.book
+def test_a_reference_into_the_instructors_page_reads_as_its_title_in_the_student_edition(
+    tmp_path, edition
+):
+    """The instructors' page is a stub for students: its sections go with their labels, and a
+    reference to one from another page is its title in plain text (no warning under -W -n); a
+    tutors' section goes with the label in front of its heading."""
+    src = tmp_path / "src"
+    src.mkdir()
+    for name, text in STUB_BOOK.items():
+        (src / name).write_text(text)
+    (src / "conf.py").write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(ROOT / '_ext')!r})\n"
+        "extensions = ['myst_nb', 'sphinx_exercise', 'editions']\n"
+        "nb_execution_mode = 'off'\n"
+    )
+    env = dict(os.environ, UIO_TEACH_EDITION=edition)
+    proc = subprocess.run(
+        [sys.executable, "-m", "sphinx", "-W", "-n", "-E", "-q", "-b", "html", str(src),
+         str(tmp_path / "html")],
+        capture_output=True, text=True, env=env, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    index = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
+    stub = (tmp_path / "html" / "instructors.html").read_text(encoding="utf-8")
+    if edition == "student":
+        assert "SECRET" not in stub and "SECRET" not in index
+        assert re.search(r"See <span>Grading</span> and <span>the grading</span>", index)
+        # the label written before the tutors' heading closes the section before it: gone too
+        assert 'id="sec-demo-tutors"' not in index and "Instructor notes" not in index
+    else:
+        assert "SECRET-GRADING" in stub and 'href="instructors.html#sec-demo-grading"' in index

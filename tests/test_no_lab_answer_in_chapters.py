@@ -43,6 +43,8 @@ DOCUMENT_KEYS = {
 DOCUMENT_ENTRIES = {"pa9": {"F": (1, 4, 7)}, "case_study": {}, "missile": {}}
 GROUPS, SEEDS = 6, (2027, 1)
 SCALARS = "catch times and noise RMS"
+# a simple fraction or a printed value's edge, told from rounding of the answers (6+ digits)
+SMALL = 1e-8
 MIN_DIGITS = 3  # a printed number of fewer significant digits says too little to give anything away
 
 _NUMBER = re.compile(r"(?<![\w.])-?(?:\d+\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.])")
@@ -145,7 +147,7 @@ def lab_answers(lab_id: str, params) -> dict[str, list[float]]:
 def _simple(x: float) -> bool:
     """Zero, or a fraction p/q with q <= 20: such entries (2/15, 9/7, ...) fill the matrices of
     small integer plants and match a printed number by chance, whatever the quantity."""
-    return abs(x) <= 1e-12 or any(abs(x * q - round(x * q)) <= 1e-9 * q for q in range(1, 21))
+    return abs(x) <= SMALL or any(abs(x * q - round(x * q)) <= SMALL * q for q in range(1, 21))
 
 
 def groups_of(lab_id: str) -> list[tuple[str, object]]:
@@ -183,7 +185,7 @@ def printed_answers(lab_id: str, who: str, answers: dict, pages: dict) -> list[s
                 (f"{a:.6g}", value)
                 for a in numbers
                 for value, half in printed
-                if abs(value - a) <= half * (1 + 1e-9)
+                if abs(value - a) <= half * (1 + SMALL)
             }
             # distinct entries matched by distinct printed numbers
             if min(len({h[0] for h in hits}), len({h[1] for h in hits})) >= need:
