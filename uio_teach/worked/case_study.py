@@ -304,7 +304,7 @@ CASE_STUDY_LAB = CASE_STUDY.with_values(
     seed=7,
     v_hold=4,
 )
-"""The lab's own numbers: the case study's plant and steps, another pole, start and signals.
+"""The lab's own numbers (the case study's plant and steps; another pole, start and signals).
 
 The chapter prints the results of :data:`CASE_STUDY` (the pole moved to 0.3,
 the run's error, ...); the lab asks for the same computations on these

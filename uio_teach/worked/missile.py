@@ -383,7 +383,7 @@ def _table2(runs: Any, out: Path) -> list[Path]:
 
 
 MISSILE_LAB = MISSILE.with_values(poles=(-90.0, -140.0), noise_sigma=0.015, noise_seed=3)
-"""The lab's own numbers: the paper's plant, ``x0`` and inputs, other PMO poles and noise.
+"""The lab's own numbers (the paper's plant, ``x0`` and inputs; other PMO poles and noise).
 
 The chapter prints the results of :data:`MISSILE` (the catch times with the
 poles -100, -120, the noise RMS of seed 7, ...); the lab asks for the same

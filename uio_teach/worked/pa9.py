@@ -333,7 +333,7 @@ PA9_LAB = PA9.with_values(
     switch_times=(0.0, 1.5, 4.0, 8.0),
     switch_values=(-1.0, 2.0, 0.5, -1.5),
 )
-"""The lab's own numbers: the chapter's plant and grid, other poles, start and disturbances.
+"""The lab's own numbers (the chapter's plant and grid; other poles, start and disturbances).
 
 The chapters print the results of :data:`PA9` (``K1``, the errors, ...); the
 lab asks for the same computations on these numbers, so no page of the book
