@@ -178,7 +178,7 @@ def test_only_restricts_and_progress_lines_and_summary(tmp_path, capsys):
     assert lines[0].startswith("[1/2] case_error: ") and lines[0].endswith(" s)")
     assert lines[1].startswith("[2/2] missile_table2: ")
     assert lines[2].startswith(
-        f"2 of 2 figures (3 files) and {figures.MANIFEST} written to {tmp_path} in "
+        f"2 of 2 figures (4 files) and {figures.MANIFEST} written to {tmp_path} in "
     )
 
 

@@ -72,6 +72,12 @@ class FigureDescription:
         two (a screen reader reads it in place of the picture).
     details : str
         A longer description, panel by panel (empty when the text alternative says it all).
+
+    Examples
+    --------
+    >>> from uio_teach.figure_text import FigureDescription
+    >>> FigureDescription("The error decays to zero.").details
+    ''
     """
 
     alt: str
@@ -123,6 +129,15 @@ def describe(fig: Figure, alt: str, details: str | None = None) -> Figure:
 def description(fig: Figure) -> FigureDescription | None:
     """The figure's description (:func:`describe`), or ``None``.
 
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+
+    Returns
+    -------
+    FigureDescription or None
+
     Examples
     --------
     >>> from uio_teach.figure_text import description
@@ -136,6 +151,16 @@ def description(fig: Figure) -> FigureDescription | None:
 
 def description_text(fig: Figure) -> str:
     """The description as plain text, for a file beside the picture (empty if none).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+
+    Returns
+    -------
+    str
+        The text alternative, a blank line and the long description, wrapped at 88 columns.
 
     Examples
     --------
