@@ -225,13 +225,12 @@ def _open_local(browser, book_server: str, page: str, width: int, listen: dict |
             route.abort()
 
     tab.route("**/*", route)
+    console = found["console"]
     tab.on(
         "console",
-        lambda msg: (
-            found["console"].append(f"console: {msg.text}") if msg.type == "error" else None
-        ),
+        lambda msg: console.append(f"console: {msg.text}") if msg.type == "error" else None,
     )
-    tab.on("pageerror", lambda exc: found["console"].append(f"page error: {exc}"))
+    tab.on("pageerror", lambda exc: console.append(f"page error: {exc}"))
     tab.on(
         "response",
         lambda r, failed=found["failed"]: (
@@ -281,7 +280,8 @@ def page_facts(browser, book_server: str, page: str, width: int) -> dict:
         facts["structure"] = tab.evaluate(_STRUCTURE_JS)
         # what the page itself requested; axe-core then fetches the style sheets again to read
         # them (its CSSOM), with URLs of its own making that the page never asks for
-        facts["failed"] = list(facts["failed"])  # a copy: later requests are not the page's
+        facts["failed"] = list(facts["failed"])  # copies: later requests are not the page's
+        facts["console"] = list(facts["console"])
         facts["axe"] = axe_violations(tab)
     finally:
         context.close()
