@@ -140,6 +140,11 @@ def test_an_input_figure_and_the_banks_figure_say_what_they_show():
     said = plotting.description(fig)
     assert said.alt.startswith("Alarms of the bank of UIOs, one panel per run")
     assert said.details.startswith("Run no fault: ")
+    # on a phone the legend of the whole figure takes one column: the picture fits a phone
+    before = _drawn(fig)
+    narrow = re.search(r'srcset="[^"]+" width="(\d+)"', figure_text.figure_html(fig))
+    assert int(narrow.group(1)) <= 1.1 * figure_text.NARROW_WIDTH * fig.dpi, narrow.group(1)
+    assert _drawn(fig) == before
     import matplotlib.pyplot as plt
 
     plt.close("all")

@@ -225,16 +225,17 @@ def _open_local(browser, book_server: str, page: str, width: int, listen: dict |
             route.abort()
 
     tab.route("**/*", route)
+    console = found["console"]
     tab.on(
         "console",
-        lambda msg: (
-            found["console"].append(f"console: {msg.text}") if msg.type == "error" else None
-        ),
+        lambda msg: console.append(f"console: {msg.text}") if msg.type == "error" else None,
     )
-    tab.on("pageerror", lambda exc: found["console"].append(f"page error: {exc}"))
+    tab.on("pageerror", lambda exc: console.append(f"page error: {exc}"))
     tab.on(
         "response",
-        lambda r: found["failed"].append(f"{r.status} {r.url}") if r.status >= 400 else None,
+        lambda r, failed=found["failed"]: (
+            failed.append(f"{r.status} {r.url}") if r.status >= 400 else None
+        ),
     )
     response = tab.goto(f"{book_server}/{page}.html", wait_until="load")
     found["loaded"] = response is not None and response.ok
@@ -277,6 +278,10 @@ def page_facts(browser, book_server: str, page: str, width: int) -> dict:
         facts["wide_outputs"] = tab.evaluate(_WIDE_OUTPUTS_JS)  # it opens the dropdowns
         # with every dropdown open, so that what a reader opens is checked too
         facts["structure"] = tab.evaluate(_STRUCTURE_JS)
+        # what the page itself requested; axe-core then fetches the style sheets again to read
+        # them (its CSSOM), with URLs of its own making that the page never asks for
+        facts["failed"] = list(facts["failed"])  # copies: later requests are not the page's
+        facts["console"] = list(facts["console"])
         facts["axe"] = axe_violations(tab)
     finally:
         context.close()

@@ -72,6 +72,12 @@ class FigureDescription:
         two (a screen reader reads it in place of the picture).
     details : str
         A longer description, panel by panel (empty when the text alternative says it all).
+
+    Examples
+    --------
+    >>> from uio_teach.figure_text import FigureDescription
+    >>> FigureDescription("The error decays to zero.").details
+    ''
     """
 
     alt: str
@@ -123,6 +129,15 @@ def describe(fig: Figure, alt: str, details: str | None = None) -> Figure:
 def description(fig: Figure) -> FigureDescription | None:
     """The figure's description (:func:`describe`), or ``None``.
 
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+
+    Returns
+    -------
+    FigureDescription or None
+
     Examples
     --------
     >>> from uio_teach.figure_text import description
@@ -136,6 +151,16 @@ def description(fig: Figure) -> FigureDescription | None:
 
 def description_text(fig: Figure) -> str:
     """The description as plain text, for a file beside the picture (empty if none).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+
+    Returns
+    -------
+    str
+        The text alternative, a blank line and the long description, wrapped at 88 columns.
 
     Examples
     --------
@@ -206,9 +231,21 @@ def narrow_layout(fig: Figure, width: float = NARROW_WIDTH) -> Iterator[Figure]:
     specs = [(ax, ax.get_subplotspec()) for ax in panels]
     ticks = [(ax, ax.xaxis.get_tick_params(), ax.yaxis.get_tick_params()) for ax in panels]
     legends = [(ax, ax.get_legend()) for ax in panels]
-    titles = [(ax, ax.get_title()) for ax in panels]
+    titles = [(ax, ax.get_title(), _font(ax.title)) for ax in panels]
     suptitle = fig.get_suptitle() if hasattr(fig, "get_suptitle") else ""
+    figure_legends = list(fig.legends)
     try:
+        for old in figure_legends:  # a legend of the whole figure: one column above the panels
+            fig.legends.remove(old)
+            texts = old.get_texts()
+            fig.legend(
+                old.legend_handles,
+                [t.get_text() for t in texts],
+                loc="outside upper center",
+                ncols=1,
+                fontsize=texts[0].get_fontsize() if texts else None,
+                frameon=False,
+            )
         if len(panels) > 1:
             grid = GridSpec(len(panels), 1, figure=fig)
             for k, ax in enumerate(panels):
@@ -216,7 +253,7 @@ def narrow_layout(fig: Figure, width: float = NARROW_WIDTH) -> Iterator[Figure]:
         rows = 0
         for ax in panels:
             ax.tick_params(labelbottom=True, labelleft=True)
-            ax.set_title(textwrap.fill(ax.get_title(), 40))
+            ax.title.set_text(textwrap.fill(ax.get_title(), 40))
             rows += _legend_above(ax)
         if suptitle:
             fig.suptitle(textwrap.fill(suptitle, 36))
@@ -236,12 +273,18 @@ def narrow_layout(fig: Figure, width: float = NARROW_WIDTH) -> Iterator[Figure]:
             ax.yaxis.set_tick_params(**_label_params(y))
         for ax, legend in legends:
             ax.legend_ = legend
-        for ax, title in titles:
-            ax.set_title(title)
+        for ax, title, font in titles:
+            ax.set_title(title, **font)
         if suptitle:
             fig.suptitle(suptitle)
+        fig.legends[:] = figure_legends
         if fig.get_layout_engine() is not engine:
             fig.set_layout_engine(engine if engine is not None else "none")
+
+
+def _font(text: Any) -> dict:
+    """The font of a title, to set it again as it was."""
+    return {"fontsize": text.get_fontsize(), "fontweight": text.get_fontweight()}
 
 
 def _label_params(params: dict) -> dict:
@@ -273,7 +316,7 @@ def _legend_above(ax: Any) -> int:
     rows = -(-len(labels) // ncols)
     if ax.get_title():  # the title goes above the legend
         size = texts[0].get_fontsize() if texts else 10.0
-        ax.set_title(ax.get_title(), pad=8 + rows * 1.45 * size)
+        ax.set_title(ax.get_title(), pad=8 + rows * 1.45 * size, **_font(ax.title))
     return rows
 
 
