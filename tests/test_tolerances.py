@@ -10,6 +10,7 @@ tolerance fails a named test). A new tolerance without a pin fails
 
 from __future__ import annotations
 
+import copy
 import warnings
 from collections.abc import Callable
 
@@ -18,7 +19,14 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import tolerances as tols
+from uio_teach._validation import as_poles
 from uio_teach.balancing import _split_from_modes, modes_agree
+from uio_teach.checks.common import (
+    looks_two_decimals,
+    rerun_without_unknown_inputs,
+    same_poles,
+    up_to,
+)
 from uio_teach.existence import conditioning_condition, rank_condition, zero_condition
 from uio_teach.linalg import checked_zeros, is_stable, observability_decomposition, rank_decision
 from uio_teach.lmi import _meets_each
@@ -257,6 +265,66 @@ def _():
 def _():
     r = DECLARED["GAIN_ROUNDED_RTOL"]
     return _gain(r / 10) == "warned", _gain(10 * r) == "refused"
+
+
+@pin("CONJUGATE_RTOL")
+def _():
+    r = DECLARED["CONJUGATE_RTOL"]  # poles of size below 1: the tolerance is absolute
+
+    def paired(e):
+        return outcome(lambda: as_poles("poles", [-0.3 + 0.4j, -0.3 - 0.4j + e * 1j])) == "ok"
+
+    return paired(r / 10), not paired(10 * r)
+
+
+# answers' checks --------------------------------------------------------------------------------
+@pin("CHECK_ZERO_ATOL")
+def _():
+    r = DECLARED["CHECK_ZERO_ATOL"]
+    return up_to(r / 10, "x") == " (up to rounding)", up_to(10 * r, "x") != " (up to rounding)"
+
+
+@pin("CHECK_EXACT_RTOL")
+def _():
+    # a matrix typed with the 2 decimals of a document, off by e from them (scale 1)
+    r = DECLARED["CHECK_EXACT_RTOL"]
+    exact = np.array([[1 / 3, -0.25]])
+
+    def typed(e):
+        return looks_two_decimals(np.array([[0.33 + e, -0.25]]), exact)
+
+    return typed(r / 10), not typed(10 * r)
+
+
+_RUN = ut.simulate(
+    ut.Plant([[-1.0]], [[1.0]], E=[[1.0]]),
+    ut.design_luenberger(ut.Plant([[-1.0]], [[1.0]], E=[[1.0]]), poles=[-3.0]),
+    np.linspace(0.0, 1.0, 11),
+    initial_state=[2.0],
+)
+
+
+@pin("CHECK_RUN_RTOL")
+def _():
+    # the run replayed without its (absent) unknown input is the run itself: a change e of its
+    # error, relative to its largest state (2), is what the replay finds
+    r = DECLARED["CHECK_RUN_RTOL"]
+
+    def same(e):
+        run = copy.copy(_RUN)
+        run.error = _RUN.error.copy()
+        run.error[0, -1] += e * 2.0
+        return rerun_without_unknown_inputs(run)[1]
+
+    return same(r / 10), not same(10 * r)
+
+
+@pin("CHECK_RTOL")
+def _():
+    r = DECLARED["CHECK_RTOL"]
+    return same_poles([-1 - r / 10, -2.0], [-2.0, -1.0]), not same_poles(
+        [-1 - 10 * r, -2], [-2, -1]
+    )
 
 
 @pin("DECAY_RTOL")
