@@ -19,6 +19,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import tolerances as tols
+from uio_teach._display import format_matrix_line, format_poles
 from uio_teach._validation import as_poles
 from uio_teach.balancing import _split_from_modes, modes_agree
 from uio_teach.checks.common import (
@@ -333,6 +334,21 @@ def _():
     meets = _meets_each(np.array([-1 + r / 10 + 0j]), False, 1.0)[0]
     misses = not _meets_each(np.array([-1 + 10 * r + 0j]), False, 1.0)[0]
     return bool(meets), bool(misses)
+
+
+# what is shown as zero -------------------------------------------------------------------------
+@pin("ROUNDING_RTOL")
+def _():
+    r = DECLARED["ROUNDING_RTOL"]
+    return format_poles([-1 + r / 10 * 1j]) == "-1", format_poles([-1 + 10 * r * 1j]) != "-1"
+
+
+@pin("DISPLAY_ZERO_RTOL")
+def _():
+    r = DECLARED["DISPLAY_ZERO_RTOL"]
+    shown = format_matrix_line([[1.0, r / 10]]) == "[[1, 0]]"
+    kept = format_matrix_line([[1.0, 10 * r]]) != "[[1, 0]]"
+    return shown, kept
 
 
 @pin("TIME_GRID_RTOL")

@@ -145,6 +145,18 @@ rebuilt), meets what it must to this fraction (at least 1): a solver meets its c
 to about ``1e-8`` and a double pole moves by ``sqrt(eps)``; a typo or a wrong formula is
 farther off."""
 
+# what is shown as zero ---------------------------------------------------------------------------
+
+ROUNDING_RTOL = 1e-9
+"""A computed value (a pole, a run's error or residual) below this fraction of its scale is
+shown and called zero to rounding (``format_poles``, a panel's "zero to rounding"): eigenvalues
+and long recursions carry more rounding than a single product, far less than any design
+leaves."""
+
+DISPLAY_ZERO_RTOL = 1e-12
+"""An entry (or an imaginary part) of a printed matrix or number below this fraction of the
+largest entry shown with it prints as 0: the rounding of a product of data of order 1."""
+
 # time grids -------------------------------------------------------------------------------------
 
 TIME_GRID_RTOL = 1e-9
