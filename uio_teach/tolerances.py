@@ -12,7 +12,7 @@ Examples
 >>> tolerances.IDENTITY_RTOL
 1e-08
 >>> sorted(tolerances.ALL)[:3]
-['AMPLIFICATION_LIMIT', 'CLOSE_NOTE_RTOL', 'DECAY_RTOL']
+['AMPLIFICATION_LIMIT', 'CHECK_EXACT_RTOL', 'CHECK_RTOL']
 """
 
 from __future__ import annotations
