@@ -5,7 +5,8 @@ times outside, both built from the declared value, judged by the package reading
 ``test_tolerance_holds`` checks both at the declared value; ``test_tolerance_is_pinned`` sets it
 a hundred times looser and a hundred times tighter and checks that its pin then fails (a moved
 tolerance fails a named test). A new tolerance without a pin fails
-``test_every_tolerance_has_a_pin``.
+``test_every_tolerance_has_a_pin``, and a literal tolerance written anywhere else in the package
+fails ``test_no_tolerance_outside_tolerances_py``.
 """
 
 from __future__ import annotations
