@@ -40,6 +40,7 @@ from uio_teach.placement import strip_fixed
 from uio_teach.simulation import _check_discrete_grid
 from uio_teach.verify import (
     DecouplingWarning,
+    _condition_numbers,
     check_decoupling,
     check_identity,
     check_poles,
@@ -201,6 +202,21 @@ def _():
 def _():
     r = DECLARED["WARN_RTOL"]
     return _poles_off(r / 10) == "warned", _poles_off(10 * r) == "refused"
+
+
+@pin("ROUNDOFF_ROOM")
+def _():
+    # an eigenvalue of condition number about 1e5: its round-off n eps ||F|| kappa is 4.4e-6,
+    # above POLE_RTOL, so only ROUNDOFF_ROOM accepts an error of that order
+    F = np.array([[-1.0, 1e5], [0.0, -2.0]])
+    w, kappa = _condition_numbers(F)
+    unit = 2 * EPS * np.linalg.norm(F, 2) * kappa[np.argmin(abs(w + 1))]
+    room = DECLARED["ROUNDOFF_ROOM"]
+
+    def off(c):
+        return outcome(lambda: check_poles(F, [-1.0 - c * unit, -2.0]))
+
+    return off(room / 10) == "ok", off(10 * room) == "warned"
 
 
 @pin("IDENTITY_RTOL")

@@ -83,6 +83,12 @@ modes, or refused as indistinguishable from it)."""
 POLE_RTOL = 1e-6
 """Obtained poles within this fraction of the requested ones are accepted without a word."""
 
+ROUNDOFF_ROOM = 10.0
+"""Obtained poles off by up to this many times their first-order round-off (``n eps ||F||``
+times the eigenvalue's condition number, or the distance ``n eps ||F||`` of a matrix having the
+requested value as eigenvalue) are accepted without a word: the estimates leave out constants
+of order 1 (``check_poles``)."""
+
 WARN_RTOL = 1e-3
 """Obtained poles off by more than round-off explains are accepted with a warning up to this
 fraction, refused beyond."""
