@@ -5,20 +5,33 @@ times outside, both built from the declared value, judged by the package reading
 ``test_tolerance_holds`` checks both at the declared value; ``test_tolerance_is_pinned`` sets it
 a hundred times looser and a hundred times tighter and checks that its pin then fails (a moved
 tolerance fails a named test). A new tolerance without a pin fails
-``test_every_tolerance_has_a_pin``.
+``test_every_tolerance_has_a_pin``, and a literal tolerance written anywhere else in the package
+fails ``test_no_tolerance_outside_tolerances_py``.
 """
 
 from __future__ import annotations
 
+import ast
+import copy
+import sys
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import uio_teach as ut
 from uio_teach import tolerances as tols
+from uio_teach._display import format_matrix_line, format_poles
+from uio_teach._validation import as_poles
 from uio_teach.balancing import _split_from_modes, modes_agree
+from uio_teach.checks.common import (
+    looks_two_decimals,
+    rerun_without_unknown_inputs,
+    same_poles,
+    up_to,
+)
 from uio_teach.existence import conditioning_condition, rank_condition, zero_condition
 from uio_teach.linalg import checked_zeros, is_stable, observability_decomposition, rank_decision
 from uio_teach.lmi import _meets_each
@@ -27,6 +40,7 @@ from uio_teach.placement import strip_fixed
 from uio_teach.simulation import _check_discrete_grid
 from uio_teach.verify import (
     DecouplingWarning,
+    _condition_numbers,
     check_decoupling,
     check_identity,
     check_poles,
@@ -190,6 +204,21 @@ def _():
     return _poles_off(r / 10) == "warned", _poles_off(10 * r) == "refused"
 
 
+@pin("ROUNDOFF_ROOM")
+def _():
+    # an eigenvalue of condition number about 1e5: its round-off n eps ||F|| kappa is 4.4e-6,
+    # above POLE_RTOL, so only ROUNDOFF_ROOM accepts an error of that order
+    F = np.array([[-1.0, 1e5], [0.0, -2.0]])
+    w, kappa = _condition_numbers(F)
+    unit = 2 * EPS * np.linalg.norm(F, 2) * kappa[np.argmin(abs(w + 1))]
+    room = DECLARED["ROUNDOFF_ROOM"]
+
+    def off(c):
+        return outcome(lambda: check_poles(F, [-1.0 - c * unit, -2.0]))
+
+    return off(room / 10) == "ok", off(10 * room) == "warned"
+
+
 @pin("IDENTITY_RTOL")
 def _():
     r = DECLARED["IDENTITY_RTOL"]
@@ -259,12 +288,87 @@ def _():
     return _gain(r / 10) == "warned", _gain(10 * r) == "refused"
 
 
+@pin("CONJUGATE_RTOL")
+def _():
+    r = DECLARED["CONJUGATE_RTOL"]  # poles of size below 1: the tolerance is absolute
+
+    def paired(e):
+        return outcome(lambda: as_poles("poles", [-0.3 + 0.4j, -0.3 - 0.4j + e * 1j])) == "ok"
+
+    return paired(r / 10), not paired(10 * r)
+
+
+# answers' checks --------------------------------------------------------------------------------
+@pin("CHECK_ZERO_ATOL")
+def _():
+    r = DECLARED["CHECK_ZERO_ATOL"]
+    return up_to(r / 10, "x") == " (up to rounding)", up_to(10 * r, "x") != " (up to rounding)"
+
+
+@pin("CHECK_EXACT_RTOL")
+def _():
+    # a matrix typed with the 2 decimals of a document, off by e from them (scale 1)
+    r = DECLARED["CHECK_EXACT_RTOL"]
+    exact = np.array([[1 / 3, -0.25]])
+
+    def typed(e):
+        return looks_two_decimals(np.array([[0.33 + e, -0.25]]), exact)
+
+    return typed(r / 10), not typed(10 * r)
+
+
+_RUN = ut.simulate(
+    ut.Plant([[-1.0]], [[1.0]], E=[[1.0]]),
+    ut.design_luenberger(ut.Plant([[-1.0]], [[1.0]], E=[[1.0]]), poles=[-3.0]),
+    np.linspace(0.0, 1.0, 11),
+    initial_state=[2.0],
+)
+
+
+@pin("CHECK_RUN_RTOL")
+def _():
+    # the run replayed without its (absent) unknown input is the run itself: a change e of its
+    # error, relative to its largest state (2), is what the replay finds
+    r = DECLARED["CHECK_RUN_RTOL"]
+
+    def same(e):
+        run = copy.copy(_RUN)
+        run.error = _RUN.error.copy()
+        run.error[0, -1] += e * 2.0
+        return rerun_without_unknown_inputs(run)[1]
+
+    return same(r / 10), not same(10 * r)
+
+
+@pin("CHECK_RTOL")
+def _():
+    r = DECLARED["CHECK_RTOL"]
+    return same_poles([-1 - r / 10, -2.0], [-2.0, -1.0]), not same_poles(
+        [-1 - 10 * r, -2], [-2, -1]
+    )
+
+
 @pin("DECAY_RTOL")
 def _():
     r = DECLARED["DECAY_RTOL"]
     meets = _meets_each(np.array([-1 + r / 10 + 0j]), False, 1.0)[0]
     misses = not _meets_each(np.array([-1 + 10 * r + 0j]), False, 1.0)[0]
     return bool(meets), bool(misses)
+
+
+# what is shown as zero -------------------------------------------------------------------------
+@pin("ROUNDING_RTOL")
+def _():
+    r = DECLARED["ROUNDING_RTOL"]
+    return format_poles([-1 + r / 10 * 1j]) == "-1", format_poles([-1 + 10 * r * 1j]) != "-1"
+
+
+@pin("DISPLAY_ZERO_RTOL")
+def _():
+    r = DECLARED["DISPLAY_ZERO_RTOL"]
+    shown = format_matrix_line([[1.0, r / 10]]) == "[[1, 0]]"
+    kept = format_matrix_line([[1.0, 10 * r]]) != "[[1, 0]]"
+    return shown, kept
 
 
 @pin("TIME_GRID_RTOL")
@@ -296,3 +400,156 @@ def test_tolerance_is_pinned(name, factor, monkeypatch):
     monkeypatch.setattr(tols, name, DECLARED[name] * factor)
     inside, outside = PINS[name]()
     assert not (inside and outside), f"{name} x {factor:g} passes its pin: it is not pinned"
+
+
+# no tolerance outside tolerances.py -------------------------------------------------------------
+PACKAGE = Path(ut.__file__).resolve().parent
+SMALL = 1e-3
+"""A float literal below this in size, where a comparison reads it, is a tolerance."""
+RANGE_GUARD = 1e-100
+"""Below this a literal is a floor against division by zero or underflow (``max(x, 1e-300)``),
+far below the rounding of any data: a guard of the float range, not a tolerance."""
+JUDGES = {"close", "allclose", "isclose", "assert_allclose", "same_poles"}
+"""Calls whose positional arguments are compared."""
+
+ALLOWED = {
+    ("explorers/_figure.py", "ExplorerFigure._find_cells", 1e-6): (
+        "layout geometry: which axes boxes of a figure touch, in figure fractions (no number of "
+        "the course is judged)"
+    ),
+    ("explorers/modes.py", "excited_modes", 1e-7): (
+        "the Arnoldi stopping size of the explorers' 'excited mode' marks, a widget's highlight "
+        "rather than a verdict on a design"
+    ),
+    ("explorers/modes.py", "match_poles", 1e-4): (
+        "matches Ritz values of a short Krylov space (accurate to its own stopping size, not to "
+        "round-off) to the poles, for a widget's highlight"
+    ),
+    ("explorers/frames.py", "_modes", 1e-6): (
+        "a repeated pole's copies share a widget's 'excited' mark when they sit within the "
+        "Krylov marks' accuracy of each other"
+    ),
+    ("lab_params.py", "direction_key", 1e-12): (
+        "the sign convention of a unit vector used as a lab variant's key: its first entry "
+        "above the rounding of a normalized vector of order 1 decides the sign"
+    ),
+    ("worked/pa9.py", "_pa9_luenberger", 1e-6): (
+        "the wording of a figure's description (two runs 'lie on top of each other' at the "
+        "figure's resolution), not a verdict"
+    ),
+}
+"""Small literals in comparisons that are not tolerances of the package, each with its reason."""
+
+
+def _qualname(node, parents) -> str:
+    names = []
+    while node in parents:
+        node = parents[node]
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.append(node.name)
+    return ".".join(reversed(names)) or "<module>"
+
+
+def _compared(node, parents) -> str | None:
+    """How the small literal ``node`` is used to judge a number, or None."""
+    child, computed = node, False  # computed: an argument of a computation (a grid's end)
+    while child in parents:
+        up = parents[child]
+        if isinstance(up, ast.Compare):
+            return "a comparison"
+        if isinstance(up, ast.keyword) and up.arg and "tol" in up.arg:
+            return f"{up.arg}="
+        if isinstance(up, ast.Call) and child in up.args:
+            name = (
+                up.func.attr if isinstance(up.func, ast.Attribute) else getattr(up.func, "id", "")
+            )
+            if name in JUDGES:
+                return f"an argument of {name}()"
+            computed = True
+        if isinstance(up, ast.arguments):
+            return "a default argument"
+        if isinstance(up, (ast.Assign, ast.AnnAssign)):
+            targets = up.targets if isinstance(up, ast.Assign) else [up.target]
+            names = [t.id for t in targets if isinstance(t, ast.Name)]
+            if isinstance(parents.get(up), (ast.Module, ast.ClassDef)) and any(
+                n.lstrip("_").isupper() for n in names
+            ):
+                return "a module constant"
+            if computed:
+                return None
+            scope = up
+            while scope in parents and not isinstance(scope, (ast.FunctionDef, ast.Module)):
+                scope = parents[scope]
+            for cmp in ast.walk(scope):
+                if isinstance(cmp, ast.Compare) and any(
+                    isinstance(n, ast.Name) and n.id in names for n in ast.walk(cmp)
+                ):
+                    return f"{', '.join(names)}, compared later"
+            return None
+        if isinstance(up, ast.stmt):
+            return None
+        child = up
+    return None
+
+
+def literal_tolerances() -> list[tuple[str, int, str, float, str]]:
+    """Every small float literal that judges a number, outside ``tolerances.py``."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).as_posix()
+        if rel == "tolerances.py":
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        parents = {c: p for p in ast.walk(tree) for c in ast.iter_child_nodes(p)}
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.Constant) and type(node.value) is float):
+                continue
+            if not RANGE_GUARD < abs(node.value) < SMALL:
+                continue
+            how = _compared(node, parents)
+            if how:
+                found.append((rel, node.lineno, _qualname(node, parents), node.value, how))
+    return found
+
+
+def test_no_tolerance_outside_tolerances_py():
+    stray = [
+        f"uio_teach/{rel}:{line} ({where}): {value:g} in {how}"
+        for rel, line, where, value, how in literal_tolerances()
+        if (rel, where, value) not in ALLOWED
+    ]
+    assert not stray, (
+        "literal tolerances outside uio_teach/tolerances.py (declare them there, with their "
+        "reason and a pin, or add them to ALLOWED with the reason they are no tolerance):\n"
+        + "\n".join(stray)
+    )
+
+
+def test_allowed_literals_are_still_there():
+    seen = {(rel, where, value) for rel, _, where, value, _ in literal_tolerances()}
+    assert not set(ALLOWED) - seen, f"stale entries of ALLOWED: {sorted(set(ALLOWED) - seen)}"
+
+
+def test_the_scan_finds_a_literal_tolerance(tmp_path, monkeypatch):
+    # the scan itself: a literal compared directly, through a local name and as a default
+    pkg = tmp_path / "uio_teach"
+    pkg.mkdir()
+    (pkg / "mod.py").write_text(
+        "LIMIT = 1e-7\n"
+        "def f(x, tol=1e-6):\n"
+        "    tiny = 1e-9 * abs(x)\n"
+        "    grid = np.geomspace(1e-30, 1.0, 5)\n"
+        "    if x < 1e-8 or x < tiny or x in grid:\n"
+        "        return max(x, 1e-300)\n"
+        "    return close(x, 0, 1e-5) and np.allclose(x, 0, atol=1e-4)\n"
+    )
+    monkeypatch.setattr(sys.modules[__name__], "PACKAGE", pkg)
+    got = {(value, how) for _, _, _, value, how in literal_tolerances()}
+    assert got == {
+        (1e-7, "a module constant"),
+        (1e-6, "a default argument"),
+        (1e-9, "tiny, compared later"),
+        (1e-8, "a comparison"),
+        (1e-5, "an argument of close()"),
+        (1e-4, "atol="),
+    }

@@ -8,6 +8,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from . import tolerances as tols
+
 __all__ = [
     "format_matrix",
     "matrices_text",
@@ -86,7 +88,7 @@ def format_complex(z: complex, digits: int = 4) -> str:
     """Format a number, dropping a negligible imaginary part."""
     z = complex(z)
     scale = max(1.0, abs(z))
-    if abs(z.imag) <= 1e-12 * scale:
+    if abs(z.imag) <= tols.DISPLAY_ZERO_RTOL * scale:
         return f"{z.real:.{digits}g}"
     sign = "+" if z.imag >= 0 else "-"
     return f"{z.real:.{digits}g} {sign} {abs(z.imag):.{digits}g}j"
@@ -97,8 +99,9 @@ def format_poles(
 ) -> str:
     """The one formatter of poles (and eigenvalues, zeros) used throughout the package.
 
-    Round-off below 1e-9 of the largest modulus is shown as 0, in the real and in the
-    imaginary part, so ``8.9e-16`` prints as ``0`` and a real pole carries no ``+ 0j``.
+    Round-off below ``tolerances.ROUNDING_RTOL`` of the largest modulus is shown as 0, in the
+    real and in the imaginary part, so ``8.9e-16`` prints as ``0`` and a real pole carries no
+    ``+ 0j``.
 
     Parameters
     ----------
@@ -126,7 +129,7 @@ def format_poles(
     z = np.asarray(list(poles), dtype=complex)
     if not z.size:
         return empty
-    tiny = 1e-9 * max(1.0, float(np.abs(z).max()))
+    tiny = tols.ROUNDING_RTOL * max(1.0, float(np.abs(z).max()))
     z = np.where(np.abs(z.real) < tiny, 0.0, z.real) + 1j * np.where(
         np.abs(z.imag) < tiny, 0.0, z.imag
     )
@@ -135,11 +138,12 @@ def format_poles(
 
 
 def _clean(M: np.ndarray, ref: float = 0.0) -> np.ndarray:
-    """Real part if negligible imaginary; round-off below 1e-12 of the largest entry (of this
-    matrix, or of ``ref``, the largest entry of the matrices shown together) set to 0."""
+    """Real part if negligible imaginary; round-off below ``DISPLAY_ZERO_RTOL`` of the largest
+    entry (of this matrix, or of ``ref``, the largest entry of the matrices shown together) set
+    to 0."""
     M = np.real_if_close(np.asarray(M))
     scale = max(float(np.max(np.abs(M))) if M.size else 0.0, ref)
-    return np.where(np.abs(M) <= 1e-12 * scale, 0.0, M)
+    return np.where(np.abs(M) <= tols.DISPLAY_ZERO_RTOL * scale, 0.0, M)
 
 
 def _ref(items: list[tuple[str, np.ndarray]]) -> float:
@@ -159,7 +163,7 @@ def format_matrix(M: np.ndarray, digits: int = 4, ref: float = 0.0) -> list[str]
 
 
 def format_matrix_line(M: np.ndarray, digits: int = 3) -> str:
-    """A matrix on one line, round-off (below 1e-12 of its largest entry) shown as 0.
+    """A matrix on one line, round-off (below ``DISPLAY_ZERO_RTOL`` of its largest entry) as 0.
 
     Examples
     --------
@@ -169,7 +173,7 @@ def format_matrix_line(M: np.ndarray, digits: int = 3) -> str:
     """
     M = np.atleast_2d(np.asarray(M, dtype=float))
     scale = float(np.max(np.abs(M))) if M.size else 0.0
-    M = np.where(np.abs(M) <= 1e-12 * max(scale, 1e-300), 0.0, M)
+    M = np.where(np.abs(M) <= tols.DISPLAY_ZERO_RTOL * max(scale, 1e-300), 0.0, M)
     return "[" + ", ".join("[" + ", ".join(f"{v:.{digits}g}" for v in row) + "]" for row in M) + "]"
 
 

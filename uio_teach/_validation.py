@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from . import tolerances as tols
+
 __all__ = [
     "as_matrix",
     "as_poles",
@@ -91,7 +93,7 @@ def as_time(name: str, value: Any, *, min_size: int = 2, uniform: bool = False) 
         )
     if uniform and t.size > 2:
         h = (t[-1] - t[0]) / (t.size - 1)
-        tol = 1e-9 * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
+        tol = tols.TIME_GRID_RTOL * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
         if np.max(np.abs(steps - h)) > tol:
             raise ValueError(
                 f"{name} must be uniformly spaced, got steps from {steps.min():g} to "
@@ -179,7 +181,7 @@ def as_matrix(
 def as_poles(name: str, value: Any) -> np.ndarray:
     """Return requested poles as a 1-D complex array; conjugate pairs are required.
 
-    A pair conjugate to within ``1e-9`` (relative) is made exactly conjugate
+    A pair conjugate to within ``tolerances.CONJUGATE_RTOL`` (relative) is made exactly conjugate
     and a round-off imaginary part dropped, so the designs place exactly the
     poles the validator accepted.
 
@@ -199,7 +201,7 @@ def as_poles(name: str, value: Any) -> np.ndarray:
     if not np.all(np.isfinite(poles)):
         raise ValueError(f"{name} must be finite numbers, got {value!r}")
     scale = max(1.0, float(np.max(np.abs(poles)))) if poles.size else 1.0
-    tol = 1e-9 * scale
+    tol = tols.CONJUGATE_RTOL * scale
     poles = poles.copy()
     unmatched = [int(i) for i in np.flatnonzero(np.abs(poles.imag) > tol)]
     while unmatched:

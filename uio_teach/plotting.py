@@ -44,6 +44,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import tolerances as tols
 from .figure_text import describe, description
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -98,8 +99,6 @@ FIGURE_WIDTH = 9.0
 FONT_SIZE = 11
 """Font size (points) of legends and notes: about 11.5 px at the book's column width (688 px)."""
 
-_ROUNDING = 1e-9
-"""Relative size below which a panel's values are called zero to rounding."""
 _MIN_SPAN = 1e-3
 """The smallest half-range of a panel, relative to the size of the signals it derives from."""
 
@@ -245,7 +244,7 @@ def zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
 
     ``scale`` is the size of the signals ``values`` derive from (the states for
     an error, the outputs for a residual). Returns True, and writes "zero to
-    rounding" in the panel, when every value is below ``_ROUNDING * scale``.
+    rounding" in the panel, when every value is below ``ROUNDING_RTOL * scale``.
     """
     values = np.asarray(values, dtype=float)
     if not scale > 0 or values.size == 0 or not np.all(np.isfinite(values)):
@@ -256,7 +255,7 @@ def zero_to_rounding(ax: Axes, values: np.ndarray, scale: float) -> bool:
         low, high = ax.get_ylim()
         if high - low < 2 * half:
             ax.set_ylim(-half, half)
-    if peak <= _ROUNDING * scale:
+    if peak <= tols.ROUNDING_RTOL * scale:
         ax.text(
             0.02,
             0.9,
@@ -639,7 +638,7 @@ def how_it_ends(
     if not np.isfinite(peak):
         return "grows without bound (the simulation overflowed)"
     scale = peak if scale is None else scale
-    if peak <= _ROUNDING * max(scale, 1e-300):
+    if peak <= tols.ROUNDING_RTOL * max(scale, 1e-300):
         return "is zero to rounding throughout"
     above = np.flatnonzero(worst > _SETTLED * peak)
     last = int(above[-1]) if above.size else -1

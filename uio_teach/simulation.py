@@ -1082,7 +1082,7 @@ def _overflow(Az: np.ndarray, plant: Plant, t: np.ndarray, k: int) -> Simulation
     for pole in sorted(unstable, key=lambda z: -abs(z)):
         src = (
             "plant"
-            if np.min(np.abs(plant_poles - pole)) <= 1e-9 * max(1, abs(pole))
+            if np.min(np.abs(plant_poles - pole)) <= tols.MODES_RTOL * max(1, abs(pole))
             else ("observer")
         )
         words.append(f"{format_complex(pole)} ({src})")

@@ -12,7 +12,7 @@ Examples
 >>> tolerances.IDENTITY_RTOL
 1e-08
 >>> sorted(tolerances.ALL)[:3]
-['AMPLIFICATION_LIMIT', 'CLOSE_NOTE_RTOL', 'DECAY_RTOL']
+['AMPLIFICATION_LIMIT', 'CHECK_EXACT_RTOL', 'CHECK_RTOL']
 """
 
 from __future__ import annotations
@@ -83,6 +83,12 @@ modes, or refused as indistinguishable from it)."""
 POLE_RTOL = 1e-6
 """Obtained poles within this fraction of the requested ones are accepted without a word."""
 
+ROUNDOFF_ROOM = 10.0
+"""Obtained poles off by up to this many times their first-order round-off (``n eps ||F||``
+times the eigenvalue's condition number, or the distance ``n eps ||F||`` of a matrix having the
+requested value as eigenvalue) are accepted without a word: the estimates leave out constants
+of order 1 (``check_poles``)."""
+
 WARN_RTOL = 1e-3
 """Obtained poles off by more than round-off explains are accepted with a warning up to this
 fraction, refused beyond."""
@@ -115,6 +121,47 @@ refused."""
 DECAY_RTOL = 1e-6
 """An LMI gain meets a requested decay rate when every pole is within this fraction of it
 (the solver meets its constraints to about ``1e-8``)."""
+
+CONJUGATE_RTOL = 1e-9
+"""Requested poles: an imaginary part below this fraction of the poles' size (at least 1) is
+round-off of a real pole, and two poles within it of each other's conjugate are one conjugate
+pair, typed or computed to round-off; they are made exactly real or conjugate."""
+
+# answers' checks --------------------------------------------------------------------------------
+
+CHECK_ZERO_ATOL = 1e-12
+"""An answer's quantity that must vanish (an initial error, a regenerated noise's difference, a
+matrix's imaginary parts, relative to its entries) counts as zero below this: the rounding of
+numbers of order 1, far below what any typed or rounded number leaves."""
+
+CHECK_EXACT_RTOL = 1e-9
+"""An answer recomputed in double precision agrees with the reference to this fraction of the
+reference's size (at least 1), entry by entry: a matrix copied or computed from the data passes,
+one typed with the digits printed in a document (``0.33`` for ``1/3``) does not."""
+
+CHECK_RUN_RTOL = 1e-8
+"""Two computations of one result along different sequences of operations (a student's run
+and the check's replay, a run and its replay without the unknown inputs, a gain and the
+observer built from it) agree to this fraction of its size (at least 1): the rounding of a
+simulation adds up over its steps, to well above ``CHECK_EXACT_RTOL`` of a single product."""
+
+CHECK_RTOL = 1e-6
+"""A design, solved or recomputed by the student (poles placed, an LMI solved, a gain
+rebuilt), meets what it must to this fraction (at least 1): a solver meets its constraints
+to about ``1e-8`` and a double pole moves by ``sqrt(eps)``; a typo or a wrong formula is
+farther off."""
+
+# what is shown as zero ---------------------------------------------------------------------------
+
+ROUNDING_RTOL = 1e-9
+"""A computed value (a pole, a run's error or residual) below this fraction of its scale is
+shown and called zero to rounding (``format_poles``, a panel's "zero to rounding"): eigenvalues
+and long recursions carry more rounding than a single product, far less than any design
+leaves."""
+
+DISPLAY_ZERO_RTOL = 1e-12
+"""An entry (or an imaginary part) of a printed matrix or number below this fraction of the
+largest entry shown with it prints as 0: the rounding of a product of data of order 1."""
 
 # time grids -------------------------------------------------------------------------------------
 

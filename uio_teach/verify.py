@@ -8,7 +8,8 @@ it obtained with what it promised:
 * **Poles.** The obtained eigenvalues are matched one to one with the
   requested ones (fixed modes included). A pole is accepted when it lies within
   ``POLE_RTOL * max(1, |p|)`` of its request, or within the round-off bound of
-  the eigenvalue problem, ``n * eps * ||F|| * kappa`` (``kappa`` the eigenvalue's
+  the eigenvalue problem, ``n * eps * ||F|| * kappa`` with a room of ``ROUNDOFF_ROOM``
+  (``kappa`` the eigenvalue's
   condition number; a pole requested ``m`` times may move by
   ``(100 * n * eps * ||F||^m)^(1/m)``, the Hölder bound of a Jordan block), or when the
   requested value is an eigenvalue of a matrix within ``n * eps * ||F||`` of
@@ -188,23 +189,28 @@ def check_poles(
         scale = np.maximum(normF, np.abs(req))
         label = _clusters(req, zeros, radius)
         m = np.bincount(label)[label].astype(float)
-        holder = (100 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m) / 10
+        holder = (100 * n * _EPS * normF * scale ** (m - 1)) ** (1 / m) / tols.ROUNDOFF_ROOM
     round_off = np.where(m > 1, np.maximum(round_off, holder), round_off)
-    explained = err <= 10 * round_off
+    explained = err <= tols.ROUNDOFF_ROOM * round_off
     # a cluster (a repeated pole, a defective fixed mode) is verified by what it promises: its
     # centre, well conditioned, to round-off, and its members within the Hoelder radius
     for c in np.unique(label[m > 1]):
         members = label == c
         centre = complex(np.mean(req[members]))
         moved = abs(complex(np.mean(obtained[members])) - centre)
-        if moved <= tols.POLE_RTOL * abs(centre) + 10 * n * _EPS * normF:
-            size = np.where(members, np.maximum(size, 10 * holder / tols.WARN_RTOL), size)
+        if moved <= tols.POLE_RTOL * abs(centre) + tols.ROUNDOFF_ROOM * n * _EPS * normF:
+            room = tols.ROUNDOFF_ROOM * holder / tols.WARN_RTOL  # the Hoelder radius / WARN_RTOL
+            size = np.where(members, np.maximum(size, room), size)
     for i in np.flatnonzero(~tight & ~explained & (err <= tols.WARN_RTOL * size)):
         # backward check: is the requested value an eigenvalue of a matrix close to F?
         smin = np.linalg.svd(F - req[i] * np.eye(n), compute_uv=False)[-1]
-        explained[i] = smin <= 10 * n * _EPS * max(normF, abs(req[i]))
+        explained[i] = smin <= tols.ROUNDOFF_ROOM * n * _EPS * max(normF, abs(req[i]))
     # an error at the round-off of F's eigenvalues themselves is no error, whatever the pole
-    ok = tight | (explained & (err <= tols.WARN_RTOL * size)) | (err <= 10 * n * _EPS * normF)
+    ok = (
+        tight
+        | (explained & (err <= tols.WARN_RTOL * size))
+        | (err <= tols.ROUNDOFF_ROOM * n * _EPS * normF)
+    )
     if np.all(ok):
         return obtained
     bad = ~ok

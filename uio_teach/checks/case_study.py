@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .. import examples
+from .. import tolerances as tols
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence, decoupling
 from ..linalg import left_null
@@ -70,7 +71,7 @@ def _small(X: np.ndarray, scale: float, tol: float) -> tuple[bool, float]:
 
 
 @never_raises("Case study: the projection matrix M", "case_study.projection")
-def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> CheckResult:
+def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None) -> CheckResult:
     """Check ``M``: it removes ``u2``, ``(I - MC)B2 = 0``, and the disturbance, ``MD = 0``.
 
     Parameters
@@ -80,7 +81,8 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     plant : Plant, optional
         The plant; :func:`uio_teach.examples.dt_case_study` by default.
     tol : float, optional
-        Tolerance of the two identities (relative to the largest entry of ``M``).
+        Tolerance of the two identities (relative to the largest entry of ``M``); default
+        ``tolerances.CHECK_EXACT_RTOL``.
 
     Returns
     -------
@@ -96,6 +98,7 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     >>> "Your M is B2 (CB2)^+, which ignores D" in checks.case_study_projection(M).failures[0]
     True
     """
+    tol = tols.CHECK_EXACT_RTOL if tol is None else tol
     result = CheckResult("Case study: the projection matrix M")
     plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
@@ -111,9 +114,11 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
     if ok:
         result.add(True, f"(I - MC)B2 = 0{up_to(big, 'largest entry')}: u2 is projected out.")
     else:
-        if close(M, np.round(ref, 4), 1e-9) or close(M, np.round(ref, 2), 1e-9):
+        if close(M, np.round(ref, 4), tols.CHECK_EXACT_RTOL) or close(
+            M, np.round(ref, 2), tols.CHECK_EXACT_RTOL
+        ):
             hint = " Your M is the printed one, rounded: compute it at full precision."
-        elif close(M, -ref, 1e-9):
+        elif close(M, -ref, tols.CHECK_EXACT_RTOL):
             hint = " Your M is -[B2 0][CB2 D]^+: check the sign."
         else:
             hint = (
@@ -132,7 +137,7 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float = 1e-9) -> Ch
         only_b2 = B2 @ np.linalg.pinv(C @ B2)
         hint = (
             " Your M is B2 (CB2)^+, which ignores D: M must remove u2 and v together."
-            if close(M, only_b2, 1e-9)
+            if close(M, only_b2, tols.CHECK_EXACT_RTOL)
             else " M must also satisfy MD = 0, together with MCB2 = B2."
         )
         result.add(
@@ -158,7 +163,7 @@ def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
     hint = (
         " Your L is the printed one, rounded to 4 decimals; rounding moves it off LD = 0. Use "
         "the gain of your solver."
-        if close(L, pub, 1e-9)
+        if close(L, pub, tols.CHECK_EXACT_RTOL)
         else " With Y = PL, LD = 0 is the linear constraint YD = 0: is it in your LMI?"
     )
     result.add(
@@ -175,7 +180,7 @@ def case_study_lmi(
     P: Any = None,
     plant: Any = None,
     *,
-    tol: float = 1e-6,
+    tol: float | None = None,
     Y: Any = None,
     margin: float = 0.0,
 ) -> CheckResult:
@@ -197,7 +202,7 @@ def case_study_lmi(
         The plant; :func:`uio_teach.examples.dt_case_study` by default.
     tol : float, optional
         Tolerance of ``LD = 0``, of ``L = P^{-1} Y`` (relative) and of the LMI
-        (a solver meets them to about 1e-8).
+        (a solver meets them to about 1e-8); default ``tolerances.CHECK_RTOL``.
     Y : array_like, shape (n, p), optional
         The solver's ``Y``: the gain must be ``P^{-1} Y``. Without it, ``L``
         cannot be traced to the solve, and the check says so (a ✗).
@@ -220,6 +225,7 @@ def case_study_lmi(
     >>> checks.case_study_lmi(pmo.L, None).failures[0][:40]
     'P is missing: the gain must come from th'
     """
+    tol = tols.CHECK_RTOL if tol is None else tol
     result = CheckResult("Case study: the gain L from the LMI")
     plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
@@ -244,7 +250,7 @@ def case_study_lmi(
     F = _error_matrix(plant, L)
     eig = np.linalg.eigvals(F)
     worst = float(np.max(np.abs(eig)))
-    if worst < 1 - 1e-9:
+    if worst < 1 - tols.STABILITY_MARGIN:
         result.add(
             True,
             f"F = A1 - LC is stable: its eigenvalues {format_poles(eig)} lie inside the unit "
@@ -310,7 +316,9 @@ def _L_from_solve(
 
 
 @never_raises("Case study: moving the movable pole", "case_study.pole")
-def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6) -> CheckResult:
+def case_study_pole(
+    L: Any, pole: float, plant: Any = None, *, tol: float | None = None
+) -> CheckResult:
     """Check a gain that moves the one movable pole to ``pole`` with ``LD = 0``.
 
     Parameters
@@ -322,7 +330,7 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
     plant : Plant, optional
         The plant; :func:`uio_teach.examples.dt_case_study` by default.
     tol : float, optional
-        Tolerance of ``LD = 0`` and of the poles.
+        Tolerance of ``LD = 0`` and of the poles; default ``tolerances.CHECK_RTOL``.
 
     Returns
     -------
@@ -336,6 +344,7 @@ def case_study_pole(L: Any, pole: float, plant: Any = None, *, tol: float = 1e-6
     >>> checks.case_study_pole(placed.L, 0.3).passed
     True
     """
+    tol = tols.CHECK_RTOL if tol is None else tol
     result = CheckResult("Case study: moving the movable pole")
     plant = get_plant(result, plant, "dt_case_study")
     if plant is None:
@@ -441,7 +450,9 @@ def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_s
         result.add(False, "u2 is zero during the whole run: it acts as the plant's d.")
     elif u2 is not None:
         want = float(u2[0]) * np.sin(float(u2[1]) * t)
-        if np.allclose(d[0], want, rtol=0, atol=1e-9 * max(1.0, abs(float(u2[0])))):
+        if np.allclose(
+            d[0], want, rtol=0, atol=tols.CHECK_EXACT_RTOL * max(1.0, abs(float(u2[0])))
+        ):
             result.add(True, f"u2 is the asked {float(u2[0]):g} sin({float(u2[1]):g} k).")
         else:
             result.add(
@@ -455,7 +466,7 @@ def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_s
         result.add(False, "v is zero during the whole run: the staircase v acts on y.")
     elif v is not None:
         want = _staircase(t, float(v[0]), int(v[1]), int(v[2]))
-        if np.allclose(vv[0], want, rtol=0, atol=1e-12):
+        if np.allclose(vv[0], want, rtol=0, atol=tols.CHECK_ZERO_ATOL):
             result.add(True, "v is the asked staircase.")
         else:
             result.add(
@@ -496,7 +507,7 @@ def _ignores_and_decays(result: CheckResult, resp: Any, decay: float) -> None:
         )
     e0 = float(np.max(np.abs(resp.error[:, 0])))
     e1 = float(np.max(np.abs(resp.error[:, -1])))
-    if e0 <= 1e-12:
+    if e0 <= tols.CHECK_ZERO_ATOL:
         result.add(False, "the error is zero from the start: start the plant from x[0] != 0.")
     elif e1 <= decay * e0:
         result.add(True, f"the error decays: {e0:.3g} at k = 0, {e1:.2g} at k = {t[-1]:g}.")
@@ -525,7 +536,9 @@ def _observer_as_asked(result: CheckResult, resp: Any, observer: Any) -> None:
         )
     elif observer is not None:
         theirs = getattr(observer, "L", None)
-        if theirs is None or not close(np.asarray(resp.observer.L), np.asarray(theirs), 1e-9):
+        if theirs is None or not close(
+            np.asarray(resp.observer.L), np.asarray(theirs), tols.CHECK_EXACT_RTOL
+        ):
             result.add(
                 False,
                 "the run simulates another PMO than the one built from your LMI gain L.",
@@ -533,7 +546,9 @@ def _observer_as_asked(result: CheckResult, resp: Any, observer: Any) -> None:
         else:
             result.add(True, "the run simulates your PMO.")
     z0 = np.asarray(resp.observer_states[:, 0], float)
-    if float(np.max(np.abs(z0))) > 1e-9 * max(1.0, float(np.max(np.abs(resp.states)))):
+    if float(np.max(np.abs(z0))) > tols.CHECK_EXACT_RTOL * max(
+        1.0, float(np.max(np.abs(resp.states)))
+    ):
         result.add(
             False,
             f"the observer starts from z[0] = {numbers(z0)}, but the exercise asks for "
@@ -587,7 +602,7 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -
         return result
     v = np.asarray(resp.inputs.v, float)
     ref = plant.D @ v
-    if close(Dv_m, ref, 1e-9):
+    if close(Dv_m, ref, tols.CHECK_EXACT_RTOL):
         result.add(True, "Dv is D times the run's v.")
     else:
         result.add(
@@ -605,11 +620,13 @@ def case_study_residual(Dv: Any, Nr: Any, response: Any, *, plant: Any = None) -
     r_scale = max(1.0, float(np.max(np.abs(r))))
     got_big = float(np.max(np.abs(Nr_m)))
     want_big = float(np.max(np.abs(want)))
-    if want_big <= 1e-9 * r_scale:
-        match = got_big <= 1e-8 * r_scale
+    if want_big <= tols.CHECK_EXACT_RTOL * r_scale:
+        match = got_big <= tols.CHECK_RUN_RTOL * r_scale
     else:
         k = float(np.vdot(want, Nr_m) / np.vdot(want, want))
-        match = abs(k) > 1e-9 and np.allclose(Nr_m, k * want, rtol=0, atol=1e-8 * abs(k) * r_scale)
+        match = abs(k) > tols.CHECK_EXACT_RTOL and np.allclose(
+            Nr_m, k * want, rtol=0, atol=tols.CHECK_RUN_RTOL * abs(k) * r_scale
+        )
     if match:
         tail = float(np.max(np.abs(Nr_m[:, late])))
         result.add(
@@ -690,21 +707,23 @@ def case_study_plot(fig: Any, response: Any, *, plant: Any = None) -> CheckResul
             i
             for i in range(M.shape[0])
             for y in ys
-            if np.allclose(y, M[i], rtol=0, atol=1e-9 * scale)
+            if np.allclose(y, M[i], rtol=0, atol=tols.CHECK_EXACT_RTOL * scale)
         }
 
     def shows_Nr(ax: Any) -> bool:
-        tiny = float(np.max(np.abs(Nr))) <= 1e-9 * scale
+        tiny = float(np.max(np.abs(Nr))) <= tols.CHECK_EXACT_RTOL * scale
         for ln in ax.get_lines():
             y = np.asarray(ln.get_ydata(), float)
             if y.shape != (N,):
                 continue
             if tiny:
-                if float(np.max(np.abs(y))) <= 1e-8 * scale:
+                if float(np.max(np.abs(y))) <= tols.CHECK_RUN_RTOL * scale:
                     return True
                 continue
             k = float(np.dot(Nr, y) / np.dot(Nr, Nr))
-            if abs(k) > 1e-9 and np.linalg.norm(y - k * Nr) <= 1e-6 * np.linalg.norm(y):
+            if abs(k) > tols.CHECK_EXACT_RTOL and np.linalg.norm(
+                y - k * Nr
+            ) <= tols.CHECK_RTOL * np.linalg.norm(y):
                 return True
         return False
 

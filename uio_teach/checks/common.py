@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .. import examples
+from .. import tolerances as tols
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
 from ..simulation import simulate
@@ -371,7 +372,7 @@ def up_to(x: float, what: str) -> str:
     >>> up_to(0.0, "largest entry"), up_to(3e-9, "largest entry")
     (' (up to rounding)', ' (largest entry 3e-09)')
     """
-    return " (up to rounding)" if x <= 1e-12 else f" ({what} {x:.1g})"
+    return " (up to rounding)" if x <= tols.CHECK_ZERO_ATOL else f" ({what} {x:.1g})"
 
 
 def plural(k: int, word: str) -> str:
@@ -438,8 +439,9 @@ def looks_two_decimals(X: np.ndarray, exact: np.ndarray) -> bool:
     >>> looks_two_decimals(np.array([[0.33]]), np.array([[1 / 3]]))
     True
     """
-    return any(close(X, Y, 1e-9) for Y in (np.round(exact, 2), chopped(exact))) and not close(
-        X, exact, 1e-9
+    exact_rtol = tols.CHECK_EXACT_RTOL
+    return any(close(X, Y, exact_rtol) for Y in (np.round(exact, 2), chopped(exact))) and not close(
+        X, exact, exact_rtol
     )
 
 
@@ -473,7 +475,7 @@ def read_matrix(
         )
         return None
     if np.iscomplexobj(arr):
-        if np.all(np.abs(arr.imag) <= 1e-12 * max(1.0, float(np.max(np.abs(arr))))):
+        if np.all(np.abs(arr.imag) <= tols.CHECK_ZERO_ATOL * max(1.0, float(np.max(np.abs(arr))))):
             arr = arr.real
         else:
             result.add(False, f"{name} has complex entries; it must be a real matrix.")
@@ -590,8 +592,8 @@ def rerun_without_unknown_inputs(resp: Any, *, keep_v: bool = False) -> tuple[fl
     change : float
         The largest change of the error ``e``.
     same : bool
-        Whether the change is round-off: at most ``1e-8`` times the largest
-        state (or ``1e-8`` for states below 1).
+        Whether the change is round-off: at most ``tolerances.CHECK_RUN_RTOL`` times the
+        largest state (at least 1).
 
     Examples
     --------
@@ -612,7 +614,7 @@ def rerun_without_unknown_inputs(resp: Any, *, keep_v: bool = False) -> tuple[fl
         observer_state=resp.observer_states[:, 0],
     )
     change = float(np.max(np.abs(resp.error - quiet.error)))
-    return change, change <= 1e-8 * max(1.0, float(np.max(np.abs(resp.states))))
+    return change, change <= tols.CHECK_RUN_RTOL * max(1.0, float(np.max(np.abs(resp.states))))
 
 
 def same_plant(a: Any, b: Any) -> bool:
@@ -655,8 +657,10 @@ def check_plant_of(result: CheckResult, resp: Any, plant: Any) -> bool:
     return False
 
 
-def same_poles(got: Any, wanted: Any, rtol: float = 1e-6) -> bool:
+def same_poles(got: Any, wanted: Any, rtol: float | None = None) -> bool:
     """True if ``got`` and ``wanted`` hold the same poles (as multisets), each to ``rtol``.
+
+    ``rtol`` is by default ``tolerances.CHECK_RTOL``.
 
     Examples
     --------
@@ -664,6 +668,7 @@ def same_poles(got: Any, wanted: Any, rtol: float = 1e-6) -> bool:
     >>> same_poles([-1, -2], [-2.0000000001, -1]), same_poles([-1, -2], [-1, -3])
     (True, False)
     """
+    rtol = tols.CHECK_RTOL if rtol is None else rtol
     got = sort_poles(np.asarray(got, complex).ravel())
     wanted = np.asarray(wanted, complex).ravel()
     if got.size != wanted.size:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import tolerances as tols
 from .._display import format_matrix_line, format_poles
 from ..linalg import pinv, sort_poles
 from .common import (
@@ -50,7 +51,7 @@ def pa9_design(
     plant: Any = None,
     *,
     poles: Any = None,
-    tol: float = 1e-6,
+    tol: float | None = None,
 ) -> CheckResult:
     """Check a decoupling-observer design against the equations (8) of the assignment.
 
@@ -81,11 +82,12 @@ def pa9_design(
         default.
     poles : sequence of complex, optional
         The poles the exercise asks for (e.g. ``[-1, -2, -3]``): the eigenvalues
-        of ``F`` must be these, each to ``1e-6`` relative.
+        of ``F`` must be these, each to ``tol`` relative.
     tol : float, optional
         Relative tolerance of the equalities (entries are compared with
         ``tol * max(1, largest entry)``). Full-precision NumPy results agree to
-        about 1e-15; numbers typed with 2 decimals do not pass.
+        about 1e-15; numbers typed with 2 decimals do not pass. Default
+        ``tolerances.CHECK_RTOL``.
 
     Returns
     -------
@@ -117,6 +119,7 @@ def pa9_design(
     >>> checks.pa9_design(H, T, K1, F, -F @ H).failures
     ['K2 is -FH: the sign is flipped. The condition (A - K1C - HCA)H - K2 = 0 of eq. (7) gives K2 = FH.']
     """  # noqa: E501
+    tol = tols.CHECK_RTOL if tol is None else tol
     result = CheckResult("Practical Assignment 9: the observer design")
     plant = get_plant(result, plant)
     if plant is None:
@@ -169,7 +172,7 @@ def _cancels(result: CheckResult, plant: Any, H: np.ndarray, tol: float) -> None
             "not exact, so the disturbance is not fully cancelled. Compute H at full precision "
             "from E and C instead of typing it."
         )
-    elif close(H, -H_ref, 1e-6):
+    elif close(H, -H_ref, tols.CHECK_RTOL):
         hint = " Your H is -E(CE)^+: check the sign."
     else:
         hint = (

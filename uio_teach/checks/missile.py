@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import tolerances as tols
 from .._display import format_matrix_line, format_poles
 from ..existence import check_existence
 from ..reconstruction import catch_time, reconstruct_input
@@ -71,7 +72,7 @@ def _fixed_poles(plant) -> np.ndarray:
 
 @never_raises("Missile: the projection-operator observer", "missile.pmo")
 def missile_pmo(
-    M: Any, L: Any, F: Any, *, poles: Any, plant: Any = None, tol: float = 1e-6
+    M: Any, L: Any, F: Any, *, poles: Any, plant: Any = None, tol: float | None = None
 ) -> CheckResult:
     """Check the PMO: ``(I - MC)E = 0``, ``F = (I - MC)A - LC``, the asked and the fixed poles.
 
@@ -88,7 +89,7 @@ def missile_pmo(
     plant : Plant, optional
         :func:`uio_teach.examples.missile_autopilot` by default.
     tol : float, optional
-        Relative tolerance.
+        Relative tolerance; default ``tolerances.CHECK_RTOL``.
 
     Returns
     -------
@@ -103,6 +104,7 @@ def missile_pmo(
     >>> checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=[-100, -120]).passed
     True
     """
+    tol = tols.CHECK_RTOL if tol is None else tol
     result = CheckResult("Missile: the projection-operator observer")
     plant = get_plant(result, plant, "missile_autopilot")
     if plant is None:
@@ -122,7 +124,7 @@ def missile_pmo(
     else:
         hint = (
             " Your M is C^g, the inverse of C alone, which ignores E: M must satisfy MCE = E."
-            if close(M, np.linalg.pinv(C), 1e-9)
+            if close(M, np.linalg.pinv(C), tols.CHECK_EXACT_RTOL)
             else " M must satisfy MCE = E: build it from E and the generalized inverse of CE."
         )
         result.add(
@@ -167,7 +169,7 @@ def missile_pmo(
 
 @never_raises("Missile: the generalized-inverse observer", "missile.ginverse")
 def missile_ginverse(
-    Cg: Any, Pc: Any, Kg: Any, plant: Any = None, *, tol: float = 1e-9
+    Cg: Any, Pc: Any, Kg: Any, plant: Any = None, *, tol: float | None = None
 ) -> CheckResult:
     """Check ``Cg = C^g``, ``Pc = I - Cg C`` and condition (20), ``Pc E - Kg C E = 0``.
 
@@ -182,7 +184,7 @@ def missile_ginverse(
     plant : Plant, optional
         :func:`uio_teach.examples.missile_autopilot` by default.
     tol : float, optional
-        Relative tolerance.
+        Relative tolerance; default ``tolerances.CHECK_EXACT_RTOL``.
 
     Returns
     -------
@@ -195,6 +197,7 @@ def missile_ginverse(
     >>> checks.missile_ginverse(np.zeros((4, 2)), np.eye(4), np.zeros((4, 2))).passed
     False
     """
+    tol = tols.CHECK_EXACT_RTOL if tol is None else tol
     result = CheckResult("Missile: the generalized-inverse observer")
     plant = get_plant(result, plant, "missile_autopilot")
     if plant is None:
@@ -210,7 +213,7 @@ def missile_ginverse(
     if close(Cg, ref, tol):
         result.add(True, "Cg is the Moore-Penrose inverse of C.")
     else:
-        gen = close(C @ Cg @ C, C, 1e-9)
+        gen = close(C @ Cg @ C, C, tols.CHECK_EXACT_RTOL)
         result.add(
             False,
             "Cg is a generalized inverse (C Cg C = C) but not the Moore-Penrose one, which "
@@ -232,13 +235,13 @@ def missile_ginverse(
         result.add(False, "Pc is not I - Cg C with your Cg: recompute it from your Cg.")
     R = Pc @ E - Kg @ C @ E
     big = float(np.max(np.abs(R)))
-    if big <= 1e-6 * max(1.0, float(np.max(np.abs(E)))):
+    if big <= tols.CHECK_RTOL * max(1.0, float(np.max(np.abs(E)))):
         result.add(True, f"Pc E - Kg C E = 0{up_to(big, 'largest entry')}: condition (20) holds.")
     else:
         CEg = np.linalg.pinv(C @ E)
         hint = (
             " Your Kg is E (CE)^g, the PMO's M: the g-inverse observer projects E with Pc first."
-            if close(Kg, E @ CEg, 1e-9)
+            if close(Kg, E @ CEg, tols.CHECK_EXACT_RTOL)
             else " Kg must satisfy Kg C E = Pc E (eq. (20))."
         )
         result.add(
@@ -263,7 +266,7 @@ def _vhat(result: CheckResult, vhat: Any):
 def _paper_v(result: CheckResult, resp) -> bool:
     want = np.asarray(MISSILE.v(resp.time), float)
     d = np.asarray(resp.inputs.d, float)
-    if d.shape == want.shape and np.allclose(d, want, rtol=0, atol=1e-9):
+    if d.shape == want.shape and np.allclose(d, want, rtol=0, atol=tols.CHECK_EXACT_RTOL):
         return True
     result.add(
         False,
@@ -306,7 +309,7 @@ def _run_as_asked(
     elif poles is not None:
         wanted = as_poles(poles)
         eig = np.asarray(resp.observer.poles(), complex)
-        if not all(np.min(np.abs(eig - w)) <= 1e-6 * max(1.0, abs(w)) for w in wanted):
+        if not all(np.min(np.abs(eig - w)) <= tols.CHECK_RTOL * max(1.0, abs(w)) for w in wanted):
             result.add(
                 False,
                 f"the simulated PMO does not have the poles {format_poles(wanted)} of the "
@@ -316,7 +319,7 @@ def _run_as_asked(
     x0 = resp.states[:, 0]
     if initial_state is not None:
         want = np.asarray(initial_state, float).ravel()
-        if want.shape != x0.shape or not np.allclose(x0, want, rtol=0, atol=1e-9):
+        if want.shape != x0.shape or not np.allclose(x0, want, rtol=0, atol=tols.CHECK_EXACT_RTOL):
             dropped = " (initial_state was left out?)" if not np.any(x0) else ""
             result.add(
                 False,
@@ -334,10 +337,10 @@ def _run_as_asked(
     scale = max(1.0, float(np.max(np.abs(resp.states))))
     z0 = np.asarray(resp.observer_states[:, 0], float)
     xhat0 = np.asarray(resp.estimates[:, 0], float)
-    if start == "z0" and float(np.max(np.abs(z0))) > 1e-9 * scale:
+    if start == "z0" and float(np.max(np.abs(z0))) > tols.CHECK_EXACT_RTOL * scale:
         hint = (
             " That is the start x̂(0) = 0 of the catch-time exercise."
-            if float(np.max(np.abs(xhat0))) <= 1e-9 * scale
+            if float(np.max(np.abs(xhat0))) <= tols.CHECK_EXACT_RTOL * scale
             else ""
         )
         result.add(
@@ -346,8 +349,12 @@ def _run_as_asked(
             f"exercise asks for.{hint}",
         )
         ok = False
-    elif start == "xhat0" and float(np.max(np.abs(xhat0))) > 1e-9 * scale:
-        where = "z(0) = 0" if float(np.max(np.abs(z0))) <= 1e-9 * scale else "another z(0)"
+    elif start == "xhat0" and float(np.max(np.abs(xhat0))) > tols.CHECK_EXACT_RTOL * scale:
+        where = (
+            "z(0) = 0"
+            if float(np.max(np.abs(z0))) <= tols.CHECK_EXACT_RTOL * scale
+            else "another z(0)"
+        )
         result.add(
             False,
             f"the run starts the observer from {where}, so x̂(0) = z(0) + M y(0) is not 0: "
@@ -433,7 +440,7 @@ def missile_reconstruction(
         return result
     ref = reconstruct_input(resp.plant, resp, method=vh.method, tau=vh.tau)
     gap = float(np.max(np.abs(ref.estimates - vh.estimates)))
-    if gap > 1e-6 * max(1.0, float(np.max(np.abs(ref.estimates)))):
+    if gap > tols.CHECK_RTOL * max(1.0, float(np.max(np.abs(ref.estimates)))):
         result.add(
             False,
             f"vhat is not the reconstruction of this run (it differs from the run's "
@@ -642,7 +649,9 @@ def missile_noise(
             noise=float(sigma),
             seed=int(seed),
         )
-        if not np.allclose(np.asarray(again.inputs.noise), noise, rtol=0, atol=1e-12):
+        if not np.allclose(
+            np.asarray(again.inputs.noise), noise, rtol=0, atol=tols.CHECK_ZERO_ATOL
+        ):
             result.add(
                 False,
                 f"the noise of the run is not the one of seed {int(seed)}: take the seed of "
@@ -652,13 +661,13 @@ def missile_noise(
     late = resp.time >= after
     ref = np.sqrt(np.mean(vh.error[:, late] ** 2, axis=1))
     got = vals.ravel()
-    if close(got, ref, 1e-6):
+    if close(got, ref, tols.CHECK_RTOL):
         result.add(True, f"the RMS errors are those of the run: {ref[0]:.3g}, {ref[1]:.3g}.")
     else:
         how = [
             f"v{i + 1} too {'large' if got[i] > ref[i] else 'small'}"
             for i in range(q)
-            if abs(got[i] - ref[i]) > 1e-6 * max(1.0, abs(ref[i]))
+            if abs(got[i] - ref[i]) > tols.CHECK_RTOL * max(1.0, abs(ref[i]))
         ]
         result.add(
             False,
@@ -737,7 +746,10 @@ def missile_plot(fig: Any, vhat: Any, *, plant: Any = None) -> CheckResult:
     scale = max(1.0, float(np.max(np.abs(actual))))
 
     def drawn(row: np.ndarray) -> bool:
-        return any(np.allclose(y, row, rtol=0, atol=1e-9 * scale, equal_nan=True) for y in ys)
+        return any(
+            np.allclose(y, row, rtol=0, atol=tols.CHECK_EXACT_RTOL * scale, equal_nan=True)
+            for y in ys
+        )
 
     missing = [f"v{i + 1}" for i in range(actual.shape[0]) if not drawn(actual[i])]
     missing += [f"v̂{i + 1}" for i in range(est.shape[0]) if not drawn(est[i])]

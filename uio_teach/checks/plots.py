@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import tolerances as tols
 from .common import CheckResult, check_plant_of, never_raises, plural, read_response
 
 __all__ = [
@@ -119,7 +120,12 @@ def time_factor(x: np.ndarray, t: np.ndarray) -> float | None:
     if x.shape != t.shape:
         return None
     for k in (1.0, 1e3, 1e6):
-        if np.allclose(x, k * t, rtol=1e-9, atol=1e-9 * k * max(1.0, float(np.max(np.abs(t))))):
+        if np.allclose(
+            x,
+            k * t,
+            rtol=tols.CHECK_EXACT_RTOL,
+            atol=tols.CHECK_EXACT_RTOL * k * max(1.0, float(np.max(np.abs(t)))),
+        ):
             return k
     return None
 
@@ -361,7 +367,11 @@ def experiment_title(result: CheckResult, fig: Any, resp: Any) -> None:
     if not text:
         return
     d = np.asarray(resp.inputs.d, float)
-    jumps = np.abs(np.diff(d, axis=1)) > 1e-9 * max(1.0, float(np.max(np.abs(d)))) if d.size else d
+    jumps = (
+        np.abs(np.diff(d, axis=1)) > tols.CHECK_EXACT_RTOL * max(1.0, float(np.max(np.abs(d))))
+        if d.size
+        else d
+    )
     changing = float(np.mean(np.any(jumps, axis=0))) if d.size > d.shape[0] else 0.0
     kind = "" if not np.any(d) else "piecewise" if changing < 0.5 else "sinus"
     family = str(getattr(resp.observer, "family", "")).lower()
@@ -570,7 +580,7 @@ def _check_curves(
     result: CheckResult, axes: Sequence, kinds: Sequence[str], resp: Any, units: set
 ) -> None:
     err = np.asarray(resp.error, float)
-    tol = 1e-9 * max(1.0, float(np.max(np.abs(resp.states))))
+    tol = tols.CHECK_EXACT_RTOL * max(1.0, float(np.max(np.abs(resp.states))))
     n, p = err.shape[0], np.shape(resp.residual)[0]
     if not curves_against_time(result, axes, np.asarray(resp.time, float), units):
         return

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import tolerances as tols
 from .._display import format_complex, format_poles
 from ..signals import piecewise_constant
 from .common import (
@@ -69,7 +70,7 @@ def _noise_free(result: CheckResult, resp) -> bool:
 
 def _initial_error(result: CheckResult, resp) -> float:
     e0 = float(np.max(np.abs(resp.error[:, 0])))
-    if e0 <= 1e-12:
+    if e0 <= tols.CHECK_ZERO_ATOL:
         result.add(
             False,
             "the error is zero at t = 0, so nothing can be seen decaying: start the plant from "
@@ -109,7 +110,7 @@ def _same_without_d(result: CheckResult, resp) -> bool:
 
 
 def _decays(result: CheckResult, resp, e0: float, decay: float, decoupled: bool = True) -> None:
-    if e0 <= 1e-12:
+    if e0 <= tols.CHECK_ZERO_ATOL:
         return
     e_end = float(np.max(np.abs(resp.error[:, -1])))
     t0, t1 = float(resp.time[0]), float(resp.time[-1])
@@ -160,7 +161,9 @@ def _seconds(resp: Any) -> str:
 def _jumps(d: np.ndarray) -> np.ndarray:
     """Indices ``k`` where some channel of ``d`` changes between samples ``k`` and ``k + 1``."""
     scale = max(1.0, float(np.max(np.abs(d))))
-    return np.flatnonzero(np.any(np.abs(np.diff(d, axis=1)) > 1e-9 * scale, axis=0))
+    return np.flatnonzero(
+        np.any(np.abs(np.diff(d, axis=1)) > tols.CHECK_EXACT_RTOL * scale, axis=0)
+    )
 
 
 @never_raises("Practical Assignment 9: the test with a sinusoidal disturbance", "pa9.simulation")
@@ -436,7 +439,7 @@ def _compare(result: CheckResult, resp, other) -> None:
         return
     diff = float(np.max(np.abs(resp.error - other.error)))
     scale = max(1.0, float(np.max(np.abs(resp.states))), float(np.max(np.abs(other.states))))
-    if diff <= 1e-8 * scale:
+    if diff <= tols.CHECK_RUN_RTOL * scale:
         result.add(
             True,
             f"the error is the same as with the sinusoidal disturbance"
@@ -453,7 +456,7 @@ def _compare(result: CheckResult, resp, other) -> None:
 
 def _asked_signal(result: CheckResult, got: np.ndarray, want: np.ndarray, what: str) -> None:
     diff = float(np.max(np.abs(np.asarray(got, float) - want)))
-    if diff <= 1e-9 * max(1.0, float(np.max(np.abs(want)))):
+    if diff <= tols.CHECK_EXACT_RTOL * max(1.0, float(np.max(np.abs(want)))):
         result.add(True, f"d is the disturbance the exercise asks for, {what}.")
     else:
         result.add(
@@ -475,7 +478,7 @@ def _asked_setup(
     if initial_state is not None:
         want = np.asarray(initial_state, float).ravel()
         got = resp.states[:, 0]
-        if want.shape == got.shape and np.allclose(got, want, rtol=0, atol=1e-9):
+        if want.shape == got.shape and np.allclose(got, want, rtol=0, atol=tols.CHECK_EXACT_RTOL):
             result.add(True, f"the plant starts from x(0) = {numbers(want)}, as asked.")
         elif not np.any(got):
             result.add(
@@ -526,7 +529,11 @@ def _own_design(result: CheckResult, observer: Any, H: Any, K1: Any) -> bool | N
             mine = np.asarray(value, float)
         except (TypeError, ValueError):
             mine = None
-        if theirs is None or mine is None or not close(mine, np.asarray(theirs, float), 1e-8):
+        if (
+            theirs is None
+            or mine is None
+            or not close(mine, np.asarray(theirs, float), tols.CHECK_RUN_RTOL)
+        ):
             differ.append(name)
     if not differ:
         result.add(True, "the simulated observer is your design of requirement 1.")

@@ -33,6 +33,7 @@ from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter
 from matplotlib.transforms import Bbox, IdentityTransform, TransformedBbox
 from PIL import Image
 
+from .. import tolerances as tols
 from ..plotting import COLORS, axis_label, channel_style, symbol, time_label
 from .frames import Frame, compute_frame, finite_max
 from .messages import ROUNDING
@@ -69,7 +70,7 @@ def _nice_range(arrays: Sequence[np.ndarray | None]) -> tuple[float, float]:
         a = a[np.isfinite(a)]
         if a.size:
             lo, hi = min(lo, float(a.min())), max(hi, float(a.max()))
-    if not np.isfinite(lo) or hi - lo < 1e-12 * max(1.0, abs(lo), abs(hi)):
+    if not np.isfinite(lo) or hi - lo < tols.DISPLAY_ZERO_RTOL * max(1.0, abs(lo), abs(hi)):
         mid = 0.0 if not np.isfinite(lo) else lo
         lo, hi = mid - max(1.0, abs(mid)) * 0.5, mid + max(1.0, abs(mid)) * 0.5
         if not np.isfinite(lo):

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import tolerances as tols
 from .._display import format_poles
 from ..linalg import is_stable
 from ..lmi import LMIInfeasibleError
@@ -49,8 +50,9 @@ __all__ = [
 TOLERANCE = 0.01
 """Relative change below which the error counts as ending where it started."""
 
-ROUNDING = 1e-9
-"""Size, relative to the plant's own signals, below which an error is zero to rounding."""
+ROUNDING = tols.ROUNDING_RTOL
+"""Size, relative to the plant's own signals, below which an error is zero to rounding
+(``tolerances.ROUNDING_RTOL``)."""
 
 
 @dataclass(frozen=True)
@@ -228,7 +230,7 @@ def _pair(p: complex) -> str:
 def _growing(poles: np.ndarray, discrete: bool) -> np.ndarray:
     bad = ~is_stable(poles, discrete)
     mag = np.abs(poles) - 1 if discrete else poles.real
-    return bad & (mag > 1e-9 * np.maximum(1, np.abs(poles)))
+    return bad & (mag > tols.STABILITY_MARGIN * np.maximum(1, np.abs(poles)))
 
 
 def stability_message(
@@ -429,7 +431,11 @@ def zero_notes(scenario: Scenario, movable: np.ndarray) -> list[str]:
         size = max(abs(z), abs(p))
         if gaps[j] > NEXT_TO * size:
             continue
-        where = "sits on" if gaps[j] <= 1e-9 * max(size, np.finfo(float).tiny) else "is next to"
+        where = (
+            "sits on"
+            if gaps[j] <= tols.ROUNDING_RTOL * max(size, np.finfo(float).tiny)
+            else "is next to"
+        )
         text = (
             f"pole {format_poles([p], 3)} {where} the invariant zero {format_poles([z], 3)}, "
             "where a fixed pole already is: the error there decays no faster than that fixed "

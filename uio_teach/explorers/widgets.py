@@ -54,6 +54,7 @@ except ImportError as err:  # the live explorers are an extra: say so in one lin
         "need no extra)"
     ) from None
 
+from .. import tolerances as tols
 from .._display import format_poles
 from ..plant import Plant
 from ._drag import DragPoles, drag_available, in_kernel
@@ -411,7 +412,7 @@ class Explorer(DragPoles):
                 p = cmath.rect(values[0], math.radians(values[1]))
             else:
                 p = complex(values[0], values[1])
-            if abs(p.imag) <= 1e-12 * max(1.0, abs(p)):
+            if abs(p.imag) <= tols.CONJUGATE_RTOL * max(1.0, abs(p)):
                 poles += [float(p.real), float(p.real)]  # a double real pole
             else:
                 poles.append(p)

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from .. import signals
+from .. import tolerances as tols
 from .._display import format_poles
 from ..existence import check_existence, decoupling
 from ..experiments import (
@@ -277,7 +278,11 @@ def _case_error(runs: Any) -> Figure:
     finish_panel(ax, with_unit(r"$\|e[k]\|_2$"))
     ax.set_title("Case study: the estimation error ignores both unknown signals")
     gap = float(np.max(np.abs(loud.error - quiet.error)))
-    same = "the same" if gap <= 1e-9 * max(float(norm.max()), 1.0) else f"within {gap:.2g}"
+    same = (
+        "the same"
+        if gap <= tols.ROUNDING_RTOL * max(float(norm.max()), 1.0)
+        else f"within {gap:.2g}"
+    )
     describe(
         fig,
         "The size of the case-study PMO's estimation error at each step k, on a logarithmic "
@@ -445,7 +450,10 @@ class CaseStudyParams(LabParams):
                 pmo = design_pmo(plant, method="lmi")
             except ValueError as err:
                 return [f"the LMI has no solution: {err}"]
-            if np.max(np.abs(pmo.L @ plant.D)) > 1e-6 or np.max(np.abs(pmo.poles())) >= 1:
+            if (
+                np.max(np.abs(pmo.L @ plant.D)) > tols.CHECK_RTOL
+                or np.max(np.abs(pmo.poles())) >= 1
+            ):
                 out.append("the LMI gain must satisfy L D = 0 and be stable")
         return out
 

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from .. import signals
+from .. import tolerances as tols
 from .._display import format_poles
 from ..examples import TankOperatingPoint, quadruple_tank, tank_operating_point
 from ..existence import check_existence
@@ -359,7 +360,7 @@ def valve_verdict(gamma1: float, gamma2: float, v0: Any = None) -> str:
     if not zeros.size:  # pragma: no cover - the rank condition holds: the plant has its zeros
         return f"{head}, and no UIO with a stable error exists"
     worst = float(zeros[-1])
-    if abs(worst) <= 1e-9 * max(1.0, float(np.max(np.abs(zeros)))):
+    if abs(worst) <= tols.STABILITY_MARGIN * max(1.0, float(np.max(np.abs(zeros)))):
         place = "an invariant zero sits at the origin (to round-off)"
     else:
         place = f"an invariant zero lies in the right half-plane at {worst:.3g}"
