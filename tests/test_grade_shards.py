@@ -29,6 +29,7 @@ from uio_teach.grading.gradebook import read_gradebook
 from uio_teach.grading.merge import shard_of
 from uio_teach.grading.sandbox import Limits, sandbox_problem
 from uio_teach.instructor import cli
+from uio_teach.instructor.labs import LABS
 
 pytestmark = [pytest.mark.kernel, pytest.mark.filterwarnings("ignore::DeprecationWarning")]
 
@@ -118,7 +119,8 @@ def notebook(*cells: str) -> nbformat.NotebookNode:
         "display_name": "Python 3",
         "language": "python",
     }
-    params = nbformat.v4.new_code_cell("PARAMS = {'poles': [-1.0, -2.0, -3.0]}")
+    poles = list(LABS["pa9"].params().to_params()["poles"])  # the lab's own, as the key's
+    params = nbformat.v4.new_code_cell(f"PARAMS = {{'poles': {poles}}}")
     params.metadata["tags"] = ["parameters"]
     nb.cells = [params] + [nbformat.v4.new_code_cell(c) for c in cells]
     return nb

@@ -411,7 +411,11 @@ def test_controls_work_from_the_keyboard_with_focus_labels_and_announcements(nam
         seen.append(page.evaluate(_CONTROLS_JS, 0))
         page.keyboard.press("End")
         page.keyboard.press("ArrowLeft")
-        seen.append(page.evaluate(_CONTROLS_JS, 0))
+        moved = page.evaluate(_CONTROLS_JS, 0)
+        if moved["shown"] == seen[0]["shown"]:  # the slider starts one short of its end
+            page.keyboard.press("ArrowLeft")
+            moved = page.evaluate(_CONTROLS_JS, 0)
+        seen.append(moved)
         if kinds > 1:
             page.keyboard.press("Tab")  # the disturbance menu
             page.keyboard.press("ArrowDown")

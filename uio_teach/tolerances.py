@@ -123,7 +123,7 @@ DECAY_RTOL = 1e-6
 (the solver meets its constraints to about ``1e-8``)."""
 
 CONJUGATE_RTOL = 1e-9
-"""Requested poles: an imaginary part below this fraction of the poles' size (at least 1) is
+"""For requested poles, an imaginary part below this fraction of the poles' size (at least 1) is
 round-off of a real pole, and two poles within it of each other's conjugate are one conjugate
 pair, typed or computed to round-off; they are made exactly real or conjugate."""
 
