@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import concurrent.futures
 import functools
 import html
 import os
@@ -781,6 +782,17 @@ async def _print_all(job: Job, jobs: int, book: Job | None) -> list[tuple[Path, 
     return list(results)
 
 
+def _run(coroutine):  # noqa: ANN001, ANN202 (any coroutine, its result)
+    """Run ``coroutine`` to its end, also when the caller's thread already runs an event loop
+    (Playwright's synchronous API keeps one running): then in a thread of its own."""
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:
+        return asyncio.run(coroutine)
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        return pool.submit(asyncio.run, coroutine).result()
+
+
 def print_site(
     site: Path,
     out: Path,
@@ -819,7 +831,7 @@ def print_site(
             meta=f"Printed on {time.localtime().tm_mday} {time.strftime('%B %Y')} from the "
             "book's web pages",
         )
-        results = asyncio.run(_print_all(job, jobs or os.cpu_count() or 1, job if book else None))
+        results = _run(_print_all(job, jobs or os.cpu_count() or 1, job if book else None))
     pdfs = [path for path, _ in results]
     problems = [line for path in pdfs for line in audit_pdf(path)]
     if problems:

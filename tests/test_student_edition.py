@@ -234,7 +234,8 @@ def test_lab_checks_are_shown_unrun(page: str, built_book: Path) -> None:
     """A lab's check cells have no output (their verdicts would come from the model solution)
     and say why; no ✓/✗ verdict and no "checks passed" is on the page."""
     html = (built_book / f"{page}.html").read_text(encoding="utf-8")
-    cells = re.split(r'<div class="cell docutils container', html)[1:]
+    # a cell's tags are classes of its box (``cell tag_check docutils container``)
+    cells = re.split(r'<div class="cell(?: [\w-]+)* docutils container', html)[1:]
     checks = [c for c in cells if 'checks</span><span class="o">.</span>' in c.split("</pre>")[0]]
     assert checks, f"{page}: no check cell found"
     with_output = [c[:200] for c in checks if 'class="cell_output' in c]
