@@ -85,6 +85,31 @@ def test_the_outlets_round_to_the_printed_ones_which_taken_exactly_miss_the_prin
     assert misses > 0
 
 
+def _reproduces_every_printed_value(a24: float) -> bool:
+    """Whether outlets a2 = a4 = a24 give every printed time constant and zero of both settings."""
+    for setting in SETTINGS:
+        pub = QUADRUPLE_TANK_PUBLISHED[setting]
+        op = tank_operating_point(setting)
+        a = np.array([TANK_OUTLETS[0], a24, TANK_OUTLETS[2], a24])
+        T = np.asarray(pub.A) * op.flows / (a**2 * pub.g)  # T = A q / (a^2 g) at the same flows
+        g1, g2 = pub.gamma
+        rhs = (1 - g1) * (1 - g2) / (g1 * g2)
+        zeros = np.sort(np.roots([T[2] * T[3], T[2] + T[3], 1 - rhs]).real)
+        same_zeros = np.array_equal(np.round(zeros, 3), pub.zeros)
+        if not (np.array_equal(np.round(T), pub.T) and same_zeros):
+            return False
+    return True
+
+
+def test_the_outlet_interval_the_docstring_states_is_the_one_that_works():
+    """TANK_OUTLETS says every value from about 0.05715 to 0.05729 reproduces the printed
+    numbers: both ends do, and a step of 0.00002 beyond either end does not."""
+    assert _reproduces_every_printed_value(TANK_OUTLETS[1])
+    assert _reproduces_every_printed_value(0.05716) and _reproduces_every_printed_value(0.05728)
+    assert not _reproduces_every_printed_value(0.05713)
+    assert not _reproduces_every_printed_value(0.05731)
+
+
 @pytest.mark.parametrize("valves", VALVES)
 @pytest.mark.parametrize("setting", SETTINGS)
 def test_the_operating_point_is_a_steady_state_of_the_nonlinear_model(setting, valves):
