@@ -214,7 +214,7 @@ def _tank_published(setting: str, values: dict[str, Any]) -> Published:
         "g": 981.0,  # cm/s^2
     }
     return Published(
-        source=f"Johansson, IEEE TCST 8(3) 2000, Tables I-II, setting {setting}",
+        source=f"Johansson, IEEE TCST 8(3) 2000, setting {setting}",
         decimals=3,
         values=MappingProxyType({k: read_only(v) for k, v in {**shared, **values}.items()}),
     )
