@@ -64,7 +64,7 @@ class Condition:
     reason: str
     required: bool = True
     margin: float | None = None
-    """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
+    """For a verdict that rests on a rank decision, the smallest ratio (kept singular value /
     rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
     threshold, that ratio (threshold / dropped value); below
     ``uio_teach.tolerances.RANK_MARGIN`` the verdict hangs on round-off and the reason says
@@ -243,7 +243,8 @@ class ExistenceReport:
 
     @property
     def zero_radius(self) -> np.ndarray | None:
-        """How far round-off of the data can move each invariant zero (``None``: not computed)."""
+        """How far round-off of the data can move each invariant zero (``None``
+        when not computed)."""
         return None if self.zero_set is None else self.zero_set.radius
 
     @property
