@@ -150,8 +150,13 @@ def make_scenario(
     Continuous time: the default movable poles are ``-s, -1.5 s, -2 s, ...``
     with ``s`` the largest of 1, the plant's fastest mode and the fixed
     poles' moduli; the window lasts 8 time constants of the slowest observer
-    pole (1001 samples). Discrete time: poles ``0.5, 0.4, 0.3, ...`` and
-    enough steps for the slowest pole to decay to 0.1 %. The disturbance
+    pole (1001 samples; shorter when a lightly damped pair would otherwise get
+    too few samples a period). Discrete time: poles ``0.5, 0.4, 0.3, ...`` and
+    enough steps (30 to 300) for the slowest pole to shrink the error a
+    thousandfold. A candidate pole next to a fixed pole is skipped (the case
+    study starts at 0.4, beside its fixed poles at 0.5); see
+    ``uio_teach.explorers.model.default_poles`` and
+    ``default_timepts``. The disturbance
     starts as a sinusoid with three periods in the window.
 
     Parameters
@@ -192,6 +197,8 @@ def make_scenario(
     >>> s = make_scenario(ut.examples.pa9(), "pmo")
     >>> s.defaults.poles, round(float(s.timepts[-1]), 3)
     ((-2.0, -3.0, -4.0), 4.0)
+    >>> make_scenario(ut.examples.dt_case_study(), "pmo").defaults.poles
+    (0.4,)
     """
     if not isinstance(plant, Plant):
         raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
