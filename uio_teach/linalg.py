@@ -287,7 +287,7 @@ class ObservabilitySplit(NamedTuple):
     @property
     def marginal(self) -> bool:
         """True when a rank decision of the staircase sat within ``MARGIN`` of round-off."""
-        return bool(self.margin < MARGIN)
+        return bool(self.margin < tols.RANK_MARGIN)
 
     @property
     def unobservable_modes(self) -> np.ndarray:
