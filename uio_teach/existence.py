@@ -615,7 +615,10 @@ def conditioning_condition(bal: Plant) -> Condition:
     amp = top / smin if smin > 0 else np.inf
     ok = bool(amp <= tols.AMPLIFICATION_LIMIT)
     if ok:
-        reason = f"any UIO amplifies round-off by about {amp:.2g} at most"
+        reason = (
+            f"the UIO of least ||H|| amplifies round-off by about {amp:.2g}, the least any "
+            "UIO can"
+        )
     else:
         reason = (
             f"a UIO exists only ill-conditioned: C E is {1 / amp:.2g} of ||C|| ||E||, so H "
@@ -641,7 +644,10 @@ def check_existence(plant: Plant) -> ExistenceReport:
        unobservable modes are the fixed observer poles; they are exactly the
        invariant zeros of 2.
     4. **observability** of that pair (information): every pole can be placed.
-    5. **E full column rank** (information): the unknown input can be
+    5. **well-conditioned decoupling** (information): how much a UIO must
+       amplify the data's round-off, ``||E|| ||C|| / sigma_min(C E)`` at least
+       (see ``conditioning_condition``).
+    6. **E full column rank** (information): the unknown input can be
        reconstructed uniquely from the state estimate.
 
     Every decision is made on the plant in balanced units
