@@ -80,7 +80,8 @@ class Condition:
 
     @property
     def symbol(self) -> str:
-        """The verdict in one character; ✓, ✗, – (not evaluated) or ○ (info, not met)."""
+        """The verdict in one character; ✓, ✗, ? (undecided: round-off could change it), – (not
+        evaluated) or ○ (info, not met)."""
         if not self.required and self.holds is False:
             return "○"
         if self.undecided:
@@ -616,8 +617,7 @@ def conditioning_condition(bal: Plant) -> Condition:
     ok = bool(amp <= tols.AMPLIFICATION_LIMIT)
     if ok:
         reason = (
-            f"the UIO of least ||H|| amplifies round-off by about {amp:.2g}, the least any "
-            "UIO can"
+            f"the UIO of least ||H|| amplifies round-off by about {amp:.2g}, the least any UIO can"
         )
     else:
         reason = (
