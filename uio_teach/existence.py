@@ -80,7 +80,7 @@ class Condition:
 
     @property
     def symbol(self) -> str:
-        """The verdict in one character; ✓, ✗, ? (undecided: round-off could change it), – (not
+        """The verdict in one character; ✓, ✗, ? (undecided, round-off could change it), – (not
         evaluated) or ○ (info, not met)."""
         if not self.required and self.holds is False:
             return "○"
