@@ -1,4 +1,7 @@
-"""The plants of the three source documents, exactly as printed, and their published extras.
+"""The plants of the course, with the values their sources print.
+
+The three source documents' plants as printed (the missile's as read back from the paper's
+scrambled text) and Johansson's quadruple tank, built from the paper's parameters:
 
 * :func:`dt_case_study` -- *Case Study*: a discrete-time projection-operator UIO
   (3 states, unknown state input ``u2`` with matrix ``B2 = E``, measurement

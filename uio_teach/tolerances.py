@@ -2,9 +2,10 @@
 
 The algorithms read these names at call time (``tolerances.NAME``), so the one definition here is
 the one in use; ``tests/test_tolerances.py`` pins each from both sides (a value a hundred times
-looser or tighter fails a named test). Relative tolerances are relative to the size of the data
-they judge, never absolute: a verdict does not change when time, states, inputs or outputs are
-measured in other units.
+looser or tighter fails a named test). The relative tolerances (``*_RTOL``, the margins) are
+relative to the size of the data they judge: a verdict of the algorithms does not change when
+time, states, inputs or outputs are measured in other units. ``CHECK_ZERO_ATOL`` alone is
+absolute: the lab checks judge the course's own plants, whose numbers are of order 1.
 
 Examples
 --------
