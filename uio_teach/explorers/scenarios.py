@@ -60,13 +60,28 @@ def scenario_of(name: str, **plant_values: float) -> Scenario:
     -------
     Scenario
 
+    Raises
+    ------
+    uio_teach.worked.RegistryError
+        An unknown worked example (the message lists the known ones), or a
+        value for a field its experiment does not have.
+
     Examples
     --------
     >>> from uio_teach.explorers.scenarios import scenario_of
     >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
     False
     """
-    return WORKED[name].make_scenario(**plant_values)
+    return _entry(name).make_scenario(**plant_values)
+
+
+def _entry(name: str):
+    """The registry entry of a worked example, or a RegistryError naming the known ones."""
+    if name not in WORKED:
+        raise RegistryError(
+            f"no worked example {name!r}; the worked examples are {', '.join(WORKED)}"
+        )
+    return WORKED[name]
 
 
 def _range(experiment: Any, control: str) -> tuple[float, float]:
@@ -289,8 +304,9 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     Raises
     ------
     uio_teach.worked.RegistryError
-        A value for a field the experiment does not have, or an option that
-        a declared field already sets (the range of a control given twice).
+        An unknown worked example, a value for a field the experiment does not
+        have, or an option that a declared field already sets (the range of a
+        control given twice).
 
     Examples
     --------
@@ -299,7 +315,7 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     >>> s.existence.ok, [c.value for c in s.plant_controls]
     (False, [0.43, 0.34])
     """
-    entry = WORKED[name]
+    entry = _entry(name)
     opts = entry.explorer
     run = entry.run()
     fields = {f for f, spec in experiment_params(run) if spec.range and not spec.control}
