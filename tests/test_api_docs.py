@@ -121,3 +121,55 @@ def test_docstring_examples_run(modname):
     mod = importlib.import_module(modname)
     result = doctest.testmod(mod, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0, f"{result.failed} docstring example(s) failed in {modname}"
+
+
+def _attribute_docstrings():
+    """(label, name, docstring) of every property and module-level attribute docstring."""
+    import ast
+
+    found = []
+    for info in pkgutil.walk_packages(ut.__path__, prefix="uio_teach."):
+        # the grader's engine (uio_teach.grading) is documented apart from this package's API
+        if info.name.endswith("__main__") or info.name.startswith("uio_teach.grading"):
+            continue
+        mod = importlib.import_module(info.name)
+        for cname, cls in vars(mod).items():
+            if inspect.isclass(cls) and cls.__module__ == info.name:
+                for pname, prop in vars(cls).items():
+                    if isinstance(prop, property) and prop.__doc__:
+                        found.append((f"{info.name}.{cname}.{pname}", pname, prop.__doc__))
+        for node in ast.walk(ast.parse(inspect.getsource(mod))):
+            body = getattr(node, "body", None)
+            if not isinstance(body, list):
+                continue
+            for stmt, doc in zip(body, body[1:], strict=False):
+                target = (
+                    getattr(stmt, "target", None) or (getattr(stmt, "targets", None) or [None])[0]
+                )
+                if (
+                    isinstance(stmt, ast.Assign | ast.AnnAssign)
+                    and isinstance(target, ast.Name)
+                    and isinstance(doc, ast.Expr)
+                    and isinstance(doc.value, ast.Constant)
+                    and isinstance(doc.value.value, str)
+                ):
+                    found.append((f"{info.name}.{target.id}", target.id, doc.value.value))
+    return found
+
+
+def test_no_attribute_docstring_renders_as_a_type():
+    """Napoleon reads a property's or constant's first line ``X: text`` as the type ``X``: the
+    API page would print "text" and then "Type: X" (half a formula). No first line may do so."""
+    from sphinx.ext.napoleon import Config
+    from sphinx.ext.napoleon.docstring import NumpyDocstring
+
+    config = Config(napoleon_use_ivar=False)
+    docs = _attribute_docstrings()
+    assert len(docs) > 50  # the properties of the observers and every tolerance are among them
+    typed = [
+        label
+        for label, name, doc in docs
+        if ":type:"
+        in str(NumpyDocstring(inspect.cleandoc(doc), config, what="attribute", name=name))
+    ]
+    assert not typed, f"first lines read as a type on the API page: {typed}"

@@ -447,7 +447,11 @@ def test_isolation_verdicts():
             lambda p: ut.design_uio_bank(
                 ut.Plant(p.A, p.C, B=p.B[:, :1], E=p.E), "actuator", poles=[-1, -2, -3]
             ),
-            "at least 2 actuators",
+            "^an actuator bank needs at least 2 actuators",
+        ),
+        (
+            lambda p: ut.design_uio_bank(ut.Plant(p.A, p.C[:1], B=p.B), "sensor", poles=[-1, -2]),
+            "^a sensor bank needs at least 2 sensors",
         ),
     ],
 )

@@ -33,7 +33,7 @@ from uio_teach.explorers import (
     render,
     scenario_of,
 )
-from uio_teach.worked import WORKED
+from uio_teach.worked import WORKED, RegistryError
 
 # every worked example of the registry: a new one is explored and checked with no line here
 SCENARIOS = {name: functools.partial(scenario_of, name) for name in WORKED}
@@ -867,3 +867,11 @@ def test_every_static_frame_says_what_its_numbers_show(name):
             for num in re.findall(r"right half-plane at (\S+?),", fsc.note):
                 assert float(num) == pytest.approx(zeros[-1], rel=5e-3)
     assert seen >= 2 * len(sc.static_values)
+
+
+def test_an_unknown_worked_example_is_named_with_the_known_ones():
+    """Not a bare KeyError: the package's error, naming the name given and the names it knows."""
+    with pytest.raises(RegistryError, match=r"no worked example 'tank'; the worked examples are "):
+        scenario_of("tank")
+    with pytest.raises(RegistryError, match="pa9, case_study, missile, quadruple_tank"):
+        scenario_of("nope")

@@ -443,3 +443,31 @@ def test_at_the_unstable_end_of_the_pole_slider_the_error_grows_and_the_words_sa
     shown = np.abs(frame.curves["uio.error"])
     N = shown.shape[1]
     assert shown[:, -N // 10 :].max() > 1.5 * shown[:, : N // 10].max()
+
+
+def _reproduces_the_printed_numbers(a24: float) -> bool:
+    """Whether outlets a_2 = a_4 = a24 give every printed T (whole seconds) and zero (2 digits),
+    from the mass balance written out here (not the package's operating point)."""
+    for pub in QUADRUPLE_TANK_PUBLISHED.values():
+        A, g = np.asarray(pub.A), pub.g
+        a = np.array([TANK_OUTLETS[0], a24, TANK_OUTLETS[2], a24])
+        (g1, g2), (k1, k2), (v1, v2) = pub.gamma, pub.k, pub.v0
+        q3, q4 = (1 - g2) * k2 * v2, (1 - g1) * k1 * v1
+        q = np.array([g1 * k1 * v1 + q3, g2 * k2 * v2 + q4, q3, q4])
+        T = A * q / (a**2 * g)  # (A/a) sqrt(2 h0/g) with h0 = (q/a)^2 / (2 g)
+        zeros = _closed_form_zeros(T[2], T[3], g1, g2)
+        if not np.array_equal(np.round(T), pub.T):
+            return False
+        if not all(float(f"{z:.2g}") == p for z, p in zip(zeros, np.sort(pub.zeros), strict=True)):
+            return False
+    return True
+
+
+def test_the_outlet_areas_that_reproduce_the_paper_are_those_the_docstring_names():
+    """TANK_OUTLETS' docstring: 0.057 exactly misses, 0.0572 and any value from 0.05715 to
+    0.05729 reproduce every printed time constant and zero, 0.0571 and 0.0573 do not."""
+    assert _reproduces_the_printed_numbers(TANK_OUTLETS[1])
+    for a24 in np.linspace(0.05715, 0.05729, 15):
+        assert _reproduces_the_printed_numbers(a24), a24
+    for a24 in (0.057, 0.0571, 0.0573):
+        assert not _reproduces_the_printed_numbers(a24), a24

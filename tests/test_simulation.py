@@ -705,3 +705,14 @@ def test_unstable_plant_overflow_names_the_plant_pole():
     obs = ut.design_luenberger(plant, poles=[-1.0])
     with pytest.raises(ut.simulation.SimulationOverflowError, match=r"50 \(plant\)"):
         ut.simulate(plant, obs, np.linspace(0, 20, 2001), initial_state=[1.0])
+
+
+def test_overflow_names_a_pole_of_plant_and_observer_once_for_each():
+    """An observer without gain keeps the plant's unstable pole: the joint system has it twice,
+    once the plant's and once the observer's, and the message says so."""
+    plant = ut.Plant([[50.0]], [[1.0]])
+    with pytest.warns(ut.UnstableObserverWarning):
+        obs = ut.design_luenberger(plant, L=[[0.0]])
+    with pytest.raises(ut.simulation.SimulationOverflowError) as info:
+        ut.simulate(plant, obs, np.linspace(0, 100, 101), initial_state=[1.0])
+    assert "50 (plant), 50 (observer)" in str(info.value)

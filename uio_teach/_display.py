@@ -23,7 +23,7 @@ __all__ = [
 ]
 
 LINE_WIDTH = 76
-"""Printed lines fit the book's column (1280 px): at most this many characters."""
+"""Printed lines fit the book's column (1280 px), at most this many characters."""
 
 
 def fit_lines(text: str, width: int = LINE_WIDTH, indent: str | None = None) -> str:
@@ -194,7 +194,7 @@ _SR_ONLY = (
     "position:absolute;width:1px;height:1px;overflow:hidden;clip:rect(0 0 0 0);"
     "white-space:nowrap;border:0;padding:0;margin:-1px"
 )
-"""The style of text for screen readers only: in the page's structure, not on the screen."""
+"""The style of text for screen readers only (in the page's structure, not on the screen)."""
 
 
 def _html_matrix(M: np.ndarray, digits: int, ref: float = 0.0, name: str = "") -> str:

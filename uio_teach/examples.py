@@ -1,4 +1,7 @@
-"""The plants of the three source documents, exactly as printed, and their published extras.
+"""The plants of the course, with the values their sources print.
+
+The three source documents' plants as printed (the missile's as read back from the paper's
+scrambled text) and Johansson's quadruple tank, built from the paper's parameters:
 
 * :func:`dt_case_study` -- *Case Study*: a discrete-time projection-operator UIO
   (3 states, unknown state input ``u2`` with matrix ``B2 = E``, measurement
@@ -263,7 +266,8 @@ balance gives ``T_2 = 90.6`` s at P- (printed 90), ``T_2 = 92.0`` s and
 ``T_4 = 56.6`` s at P+ (printed 91 and 56) and the slower P- zero
 ``-0.01747`` (printed ``-0.018``). ``a_2 = a_4 = 0.0572``, which the printed
 ``0.057`` rounds, reproduces every printed time constant and zero of both
-settings (so does any value from about 0.05715 to 0.05729)."""
+settings (so does any value from 0.05715 to 0.05729; 0.0571 misses the printed
+``T_2 = 91`` at P+ and 0.0573 the printed P+ zero ``-0.056``)."""
 
 
 @dataclass(frozen=True)

@@ -64,7 +64,7 @@ class Condition:
     reason: str
     required: bool = True
     margin: float | None = None
-    """For a verdict that rests on a rank decision: the smallest ratio (kept singular value /
+    """For a verdict that rests on a rank decision, the smallest ratio (kept singular value /
     rank threshold), or, when a value taken as 0 sits within ``DROP_MARGIN`` below the
     threshold, that ratio (threshold / dropped value); below
     ``uio_teach.tolerances.RANK_MARGIN`` the verdict hangs on round-off and the reason says
@@ -80,7 +80,8 @@ class Condition:
 
     @property
     def symbol(self) -> str:
-        """The verdict in one character; ✓, ✗, – (not evaluated) or ○ (info, not met)."""
+        """The verdict in one character; ✓, ✗, ? (undecided, round-off could change it), – (not
+        evaluated) or ○ (info, not met)."""
         if not self.required and self.holds is False:
             return "○"
         if self.undecided:
@@ -243,7 +244,8 @@ class ExistenceReport:
 
     @property
     def zero_radius(self) -> np.ndarray | None:
-        """How far round-off of the data can move each invariant zero (``None``: not computed)."""
+        """How far round-off of the data can move each invariant zero (``None``
+        when not computed)."""
         return None if self.zero_set is None else self.zero_set.radius
 
     @property
@@ -614,7 +616,9 @@ def conditioning_condition(bal: Plant) -> Condition:
     amp = top / smin if smin > 0 else np.inf
     ok = bool(amp <= tols.AMPLIFICATION_LIMIT)
     if ok:
-        reason = f"any UIO amplifies round-off by about {amp:.2g} at most"
+        reason = (
+            f"the UIO of least ||H|| amplifies round-off by about {amp:.2g}, the least any UIO can"
+        )
     else:
         reason = (
             f"a UIO exists only ill-conditioned: C E is {1 / amp:.2g} of ||C|| ||E||, so H "
@@ -640,7 +644,10 @@ def check_existence(plant: Plant) -> ExistenceReport:
        unobservable modes are the fixed observer poles; they are exactly the
        invariant zeros of 2.
     4. **observability** of that pair (information): every pole can be placed.
-    5. **E full column rank** (information): the unknown input can be
+    5. **well-conditioned decoupling** (information): how much a UIO must
+       amplify the data's round-off, ``||E|| ||C|| / sigma_min(C E)`` at least
+       (see ``conditioning_condition``).
+    6. **E full column rank** (information): the unknown input can be
        reconstructed uniquely from the state estimate.
 
     Every decision is made on the plant in balanced units

@@ -179,7 +179,7 @@ class Param:
 
     @property
     def help(self) -> str:
-        """The one-line help: :attr:`doc`, and the unit in brackets."""
+        """The one-line help, :attr:`doc` and the unit in brackets."""
         return f"{self.doc} [{self.unit}]" if self.unit else self.doc
 
 
@@ -252,7 +252,7 @@ def experiment_params(experiment: Any) -> tuple[tuple[str, Param], ...]:
 MAX_SEED = 2**32 - 1
 """The largest seed (numpy's legacy seeds and most tools take 32 bits)."""
 MAX_SAMPLES = 200_000
-"""The most time points of a continuous-time run (3 states: a few MB per signal)."""
+"""The most time points of a continuous-time run (3 states, a few MB per signal)."""
 MAX_STEPS = 100_000
 """The most steps of the discrete-time case study."""
 MAX_DURATION = 10_000.0

@@ -416,7 +416,8 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
     count = plant.m if kind == "actuator" else plant.p
     if count < 2:
         what = "actuators (columns of B)" if kind == "actuator" else "sensors (rows of C)"
-        raise ValueError(f"a {kind} bank needs at least 2 {what}; the plant has {count}")
+        article = "an" if kind == "actuator" else "a"
+        raise ValueError(f"{article} {kind} bank needs at least 2 {what}; the plant has {count}")
     members = []
     for i in range(count):
         if kind == "actuator":

@@ -15,10 +15,14 @@ invariant zeros, the fixed modes) is made by one rule:
   of numbers of size ``||C|| ||E||``; judged against its own tiny norm it would
   look like a full-rank matrix.
 * **Relative to the data's precision.** ``eps`` is the double precision
-  (``2.2e-16``); data known to fewer digits can pass ``rtol`` (e.g. ``1e-4``
+  (``2.2e-16``) in :func:`rank` and ``rank_decision``; the course's verdicts
+  give it room for the rounding of the computation that made ``M``
+  (:mod:`uio_teach.tolerances`: ``RANK_RTOL * eps``, times ``n`` for ``C E``,
+  in the rank condition, ``STAIRCASE_RTOL * eps`` in the observability
+  staircase). Data known to fewer digits can pass ``rtol`` (e.g. ``1e-4``
   for a matrix printed with four decimals) to ``rank_decision``.
 * **Marginal verdicts say so.** A kept singular value less than
-  ``MARGIN`` times the threshold means that the verdict hangs on round-off:
+  ``MARGIN`` (``RANK_MARGIN``) times the threshold means that the verdict hangs on round-off:
   ``rank_decision`` returns the ratio ``s / threshold`` as ``margin`` and
   ``marginal=True``; the existence report then states the verdict *and* the
   margin instead of guessing.
@@ -28,7 +32,8 @@ invariant zeros, the fixed modes) is made by one rule:
 * **Computed designs are verified** (``uio_teach.verify``): the obtained
   poles against the requested ones with a tolerance that grows with the
   eigenvalue condition numbers, and the decoupling identities ``T E = 0``,
-  ``H C E = E``, ``L D = 0`` against ``1e-8`` relative to the factors.
+  ``H C E = E``, ``H D = 0``, ``L D = 0`` against ``IDENTITY_RTOL = 1e-8``
+  relative to the factors.
 """
 
 from __future__ import annotations
@@ -282,7 +287,7 @@ class ObservabilitySplit(NamedTuple):
     @property
     def marginal(self) -> bool:
         """True when a rank decision of the staircase sat within ``MARGIN`` of round-off."""
-        return bool(self.margin < MARGIN)
+        return bool(self.margin < tols.RANK_MARGIN)
 
     @property
     def unobservable_modes(self) -> np.ndarray:

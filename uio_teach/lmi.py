@@ -164,7 +164,8 @@ def lmi_gain(
         minimum decay rate (decay >= 0).
     solver : str, optional
         An installed cvxpy solver (e.g. ``"CLARABEL"``, ``"SCS"``). By default
-        Clarabel, then SCS when Clarabel's answer is inaccurate or fails.
+        Clarabel, then SCS when Clarabel returns no accurate solution (it fails,
+        is inaccurate or reports infeasibility).
     fixed_modes : array_like, optional
         The modes no gain can move, when known (the designs pass the
         invariant zeros); by default the unobservable modes of the balanced
@@ -200,6 +201,10 @@ def lmi_gain(
     least ``STRICT_MARGIN = 1e-9`` (relative) inside the stability region. A
     solution on the boundary (the LMI in discrete time is non-strict) is
     solved again with ``... <= -0.01 I``.
+    **When the solver fails.** A gain placed by pole placement that meets the
+    bound, with its Lyapunov certificate (a solution of the LMI), is returned
+    instead; only when there is none is the failure raised
+    (``LMIUndecidedError``, an ``LMISolverError``) or the infeasibility.
 
     Examples
     --------

@@ -17,9 +17,11 @@ Drawing code only; the numbers come from :func:`uio_teach.simulate` and
 
 Conventions that make the figures say only true things:
 
-* units: the course's models (PA9, the case study, the missile paper) give no physical
-  units, so state, input and disturbance axes say "(model units)"; the time axis says
-  "time (s)" for continuous time and "step k" for a discrete-time plant counted in steps;
+* units: PA9, the case study and the missile paper give no physical units, so the standard
+  figures' state, input and disturbance axes say "(model units)" (a figure of a plant with
+  units, such as the quadruple tank's pump panel, names them with :func:`with_unit`); the
+  time axis says "time (s)" for continuous time and "step k" for a discrete-time plant
+  counted in steps;
 * colours and line styles: the course's cycle (:data:`COLORS`, the Okabe-Ito palette, safe for
   readers with any of the three dichromacies) and a line style per channel
   (:data:`LINESTYLES`), so that no two curves of a panel differ by hue alone; channel ``i``
@@ -92,12 +94,13 @@ LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2)), (0, (1
 and for a reader who sees two of the colours as one."""
 
 UNIT = "model units"
-"""The unit of states, inputs and disturbances: the course's models give no physical units."""
+"""The unit of states, inputs and disturbances in the standard figures (PA9, the case study and
+the missile paper give no physical units)."""
 
 FIGURE_WIDTH = 9.0
-"""Width (inches) of a new figure: drawn at 100 dpi, the book shows it at 688 of its 911 px."""
+"""Width (inches) of a new figure; drawn at 100 dpi, the book shows it at 688 of its 911 px."""
 FONT_SIZE = 11
-"""Font size (points) of legends and notes: about 11.5 px at the book's column width (688 px)."""
+"""Font size (points) of legends and notes, about 11.5 px at the book's column width (688 px)."""
 
 _MIN_SPAN = 1e-3
 """The smallest half-range of a panel, relative to the size of the signals it derives from."""
@@ -890,7 +893,7 @@ def plot_input_estimate(
 # The bank's figure: the members' colours (black is the alarm level), the smallest font size.
 _MEMBER_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 BANK_FONT_SIZE = FONT_SIZE + 1
-"""Font size (points) of every text of :func:`plot_bank_alarms`: about 9 px or more when the
+"""Font size (points) of every text of :func:`plot_bank_alarms`, about 9 px or more when the
 figure is shown at the width of the book's column."""
 
 

@@ -7,8 +7,8 @@ Once the observer's estimate ``xhat`` has converged, the plant equation
 
 which needs ``E`` of full column rank and the derivative of ``xhat``.
 :func:`reconstruct_input` computes it with a numerical derivative or with a
-filtered derivative; :func:`catch_time` reads off, as in Table II of the paper,
-when an estimate has caught the true signal.
+filtered derivative; :func:`catch_time` says when an estimate has caught the true
+signal (what Table II of the paper reads off its figures by eye), with a stated band.
 """
 
 from __future__ import annotations
@@ -314,8 +314,8 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     """When an estimate has caught a signal: the last time the error leaves the tolerance band.
 
     The band is ``tol * max|actual|`` (per channel): the estimate stays within
-    it after the returned time. This is how Table II of the missile paper
-    reads its figures.
+    it after the returned time. Table II of the missile paper reads such times
+    off its figures by eye and states no band; this one makes them precise.
 
     Parameters
     ----------

@@ -1077,14 +1077,17 @@ def _overflow(Az: np.ndarray, plant: Plant, t: np.ndarray, k: int) -> Simulation
     growth = np.log(np.abs(poles)) if discrete else poles.real
     unstable = poles[growth > 0]
     n = plant.n
-    plant_poles = np.linalg.eigvals(Az[:n, :n])
+    # each plant pole names one unstable pole of the joint system; the rest are the observer's
+    # (a pole that both have, e.g. an observer without gain on an unstable mode, is named twice)
+    plant_poles = list(np.linalg.eigvals(Az[:n, :n]))
     words = []
     for pole in sorted(unstable, key=lambda z: -abs(z)):
-        src = (
-            "plant"
-            if np.min(np.abs(plant_poles - pole)) <= tols.MODES_RTOL * max(1, abs(pole))
-            else ("observer")
-        )
+        gaps = [abs(p - pole) for p in plant_poles]
+        if gaps and min(gaps) <= tols.MODES_RTOL * max(1, abs(pole)):
+            plant_poles.pop(int(np.argmin(gaps)))
+            src = "plant"
+        else:
+            src = "observer"
         words.append(f"{format_complex(pole)} ({src})")
     rate = float(np.max(growth)) if growth.size else 0.0
     when = f"t = {t[k]:g}" if k < t.size else "the first step"

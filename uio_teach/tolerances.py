@@ -2,9 +2,10 @@
 
 The algorithms read these names at call time (``tolerances.NAME``), so the one definition here is
 the one in use; ``tests/test_tolerances.py`` pins each from both sides (a value a hundred times
-looser or tighter fails a named test). Relative tolerances are relative to the size of the data
-they judge, never absolute: a verdict does not change when time, states, inputs or outputs are
-measured in other units.
+looser or tighter fails a named test). The relative tolerances (``*_RTOL``, the margins) are
+relative to the size of the data they judge: a verdict of the algorithms does not change when
+time, states, inputs or outputs are measured in other units. ``CHECK_ZERO_ATOL`` alone is
+absolute: the lab checks judge the course's own plants, whose numbers are of order 1.
 
 Examples
 --------
@@ -20,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 EPS = float(np.finfo(float).eps)
-"""Double precision, ``2.2e-16``: the relative rounding of every stored number."""
+"""The relative rounding of every stored number (double precision, ``2.2e-16``)."""
 
 # ranks ------------------------------------------------------------------------------------------
 
@@ -50,7 +51,7 @@ is backward stable with a constant of that order). A zero is decided when no pla
 has a zero on the stability boundary."""
 
 STABILITY_MARGIN = 1e-9
-"""``is_stable``: a value counts as stable when it lies inside the region by at least this
+"""A value counts as stable (``is_stable``) when it lies inside the region by at least this
 fraction of its own size (``Re z < -STABILITY_MARGIN |z|``, ``|z| < 1 - STABILITY_MARGIN``), a
 margin relative to the value, so it is the same in any unit of time. Also the margin of a gain
 the LMI certifies."""
@@ -110,7 +111,7 @@ AMPLIFICATION_LIMIT = 1e6
 of a leak."""
 
 GAIN_EXACT_RTOL = 1e-9
-"""An explicit gain with ``L D`` below this fraction of its largest entry meets ``L D = 0``: it
+"""An explicit gain with ``L D`` below this fraction of its largest entry meets ``L D = 0``; it
 is taken as it is (the rounding of a gain computed in double precision)."""
 
 GAIN_ROUNDED_RTOL = 1e-3

@@ -344,7 +344,7 @@ class ExplorerFigure:
 
     @property
     def rows(self) -> list[str]:
-        """The kinds of curve, one row of panels each: error, residual (and input)."""
+        """The kinds of curve, one row of panels each (error, residual, and input)."""
         return ["error", "residual"] + (["input"] if self.scenario.reconstruct else [])
 
     def _layout(self, figsize: tuple[float, float] | None, dpi: float) -> None:

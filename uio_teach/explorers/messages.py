@@ -115,7 +115,7 @@ class ErrorVerdict:
             start=float(size[0]),
             end=float(size[-1]),
             peak=float(size.max()),
-            rounding=ROUNDING * max(float(scale), 0.0),
+            rounding=tols.ROUNDING_RTOL * max(float(scale), 0.0),
         )
 
     @property

@@ -51,13 +51,13 @@ DISTURBANCES = ("sinusoid", "piecewise constant", "damped sinusoid", "random ste
 """The disturbance types an explorer offers."""
 
 FAMILIES = {"uio": "UIO", "pmo": "PMO", "ginverse": "g-inverse observer"}
-"""Observer families (argument value: display name)."""
+"""Observer families, each argument value with its display name."""
 
 STARTS = {
     "zero estimate": "the estimate starts at zero, so the first error is the state itself",
     "zero observer state": "the observer's own state starts at zero",
 }
-"""Where the observers start (control value: what it means).
+"""Where the observers start, each control value with what it means.
 
 ``"zero estimate"`` (the default) starts both observers at ``xhat(0) = 0``: the
 initial error ``e(0) = x(0)`` then reaches every mode of the error dynamics that
@@ -323,7 +323,7 @@ class Scenario:
 
     @property
     def fixed_poles(self) -> np.ndarray:
-        """The observer poles no gain moves: the invariant zeros."""
+        """The observer poles no gain moves (the invariant zeros)."""
         return self.existence.fixed_modes
 
     @property
@@ -333,7 +333,8 @@ class Scenario:
 
     @property
     def static_plant_control(self) -> PlantControl | None:
-        """The plant control the static book's slider moves (``None``: a pole or the amplitude)."""
+        """The plant control the static book's slider moves (``None`` for a pole or
+        the amplitude)."""
         if not self.static_control.startswith("plant:"):
             return None
         name = self.static_control.split(":", 1)[1]

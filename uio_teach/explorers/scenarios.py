@@ -60,13 +60,28 @@ def scenario_of(name: str, **plant_values: float) -> Scenario:
     -------
     Scenario
 
+    Raises
+    ------
+    uio_teach.worked.RegistryError
+        An unknown worked example (the message lists the known ones), or a
+        value for a field its experiment does not have.
+
     Examples
     --------
     >>> from uio_teach.explorers.scenarios import scenario_of
     >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
     False
     """
-    return WORKED[name].make_scenario(**plant_values)
+    return _entry(name).make_scenario(**plant_values)
+
+
+def _entry(name: str):
+    """The registry entry of a worked example, or a RegistryError naming the known ones."""
+    if name not in WORKED:
+        raise RegistryError(
+            f"no worked example {name!r}; the worked examples are {', '.join(WORKED)}"
+        )
+    return WORKED[name]
 
 
 def _range(experiment: Any, control: str) -> tuple[float, float]:
@@ -150,8 +165,13 @@ def make_scenario(
     Continuous time: the default movable poles are ``-s, -1.5 s, -2 s, ...``
     with ``s`` the largest of 1, the plant's fastest mode and the fixed
     poles' moduli; the window lasts 8 time constants of the slowest observer
-    pole (1001 samples). Discrete time: poles ``0.5, 0.4, 0.3, ...`` and
-    enough steps for the slowest pole to decay to 0.1 %. The disturbance
+    pole (1001 samples; shorter when a lightly damped pair would otherwise get
+    too few samples a period). Discrete time: poles ``0.5, 0.4, 0.3, ...`` and
+    enough steps (30 to 300) for the slowest pole to shrink the error a
+    thousandfold. A candidate pole next to a fixed pole is skipped (the case
+    study starts at 0.4, beside its fixed poles at 0.5); see
+    ``uio_teach.explorers.model.default_poles`` and
+    ``default_timepts``. The disturbance
     starts as a sinusoid with three periods in the window.
 
     Parameters
@@ -192,6 +212,8 @@ def make_scenario(
     >>> s = make_scenario(ut.examples.pa9(), "pmo")
     >>> s.defaults.poles, round(float(s.timepts[-1]), 3)
     ((-2.0, -3.0, -4.0), 4.0)
+    >>> make_scenario(ut.examples.dt_case_study(), "pmo").defaults.poles
+    (0.4,)
     """
     if not isinstance(plant, Plant):
         raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
@@ -282,8 +304,9 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     Raises
     ------
     uio_teach.worked.RegistryError
-        A value for a field the experiment does not have, or an option that
-        a declared field already sets (the range of a control given twice).
+        An unknown worked example, a value for a field the experiment does not
+        have, or an option that a declared field already sets (the range of a
+        control given twice).
 
     Examples
     --------
@@ -292,7 +315,7 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
     >>> s.existence.ok, [c.value for c in s.plant_controls]
     (False, [0.43, 0.34])
     """
-    entry = WORKED[name]
+    entry = _entry(name)
     opts = entry.explorer
     run = entry.run()
     fields = {f for f, spec in experiment_params(run) if spec.range and not spec.control}

@@ -511,11 +511,11 @@ NARROW_PX = 700
 """At this width (CSS pixels) or less (a phone), the controls stack and the phone pictures show."""
 
 WIDE_FONTSCALE = 1.5
-"""Font scale of the wide pictures: drawn 1296 px wide and shown 688 px wide in the book's column
+"""Font scale of the wide pictures, drawn 1296 px wide and shown 688 px wide in the book's column
 on a desktop, their smallest text (legends and ticks, 7 pt times this scale) is 11.1 CSS px."""
 
 NARROW_FONTSCALE = 1.25
-"""Font scale of the phone pictures: 4.4 inches shown 330 px wide or more keep text >= 9 px."""
+"""Font scale of the phone pictures (4.4 inches shown 330 px wide or more keep text >= 9 px)."""
 
 NARROW_DPI = 136
 """Resolution of the phone pictures (about 1.6 times the CSS pixels of a phone's column)."""

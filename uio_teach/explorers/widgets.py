@@ -811,6 +811,11 @@ def worked_explorer(name: str, *, static: bool = True, drag: bool | None = None)
     -------
     Explorer
 
+    Raises
+    ------
+    uio_teach.worked.RegistryError
+        An unknown worked example (the message lists the known ones).
+
     Examples
     --------
     >>> from uio_teach.explorers import widgets

@@ -40,11 +40,11 @@ PACKAGED_COURSE = Path(__file__).resolve().parents[1] / "_course"
 _DIRECTIVE = re.compile(r"^(?P<fence>`{3,}|:{3,})\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*?)\s*$")
 _OPTION = re.compile(r"^:(?P<key>[\w-]+):[ \t]*(?P<value>.*?)\s*$")
 HEADING = re.compile(r"^(?P<hashes>#{1,6})[ \t]+(?P<text>.*?)\s*#*\s*$")
-"""A Markdown heading line: groups ``hashes`` (its level) and ``text``."""
+"""A Markdown heading line, with groups ``hashes`` (its level) and ``text``."""
 TARGET = re.compile(r"^\((?P<label>[^)\s]+)\)=\s*$")
-"""A MyST target line, ``(label)=``: group ``label``."""
+"""A MyST target line, ``(label)=``, with group ``label``."""
 LABELLED_MATH = re.compile(r"\$\$(?P<body>.+?)\$\$[ \t]*\((?P<label>[\w:.-]+)\)", re.DOTALL)
-"""A labelled display equation, ``$$ ... $$ (label)``: groups ``body`` and ``label``."""
+"""A labelled display equation, ``$$ ... $$ (label)``, with groups ``body`` and ``label``."""
 
 
 def fence_states(lines: Sequence[str]) -> list[bool]:

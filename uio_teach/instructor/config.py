@@ -716,8 +716,8 @@ def _observer_keys(worked: Mapping[str, Any]) -> dict[str, str]:
 
 
 OBSERVER_KEYS: Mapping[str, str] = RegistryView("OBSERVER_KEYS", _observer_keys)
-"""The keys that set an observer's poles, and the worked example each belongs to: the
-``poles`` field of each experiment of :data:`uio_teach.worked.WORKED`."""
+"""The keys that set an observer's poles, and the worked example each belongs to (the
+``poles`` field of each experiment of :data:`uio_teach.worked.WORKED`)."""
 
 
 def design_observer(cfg: Mapping[str, Any], key: str) -> Any:

@@ -80,7 +80,7 @@ class GInverseObserver(Observer):
 
     @property
     def projection(self) -> np.ndarray:
-        """``Pc = I - C^g C``: the orthogonal projection onto the unmeasured directions."""
+        """The orthogonal projection ``Pc = I - C^g C`` onto the unmeasured directions."""
         return self._Pc
 
     @property
@@ -90,7 +90,8 @@ class GInverseObserver(Observer):
 
     @property
     def Kg(self) -> np.ndarray:
-        """``Pc E (CE)^g + Kv (I - CE (CE)^g)``: the gain of condition (20), the paper's ``K``."""
+        """The gain ``Kg = Pc E (CE)^g + Kv (I - CE (CE)^g)`` of condition (20), the
+        paper's ``K``."""
         return self._Kg
 
     @property
@@ -110,7 +111,7 @@ class GInverseObserver(Observer):
 
     @property
     def Fv(self) -> np.ndarray:
-        """``Av - Kv Cv``: the observer-state matrix of eq. (21).
+        """The observer-state matrix ``Av - Kv Cv`` of eq. (21).
 
         Not the error matrix (``error_matrix``): it has ``rank(C)`` more eigenvalues, at 0.
         """
@@ -118,7 +119,8 @@ class GInverseObserver(Observer):
 
     @property
     def error_matrix(self) -> np.ndarray:
-        """``(Pc - Pc Kg C) A Pc``: ``e' = error_matrix e``, with ``e`` in range(Pc)."""
+        """The error dynamics ``e' = error_matrix e`` (``e`` in range(Pc)),
+        ``(Pc - Pc Kg C) A Pc``."""
         return self._Ae
 
     def poles(self) -> np.ndarray:
@@ -204,11 +206,17 @@ def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     ValueError
         The plant has a measurement disturbance, ``C`` is rank deficient, or
         ``Kv`` has the wrong shape.
-    ValueError
-        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
-        computed design fails its own check, because the poles obtained differ
-        from those requested beyond the tolerance or a decoupling identity
-        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+    PlacementAccuracyError
+        A ``ValueError``: the computed design fails its own check. The identity
+        ``(Pc - Pc Kg C) E = 0`` holds only to more than round-off, a fixed
+        mode is not an error pole, or the returned matrices let the unknown
+        input reach the error (``uio_teach.verify.DecouplingError``).
+
+    Warns
+    -----
+    DecouplingWarning
+        ``uio_teach.verify.DecouplingWarning``: the design decouples only to a
+        stated fraction, because it amplifies round-off (a small ``C E``).
 
     Examples
     --------

@@ -45,7 +45,7 @@ class LuenbergerObserver(Observer):
 
     @property
     def F(self) -> np.ndarray:
-        """``A - L C``: the error dynamics without unknown inputs."""
+        """The error dynamics ``A - L C`` (without unknown inputs)."""
         return self._F
 
     @property
@@ -82,10 +82,18 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     Raises
     ------
     ValueError
-        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
-        computed design fails its own check, because the poles obtained differ
-        from those requested beyond the tolerance or a decoupling identity
-        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+        Neither or both of ``poles`` and ``L`` given, a wrong number of poles,
+        or ``L`` of the wrong shape.
+    PlacementAccuracyError
+        A ``ValueError``: the poles of ``A - L C`` obtained differ from those
+        requested beyond the tolerance.
+
+    Warns
+    -----
+    UnstableObserverWarning
+        If the chosen poles or ``L`` leave the error dynamics unstable.
+    PlacementAccuracyWarning
+        The poles obtained are slightly off, more than round-off allows.
 
     Examples
     --------

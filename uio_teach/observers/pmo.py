@@ -62,12 +62,12 @@ class PMO(ProjectionObserver):
 
     @property
     def M(self) -> np.ndarray:
-        """``E (CE)^g + Mv (I - CE (CE)^g)`` (with ``D``: ``[E 0][CE D]^+``)."""
+        """The matrix ``M = E (CE)^g + Mv (I - CE (CE)^g)`` (with ``D``, ``M = [E 0][CE D]^+``)."""
         return self._H
 
     @property
     def projection(self) -> np.ndarray:
-        """``I - M C``: an oblique projection that annihilates ``E``."""
+        """The oblique projection ``I - M C``, which annihilates ``E``."""
         return self._T
 
     @property
@@ -82,12 +82,12 @@ class PMO(ProjectionObserver):
 
     @property
     def F(self) -> np.ndarray:
-        """``A1 - L C``: the error dynamics."""
+        """The error dynamics ``F = A1 - L C``."""
         return self._F
 
     @property
     def G(self) -> np.ndarray:
-        """``(I - MC) A M + L - L C M``: the measurement gain of eq. (13)."""
+        """The measurement gain ``G = (I - MC) A M + L - L C M`` of eq. (13)."""
         return read_only(self._K1 + self._K2)
 
 
@@ -135,13 +135,17 @@ def design_pmo(
         A condition of :func:`check_existence` fails.
     LMIInfeasibleError
         ``method="lmi"`` and the LMI has no solution.
+    LMISolverError
+        ``method="lmi"`` and the solver failed (see :func:`lmi_gain`).
     ValueError
         Inconsistent arguments, wrong pole count or shapes.
-    ValueError
-        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
-        computed design fails its own check, because the poles obtained differ
-        from those requested beyond the tolerance or a decoupling identity
-        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+    PlacementAccuracyError
+        A ``ValueError``: the computed design fails its own check. The poles
+        obtained differ from those requested beyond the tolerance, a fixed mode
+        is not an error pole, a decoupling identity (``H C E = E``,
+        ``T E = 0``; with ``D`` also ``H D = 0``, ``L D = 0``) holds only to
+        more than round-off, or the returned matrices let the unknown input
+        reach the error (``uio_teach.verify.DecouplingError``).
 
     Warns
     -----
@@ -149,6 +153,9 @@ def design_pmo(
         If the error dynamics are unstable.
     PlacementAccuracyWarning
         The poles obtained are slightly off, more than round-off allows.
+    DecouplingWarning
+        ``uio_teach.verify.DecouplingWarning``: the design decouples only to a
+        stated fraction, because it amplifies round-off (a small ``C E``).
 
     Examples
     --------

@@ -64,7 +64,7 @@ class UIO(ProjectionObserver):
 
     @property
     def F(self) -> np.ndarray:
-        """``T A - K1 C``: the error dynamics ``e' = F e``."""
+        """The error dynamics ``e' = F e``, with ``F = T A - K1 C``."""
         return self._F
 
 
@@ -100,11 +100,13 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
     ValueError
         Neither or both of ``poles`` and ``K1`` given, a wrong number of
         poles, or ``K1`` of the wrong shape.
-    ValueError
-        ``uio_teach.verify.PlacementAccuracyError`` (a ``ValueError``): the
-        computed design fails its own check, because the poles obtained differ
-        from those requested beyond the tolerance or a decoupling identity
-        (``T E = 0``, ``H C E = E``, ``L D = 0``) is lost to round-off.
+    PlacementAccuracyError
+        A ``ValueError``: the computed design fails its own check. The poles
+        obtained differ from those requested beyond the tolerance, a fixed mode
+        is not an error pole, a decoupling identity (``H C E = E``,
+        ``T E = 0``; with ``D`` also ``H D = 0``, ``L D = 0``) holds only to
+        more than round-off, or the returned matrices let the unknown input
+        reach the error (``uio_teach.verify.DecouplingError``).
 
     Warns
     -----
@@ -112,6 +114,9 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
         If the chosen poles or ``K1`` leave the error dynamics unstable.
     PlacementAccuracyWarning
         The poles obtained are slightly off, more than round-off allows.
+    DecouplingWarning
+        ``uio_teach.verify.DecouplingWarning``: the design decouples only to a
+        stated fraction, because it amplifies round-off (a small ``C E``).
 
     Examples
     --------
