@@ -457,7 +457,8 @@ def test_every_control_has_a_label_and_the_picture_is_put_in_words(make):
         assert not unnamed, f"{make}: controls without a label: {unnamed}"
         before = ex.words.value
         assert 'role="status"' in before and 'aria-live="polite"' in before, before
-        assert "explorer at observer poles" in before and "error" in before, before
+        assert "explorer, " in before and "at observer poles = " in before, before
+        assert "error" in before, before
         ex.set(**{"amplitude": 0.0})  # no disturbance: the Luenberger error decays too
         assert ex.words.value != before
         assert ex.words in ex.widget.children

@@ -65,6 +65,7 @@ __all__ = [
     "plot_error",
     "plot_residual",
     "plot_channels",
+    "line_look",
     "finish_panel",
     "new_figure",
     "symbol",
@@ -632,6 +633,8 @@ def how_it_ends(
     'decays to zero (below 2% of its peak from t = 3.92 s on)'
     >>> how_it_ends(t, np.sin(t))
     'does not settle on zero: at the end it is still 54% of its peak'
+    >>> how_it_ends(t, [np.exp(-t), 0.1 * np.exp(-t)])
+    'decays to zero (every channel below 2% of the largest peak from t = 3.92 s on)'
     """
     t = np.asarray(t, dtype=float)
     values = np.atleast_2d(np.asarray(values, dtype=float))
@@ -645,10 +648,23 @@ def how_it_ends(
         return "is zero to rounding throughout"
     above = np.flatnonzero(worst > _SETTLED * peak)
     last = int(above[-1]) if above.size else -1
+    # one signal: "its peak"; several: all of them against the largest peak of any
+    many = values.shape[0] > 1
     if last + 1 >= worst.size or worst.size - last < max(2, worst.size // 20):
         share = float(worst[-max(1, worst.size // 10) :].max()) / peak
+        if many:
+            return (
+                "does not settle on zero: at the end its largest channel is still "
+                f"{share:.0%} of the largest peak"
+            )
         return f"does not settle on zero: at the end it is still {share:.0%} of its peak"
-    return f"decays to zero (below {_SETTLED:.0%} of its peak from {_when(t[last + 1], dt)} on)"
+    when = _when(t[last + 1], dt)
+    if many:
+        return (
+            f"decays to zero (every channel below {_SETTLED:.0%} of the largest peak from "
+            f"{when} on)"
+        )
+    return f"decays to zero (below {_SETTLED:.0%} of its peak from {when} on)"
 
 
 def marker_style(i: int, samples: int) -> dict[str, Any]:
@@ -731,6 +747,48 @@ _COLOUR_NAMES = ("blue", "vermillion", "bluish green", "reddish purple", "orange
                  "black")  # fmt: skip
 _STYLE_NAMES = ("solid", "dashed", "dash-dotted", "dotted", "dash-dot-dot", "long-dashed",
                 "densely dotted")  # fmt: skip
+
+
+_OTHER_COLOURS = {"#000000": "black", "#808080": "grey", "#999999": "grey"}
+_DASHES = {"-": "solid", "--": "dashed", "-.": "dash-dotted", ":": "dotted", "None": "no line"}
+
+
+def line_look(line: Any) -> str:
+    """A drawn curve's colour, line style and marker in words, read from the curve itself.
+
+    For the words of a figure: what a reader is told to look for is what was drawn, even
+    when a chapter picks its colours by hand or a style sheet changes the cycle.
+
+    Parameters
+    ----------
+    line : matplotlib.lines.Line2D
+        The curve.
+
+    Returns
+    -------
+    str
+        E.g. ``"blue, solid"`` or ``"vermillion, dashed, squares"``; a colour outside the
+        course's palette is named by its hex code.
+
+    Examples
+    --------
+    >>> from uio_teach.plotting import line_look, new_figure
+    >>> ax = new_figure().subplots()
+    >>> line_look(ax.plot([0, 1], color="#D55E00", ls="--", marker="s")[0])
+    'vermillion, dashed, squares'
+    """
+    from matplotlib.colors import to_hex  # deferred: matplotlib only when drawing
+
+    colour = to_hex(line.get_color()).lower()
+    names = {c.lower(): n for c, n in zip(COLORS, _COLOUR_NAMES, strict=True)}
+    name = names.get(colour) or _OTHER_COLOURS.get(colour, colour)
+    style = line.get_linestyle()
+    words = [name, _DASHES.get(style, "patterned")]
+    marker = line.get_marker()
+    marks = {"o": "circles", "s": "squares", "^": "triangles", "D": "diamonds", "v": "triangles"}
+    if marker not in (None, "None", "", " "):
+        words.append(marks.get(marker, "markers"))
+    return ", ".join(words)
 
 
 def _look(i: int) -> str:
@@ -976,7 +1034,7 @@ def plot_bank_alarms(
     axes = np.atleast_1d(fig.subplots(rows, columns, sharex=True, sharey=True, squeeze=False))
     size = BANK_FONT_SIZE
     handles: dict[str, Any] = {}
-    peaks: dict[str, dict[str, float]] = {name: {} for name in names}
+    peaks: dict[str, dict[str, tuple[float, float | None]]] = {name: {} for name in names}
     for k, name in enumerate(names):
         ax = axes.flat[k]
         colour = 0
@@ -1000,7 +1058,11 @@ def plot_bank_alarms(
                     markersize=5,
                     label=label,
                 )
-                peaks[name][label] = float(np.nanmax((J / th.value)[t >= th.start]))
+                ratio = (J / th.value)[t >= th.start]
+                above = t[t >= th.start][ratio > 1.0]
+                # the peak, and when the alarm ends (None: it lasts to the end of the run)
+                ends = None if not above.size or above[-1] >= t[-1] else float(above[-1])
+                peaks[name][label] = (float(np.nanmax(ratio)), ends)
                 handles.setdefault(label, line)
                 colour += 1
                 start = th.start
@@ -1031,28 +1093,43 @@ def plot_bank_alarms(
         fontsize=size,
         frameon=False,
     )
-    _describe_bank(fig, peaks, fault_time)
+    _describe_bank(fig, peaks, fault_time, len(banks))
     return fig
 
 
 def _describe_bank(
-    fig: Figure, peaks: dict[str, dict[str, float]], fault_time: float | None
+    fig: Figure,
+    peaks: dict[str, dict[str, tuple[float, float | None]]],
+    fault_time: float | None,
+    banks: int = 1,
 ) -> None:
-    """The bank's figure in words: which members raise an alarm in which run."""
+    """The bank's figure in words: which members raise an alarm in which run, and until when."""
+
+    def members(names: list[str]) -> str:
+        return (
+            ("the member" if len(names) == 1 else "the members") + " blind to " + ", ".join(names)
+        )
+
     runs = []
     isolates = True
-    for name, members in peaks.items():
-        loud = [m.removeprefix("blind to ") for m, p in members.items() if p > 1.0]
-        quiet = [m.removeprefix("blind to ") for m, p in members.items() if p <= 1.0]
+    for name, found in peaks.items():
+        loud = [m.removeprefix("blind to ") for m, (p, _) in found.items() if p > 1.0]
+        quiet = [m.removeprefix("blind to ") for m, (p, _) in found.items() if p <= 1.0]
+        brief = [
+            f"{m.removeprefix('blind to ')} falls back below 1 at t = {end:.3g} s"
+            for m, (p, end) in found.items()
+            if p > 1.0 and end is not None
+        ]
         what = "no fault" if name == "no fault" else f"fault: {name}"
         runs.append(
             f"Run {what}: "
-            + (f"alarms from the members blind to {', '.join(loud)}" if loud else "no alarm")
-            + (f"; the members blind to {', '.join(quiet)} stay below 1." if quiet and loud
+            + (f"alarms from {members(loud)}" if loud else "no alarm")
+            + (f" (the one blind to {'; the one blind to '.join(brief)})" if brief else "")
+            + (f"; {members(quiet)} stay{'s' if len(quiet) == 1 else ''} below 1." if quiet and loud
                else ".")
         )  # fmt: skip
         isolates &= quiet == [name] if name != "no fault" else not loud
-    start = f" The faults start at t = {fault_time:g} s." if fault_time is not None else ""
+    start = f" The faults start at t = {fault_time:g} s (a dotted line)." if fault_time else ""
     summary = (
         " In every fault run all members raise an alarm except the one blind to that fault, "
         "which isolates it; with no fault none does."
@@ -1061,8 +1138,12 @@ def _describe_bank(
     )
     alt = (
         "Alarms of the bank of UIOs, one panel per run: each member's evaluation function over "
-        "its threshold (J / threshold, logarithmic axis) against time; a curve above the "
-        "dashed black line at 1 is an alarm." + start + summary
+        "its threshold (J / threshold, logarithmic axis) against time, "
+        + ("the first bank's members solid, the others dashed, " if banks > 1 else "solid, ")
+        + "each member in its own colour and marker; a curve above "
+        "the dashed black line at 1 is an alarm; the grey band at the start is not monitored."
+        + start
+        + summary
     )
     describe(fig, alt, " ".join(runs))
 

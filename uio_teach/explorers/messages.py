@@ -165,6 +165,8 @@ class ErrorVerdict:
         >>> from uio_teach.explorers.messages import ErrorVerdict
         >>> ErrorVerdict(start=1.73, end=1.88, peak=1.88).words()
         'grows from 1.73 to 1.88'
+        >>> ErrorVerdict(start=1.5, end=6.29, peak=7.1).words()
+        'grows from 1.5 to 6.29, peaking at 7.1 on the way'
         >>> ErrorVerdict(start=0.0, end=1e-13, peak=1e-13, rounding=1e-9).words()
         'is zero to rounding'
         >>> ErrorVerdict(start=1.73, end=1.6, peak=1.73).words(stable=False)
@@ -175,8 +177,9 @@ class ErrorVerdict:
             return "overflows"
         if self.zero:
             return "is zero to rounding"
-        if self.grows:
-            return f"grows from {a} to {b}"
+        if self.grows:  # a peak above the end is said: the curve rises and falls back
+            peak = f", peaking at {m} on the way" if self.peak > (1 + TOLERANCE) * self.end else ""
+            return f"grows from {a} to {b}{peak}"
         if self.decays and not stable:
             if self.outgrows_start:
                 return f"rises to {m}, then shrinks to {b} (from {a}) within the window"

@@ -234,19 +234,22 @@ def frame_caption(frame: Frame) -> str:
 
 
 def frame_alt(frame: Frame, label: str, value: str) -> str:
-    """The text alternative of a static frame: what each observer's error does, in a few sentences.
+    """The text alternative of a static frame: its settings, what each error does, its panels.
 
     The words come from the frame's verdicts on the simulated errors, as do the
     messages in the caption and the footer, so the three never disagree. A
     curve that is missing says why in one line: no design, an overflow, or a
-    failed simulation.
+    failed simulation. The first sentence names the disturbance and the main
+    control's value (before the other controls' values); the last ones say what
+    the picture holds: which panel shows what, the guide lines over the error and
+    the marks of the pole map, so that the words stand for the whole picture.
 
     Parameters
     ----------
     frame : Frame
         The frame.
     label, value : str
-        The main control's name and value.
+        The main control's name (other controls' values in brackets after it) and value.
 
     Returns
     -------
@@ -256,11 +259,16 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
     --------
     >>> from uio_teach.explorers import compute_frame, scenario_of
     >>> from uio_teach.explorers.static import frame_alt
-    >>> frame_alt(compute_frame(scenario_of("pa9")), "UIO pole", "-1").split(". ")[1]
+    >>> words = frame_alt(compute_frame(scenario_of("pa9")), "UIO pole 1 (others -2, -3)", "-1")
+    >>> words.split(". ")[0]
+    'PA9 explorer, sinusoid, amplitude 1, frequency 2 rad/s, at UIO pole 1 = -1 (others -2, -3)'
+    >>> words.split(". ")[1]
     'UIO: the error size |e| decays from 1.5 to 1.5e-05'
     """
     sc = frame.scenario
-    parts = [f"{sc.title} explorer at {label} {value}."]
+    name, _, others = label.partition(" (")
+    setting = f"{name} = {value}" + (f" ({others}" if others else "")
+    parts = [f"{sc.title} explorer, {frame.disturbance}, at {setting}."]
     rows = (
         (sc.observer_name, frame.observer, frame.verdict, frame.observer_message, frame.poles),
         (
@@ -281,9 +289,50 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
             parts.append(f"{who}: no curve (the error overflows).")
         else:
             parts.append(f"{who}: no curve (the simulation failed).")
+    marks = []
     if frame.poles.size:
-        parts.append(f"Pole map: {sc.observer_name} poles {format_poles(frame.poles, 3)}.")
+        marks.append(f"{sc.observer_name} poles {format_poles(frame.poles, 3)} (crosses)")
+    if frame.luenberger_poles.size:
+        marks.append(f"Luenberger poles {format_poles(frame.luenberger_poles, 3)} (plus signs)")
+    zeros = np.asarray(sc.invariant_zeros)
+    if zeros.size:
+        marks.append(f"invariant zeros {format_poles(zeros, 3)} (open circles)")
+    if marks:
+        parts.append(f"Pole map: {'; '.join(marks)}.")
+    parts.append(_frame_panels(frame))
     return " ".join(parts)
+
+
+_GUIDE_STYLE = {"certified": "dash-dotted", "rate of slowest moved": "dashed",
+                "rate of slowest fixed": "dotted"}  # fmt: skip
+"""The line style of each guide over ``|e|`` (as ``_figure`` draws them), by its label's start."""
+
+
+def _frame_panels(frame: Frame) -> str:
+    """What a frame's panels show, in a sentence or two (the end of its text alternative)."""
+    sc = frame.scenario
+    plant = sc.plant
+    time = "the step k" if sc.discrete else "time"
+    below = "the residual r" + (
+        f" and the reconstructed unknown input {sc.input_symbol}-hat (the true input a wide grey "
+        "line under it)"
+        if sc.reconstruct
+        else ""
+    )
+    text = (
+        f"Panels: for the {sc.observer_name} and for the Luenberger observer, the size of each "
+        f"of the {plant.n} error channels against {time} on a logarithmic axis, above "
+        f"{below}; then the pole map and the unknown inputs against {time}."
+    )
+    guides = [
+        f"{label} ({style})"
+        for label in frame.guides
+        for start, style in _GUIDE_STYLE.items()
+        if label.startswith(start)
+    ]
+    if guides:
+        text += f" Over the {sc.observer_name}'s error: " + "; ".join(guides) + "."
+    return text
 
 
 def static_explorer(

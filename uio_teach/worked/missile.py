@@ -220,16 +220,23 @@ def _missile_states(runs: Any, name: str, label: str, figs: str) -> Figure:
     )
     fig.suptitle(title)
     size = float(np.max(np.abs(resp.states)))
+    # how far v moves each state: the largest gap to the run without v, against its range
+    gaps = np.max(np.abs(resp.states - free.states), axis=1)
+    spans = np.ptp(np.concatenate([resp.states, free.states], axis=1), axis=1)
+    share = gaps / np.where(spans > 0, spans, 1.0)
     describe(
         fig,
         f"{title}: one panel per state x1 to x4 against time, the state with the unknown "
         "inputs v (vermillion, solid), without them (blue, dashed) and the observer's estimate "
-        "(black, dotted). The unknown inputs move the states far from the run without them, "
-        f"and the estimate follows the state with v: the estimation error "
+        "(black, dotted). The unknown inputs move each state away from the run without them, "
+        f"by up to {share.min():.0%} (x{int(np.argmin(share)) + 1}) to {share.max():.0%} "
+        f"(x{int(np.argmax(share)) + 1}) of the range its panel shows, "
+        "and the estimate follows the state with v: the estimation error "
         f"{how_it_ends(t, resp.error, size, m['plant'].dt)}.",
         " ".join(
             f"x{i + 1}: with v it ends at {resp.states[i, -1]:.3g}, without v at "
-            f"{free.states[i, -1]:.3g}; the error {how_it_ends(t, resp.error[i], size)}."
+            f"{free.states[i, -1]:.3g} (the largest gap {gaps[i]:.3g}); the error "
+            f"{how_it_ends(t, resp.error[i], size)}."
             for i in range(resp.states.shape[0])
         ),
     )
@@ -274,17 +281,21 @@ def _missile_error(runs: Any) -> Figure:
     fig.suptitle("Missile autopilot: estimation error of both observers")
     pmo, gin = m["pmo"]["response"], m["ginverse"]["response"]
     size = float(np.max(np.abs(pmo.states)))
+    dt = m["plant"].dt
+    apart = np.max(np.abs(pmo.error - gin.error), axis=0)
+    when = float(pmo.time[int(np.argmax(apart))])
     describe(
         fig,
         "Missile autopilot: the estimation error e1 to e4 of the PMO (solid) and of the "
-        "g-inverse observer (dashed) against time, one panel per state: "
+        "g-inverse observer (dashed) against time, one panel per state. "
         + "; ".join(
-            f"e{i + 1} {how_it_ends(pmo.time, pmo.error[i], size, m['plant'].dt)}"
+            f"e{i + 1}: the PMO's {how_it_ends(pmo.time, pmo.error[i], size, dt)}, the "
+            f"g-inverse observer's {how_it_ends(gin.time, gin.error[i], size, dt)}"
             for i in range(pmo.error.shape[0])
         )
-        + f". The two observers' errors differ by up to "
-        f"{float(np.max(np.abs(pmo.error - gin.error))):.2g} at the start, errors of up to "
-        f"{float(np.max(np.abs(pmo.error))):.2g}.",
+        + f". The two observers' errors differ most, by {float(apart.max()):.2g}, at "
+        f"t = {when:.2g} s; the PMO's errors reach {float(np.max(np.abs(pmo.error))):.2g}, "
+        f"the g-inverse observer's {float(np.max(np.abs(gin.error))):.2g}.",
     )
     return fig
 
@@ -322,16 +333,28 @@ def _missile_inputs(runs: Any) -> Figure:
         r"$\hat{v} = E^+(\dot{\hat{x}} - A\hat{x})$ (Fig. 4.5-4.6, 4.11-4.12)"
     )
     said = []
-    for i in range(actual.shape[0]):
-        gap = m["pmo"]["inputs"].estimates[i] - actual[i]
+    for i, ax in enumerate(axes):
         scale = float(np.max(np.abs(actual[i])))
-        said.append(f"for v{i + 1} the gap {how_it_ends(t, gap, scale, m['plant'].dt)}")
+        low, high = ax.get_ylim()
+        for name, label in (("pmo", "the PMO's"), ("ginverse", "the g-inverse observer's")):
+            est = m[name]["inputs"].estimates[i]
+            gap = est - actual[i]
+            off = (est < low) | (est > high)
+            start = (
+                f" (it starts off the axis, at {est[0]:.3g}, and re-enters it at "
+                f"t = {t[int(np.argmax(~off))]:.2g} s)"
+                if off[0]
+                else ""
+            )
+            said.append(
+                f"for v{i + 1} {label} gap {how_it_ends(t, gap, scale, m['plant'].dt)}{start}"
+            )
     describe(
         fig,
         "Missile autopilot: the unknown inputs v1 and v2 (wide pale vermillion lines) and their "
         "reconstructions by the PMO (black, solid) and the g-inverse observer (black, dotted) "
-        "against time, one panel per input. After a short start the reconstructions lie on the "
-        "inputs: " + "; ".join(said) + ".",
+        "against time, one panel per input, each axis 1.3 times the input's peak high. After a "
+        "short start the reconstructions lie on the inputs: " + "; ".join(said) + ".",
     )
     return fig
 

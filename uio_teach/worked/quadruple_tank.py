@@ -468,16 +468,36 @@ def _figure_zeros(runs: Any) -> Figure:
     )
     finish_panel(ax, "invariant zero (1/s)")
     ax.set_title("Quadruple tank: the zeros move with the valves and cross 0 at 1")
+    fast, slow = zeros[:, 0], zeros[:, 1]
+    cross = total[int(np.argmax(slow <= 0))]  # the first total where the slower zero is not > 0
     describe(
         fig,
-        "The two invariant zeros of the quadruple tank against gamma1 + gamma2 (valves moved "
-        f"together, gamma2 = {ratio:.3g} gamma1): the faster zero (blue, solid) stays "
-        "negative; the slower one (vermillion, dashed) rises through zero at gamma1 + gamma2 "
-        "= 1 and is positive below it, where no UIO exists (the shaded band). This run's "
+        f"The two invariant zeros (1/s) of the quadruple tank against gamma1 + gamma2 from "
+        f"{total[0]:.2g} to {total[-1]:.2g} (valves moved together, gamma2 = {ratio:.3g} "
+        "gamma1; a dotted vertical line at 1): the faster zero (blue, solid) stays negative, "
+        f"{_on_axis(total, fast, ax.get_ylim())}; the slower one (vermillion, dashed) falls "
+        f"from {slow[0]:.2g} to {slow[-1]:.2g}, through zero at gamma1 + gamma2 = "
+        f"{cross:.2g}, and is positive below it, where no UIO exists (the shaded band), "
+        f"{_on_axis(total, slow, ax.get_ylim())}. This run's "
         f"valves, gamma1 + gamma2 = {here:.3g}, give the zeros {mine[0]:.3g} and "
         f"{mine[1]:.3g} (open circles).",
     )
     return fig
+
+
+def _on_axis(x: np.ndarray, y: np.ndarray, ylim: tuple[float, float]) -> str:
+    """Where a curve is inside the axis' vertical limits, in words (it may leave the picture)."""
+    inside = (y >= ylim[0]) & (y <= ylim[1])
+    if inside.all():
+        return f"from {y[0]:.2g} to {y[-1]:.2g}"
+    if not inside.any():
+        return f"outside the axis ({ylim[0]:.2g} to {ylim[1]:.2g}) throughout"
+    shown = x[inside]
+    return (
+        f"inside the axis ({ylim[0]:.2g} to {ylim[1]:.2g}) only from gamma1 + gamma2 = "
+        f"{shown[0]:.2g} to {shown[-1]:.2g}, beyond the axis elsewhere (from {y.min():.2g} "
+        f"to {y.max():.2g})"
+    )
 
 
 EXAMPLES = (
