@@ -77,6 +77,24 @@ def test_design_accepts_lists_and_any_pole_placement():
     assert any("F not given" in m for m in result.messages)
 
 
+def test_the_poles_asked_for_are_compared_to_the_tolerance_given():
+    # pa9_design's docstring: the eigenvalues of F must be the poles asked for, each to ``tol``
+    obs = ut.design_uio(PLANT, poles=[-1, -2, -3])
+    off = [-1 * (1 + 1e-4), -2, -3]  # one pole 1e-4 relative away from F's
+    strict = checks.pa9_design(obs.H, obs.T, obs.K1, poles=off)
+    loose = checks.pa9_design(obs.H, obs.T, obs.K1, poles=off, tol=1e-3)
+    assert not strict.passed and "asks for" in failures_text(strict)
+    assert loose.passed, str(loose)
+
+
+def test_the_missile_pmo_poles_are_compared_to_the_tolerance_given():
+    plant = ut.examples.missile_autopilot()
+    pmo = ut.design_pmo(plant, poles=[-100, -120])
+    off = [-100 * (1 + 1e-4), -120]
+    assert not checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=off).passed
+    assert checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=off, tol=1e-3).passed
+
+
 def test_any_decoupling_H_is_accepted():
     # H = C^+ also satisfies (I - HC)E = 0 here, since E has no x2 component
     Hc = np.linalg.pinv(C)

@@ -153,7 +153,7 @@ def pa9_design(
     eig = _stable(result, plant, F if F_given else F_ref, F_given)
     if wanted is not None:
         which = "F" if F_given else "F = TA - K1C"
-        _poles_asked(result, eig, wanted, which, plant.A - K1 @ plant.C, F_ref, F_given)
+        _poles_asked(result, eig, wanted, which, plant.A - K1 @ plant.C, F_ref, F_given, tol)
     return result
 
 
@@ -318,20 +318,22 @@ def _poles_asked(
     F_without_T: np.ndarray,
     F_ref: np.ndarray,
     F_given: bool,
+    tol: float,
 ) -> None:
-    """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for, else a ✗ with the cause."""
-    if same_poles(eig, wanted):
+    """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for (each to ``tol``
+    relative), else a ✗ with the cause."""
+    if same_poles(eig, wanted, tol):
         result.add(True, f"{which} has the poles asked for, {format_poles(wanted)}.")
         return
-    if same_poles(np.linalg.eigvals(F_without_T), wanted):
+    if same_poles(np.linalg.eigvals(F_without_T), wanted, tol):
         hint = (
             " Your K1 places the poles of A - K1C, not of TA - K1C: place them for the pair "
             "(TA, C)."
         )
     elif (
         F_given
-        and not same_poles(np.linalg.eigvals(F_ref), eig)
-        and same_poles(np.linalg.eigvals(F_ref), wanted)
+        and not same_poles(np.linalg.eigvals(F_ref), eig, tol)
+        and same_poles(np.linalg.eigvals(F_ref), wanted, tol)
     ):
         hint = " TA - K1C has them, so your F is not TA - K1C (see above)."
     else:
