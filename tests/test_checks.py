@@ -481,3 +481,17 @@ def test_every_check_cell_passes_the_set_up_plant(chapter):
     assert len(calls) >= 5
     assert [c for c in calls if "plant=plant" not in c] == []
     assert all("PARAMS" in c or "poles" not in c for c in calls)
+
+
+def test_a_rounded_projection_matrix_is_named_with_its_decimals_on_a_groups_plant():
+    # the hint names the rounding, not "the printed M": a group's own M is printed nowhere
+    # (the book's M, [[-0.5, 2.5]] in every row, is exact in decimals)
+    plant = ut.experiments.plant_from_params(
+        "case_study", {"plant": {"D": [[0.3], [1.0]], "E": [[2.0], [1.0], [2.0]]}}
+    )
+    B2, D = plant.E, plant.D
+    exact = np.hstack([B2, np.zeros_like(B2)]) @ np.linalg.pinv(np.hstack([plant.C @ B2, D]))
+    for k in (4, 2):
+        result = checks.case_study_projection(np.round(exact, k), plant)
+        assert f"rounded to {k} decimals" in failures_text(result), str(result)
+    assert checks.case_study_projection(exact, plant).passed
