@@ -95,6 +95,15 @@ def test_the_missile_pmo_poles_are_compared_to_the_tolerance_given():
     assert checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=off, tol=1e-3).passed
 
 
+def test_two_decimals_of_a_groups_H_are_not_said_to_be_the_assignments():
+    plant = ut.experiments.plant_from_params(
+        "pa9", {"plant": {"A": A.tolist(), "E": [[2.5], [0.5], [1.0]]}}
+    )
+    exact = plant.E @ np.linalg.pinv(plant.C @ plant.E)
+    text = failures_text(checks.pa9_design(np.round(exact, 2), T, K1, plant=plant))
+    assert "only 2 decimals" in text and "assignment" not in text
+
+
 def test_any_decoupling_H_is_accepted():
     # H = C^+ also satisfies (I - HC)E = 0 here, since E has no x2 component
     Hc = np.linalg.pinv(C)
@@ -114,7 +123,7 @@ def test_printed_two_decimal_matrices_are_explained():
     pub = ut.examples.PA9_PUBLISHED
     result = checks.pa9_design(pub.H, pub.T, pub.K1, pub.F, pub.K2)
     assert not result.passed
-    assert "chopped" in result.failures[0]
+    assert "only 2 decimals, as the assignment prints it" in result.failures[0]
     assert "only 2 decimals" in result.failures[1]
 
 

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import examples
 from .. import tolerances as tols
 from .._display import format_matrix_line, format_poles
 from ..linalg import pinv, sort_poles
@@ -30,6 +31,7 @@ from .common import (
     maxdiff,
     never_raises,
     read_matrix,
+    same_plant,
     same_poles,
     stability,
     up_to,
@@ -167,10 +169,12 @@ def _cancels(result: CheckResult, plant: Any, H: np.ndarray, tol: float) -> None
         result.add(True, f"(I - HC)E = 0{up_to(big, 'largest entry')}: H cancels the disturbance.")
         return
     if looks_two_decimals(H, H_ref):
+        printed = same_plant(plant, examples.pa9())
         hint = (
-            " Your H has the 2 decimals printed in the assignment; those numbers are chopped, "
-            "not exact, so the disturbance is not fully cancelled. Compute H at full precision "
-            "from E and C instead of typing it."
+            " Your H has only 2 decimals"
+            + (", as the assignment prints it" if printed else "")
+            + "; numbers cut or rounded to 2 decimals are not exact, so the disturbance is "
+            "not fully cancelled. Compute H at full precision from E and C instead of typing it."
         )
     elif close(H, -H_ref, tols.CHECK_RTOL):
         hint = " Your H is -E(CE)^+: check the sign."
