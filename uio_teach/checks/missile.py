@@ -7,7 +7,8 @@
 * :func:`missile_reconstruction` -- ``v̂`` of a noise-free run follows ``v``;
 * :func:`missile_catch_times` -- the catch times of Table II, recomputed;
 * :func:`missile_noise` -- the RMS error of ``v̂`` with measurement noise,
-  against the prediction ``sigma rho_i / (sqrt(2) h)``.
+  against the prediction ``sigma beta_i / (sqrt(2) h)`` (``beta_i`` the length of row
+  ``i`` of ``(CE)^+``).
 
 Examples
 --------
