@@ -317,6 +317,18 @@ def test_a_missing_answer_names_the_variable_the_cell_and_a_hint():
     assert all(not r.passed for r in results)
 
 
+def test_the_hint_for_inv_tells_a_singular_matrix_from_one_that_is_not_square():
+    # the missile's CE and the case study's [CB2 D] are square: "not square" would be false there
+    singular = missing_message(Missing("M", 3, "LinAlgError", "Singular matrix"))
+    not_square = missing_message(
+        Missing("H", 4, "LinAlgError", "Last 2 dimensions of the array must be square")
+    )
+    assert "singular matrix" in singular and "not square" not in singular
+    assert "is not square" in not_square and "singular" not in not_square
+    never = missing_message(Missing("H", 2, "NameError", "name 'CE' is not defined"))
+    assert "spelling" in never and "from the top" in never
+
+
 def test_the_graders_own_messages_hold_no_solution_line():
     solution_code = set()
     for lab in GRADED:

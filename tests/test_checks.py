@@ -77,6 +77,33 @@ def test_design_accepts_lists_and_any_pole_placement():
     assert any("F not given" in m for m in result.messages)
 
 
+def test_the_poles_asked_for_are_compared_to_the_tolerance_given():
+    # pa9_design's docstring: the eigenvalues of F must be the poles asked for, each to ``tol``
+    obs = ut.design_uio(PLANT, poles=[-1, -2, -3])
+    off = [-1 * (1 + 1e-4), -2, -3]  # one pole 1e-4 relative away from F's
+    strict = checks.pa9_design(obs.H, obs.T, obs.K1, poles=off)
+    loose = checks.pa9_design(obs.H, obs.T, obs.K1, poles=off, tol=1e-3)
+    assert not strict.passed and "asks for" in failures_text(strict)
+    assert loose.passed, str(loose)
+
+
+def test_the_missile_pmo_poles_are_compared_to_the_tolerance_given():
+    plant = ut.examples.missile_autopilot()
+    pmo = ut.design_pmo(plant, poles=[-100, -120])
+    off = [-100 * (1 + 1e-4), -120]
+    assert not checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=off).passed
+    assert checks.missile_pmo(pmo.M, pmo.L, pmo.F, poles=off, tol=1e-3).passed
+
+
+def test_two_decimals_of_a_groups_H_are_not_said_to_be_the_assignments():
+    plant = ut.experiments.plant_from_params(
+        "pa9", {"plant": {"A": A.tolist(), "E": [[2.5], [0.5], [1.0]]}}
+    )
+    exact = plant.E @ np.linalg.pinv(plant.C @ plant.E)
+    text = failures_text(checks.pa9_design(np.round(exact, 2), T, K1, plant=plant))
+    assert "only 2 decimals" in text and "assignment" not in text
+
+
 def test_any_decoupling_H_is_accepted():
     # H = C^+ also satisfies (I - HC)E = 0 here, since E has no x2 component
     Hc = np.linalg.pinv(C)
@@ -96,7 +123,7 @@ def test_printed_two_decimal_matrices_are_explained():
     pub = ut.examples.PA9_PUBLISHED
     result = checks.pa9_design(pub.H, pub.T, pub.K1, pub.F, pub.K2)
     assert not result.passed
-    assert "chopped" in result.failures[0]
+    assert "only 2 decimals, as the assignment prints it" in result.failures[0]
     assert "only 2 decimals" in result.failures[1]
 
 
@@ -463,3 +490,17 @@ def test_every_check_cell_passes_the_set_up_plant(chapter):
     assert len(calls) >= 5
     assert [c for c in calls if "plant=plant" not in c] == []
     assert all("PARAMS" in c or "poles" not in c for c in calls)
+
+
+def test_a_rounded_projection_matrix_is_named_with_its_decimals_on_a_groups_plant():
+    # the hint names the rounding, not "the printed M": a group's own M is printed nowhere
+    # (the book's M, [[-0.5, 2.5]] in every row, is exact in decimals)
+    plant = ut.experiments.plant_from_params(
+        "case_study", {"plant": {"D": [[0.3], [1.0]], "E": [[2.0], [1.0], [2.0]]}}
+    )
+    B2, D = plant.E, plant.D
+    exact = np.hstack([B2, np.zeros_like(B2)]) @ np.linalg.pinv(np.hstack([plant.C @ B2, D]))
+    for k in (4, 2):
+        result = checks.case_study_projection(np.round(exact, k), plant)
+        assert f"rounded to {k} decimals" in failures_text(result), str(result)
+    assert checks.case_study_projection(exact, plant).passed

@@ -314,6 +314,19 @@ def test_merged_shards_are_what_one_whole_run_writes(tmp_path):
     assert (tmp_path / "merged" / "grades_canvas.csv").is_file()
 
 
+def test_a_pattern_that_also_matches_the_shards_exports_merges_the_gradebooks(tmp_path):
+    # `uio-teach merge marks/grades_*.csv` also picks grades_1_groups.csv, grades_1_canvas.csv
+    files = CLASS[:8]
+    students = {"g01": [("s1", "Ann")]}
+    _book(tmp_path / "whole" / "grades.csv", files, None, students=students)
+    for k in (1, 2):
+        _book(tmp_path / "marks" / f"grades_{k}.csv", files, (k, 2), students=students)
+    matched = sorted((tmp_path / "marks").glob("grades_*.csv"))
+    assert len(matched) == 6  # two gradebooks, each with its two exports
+    merge.merge(matched, tmp_path / "merged" / "grades.csv")
+    assert _tree(tmp_path / "merged") == _tree(tmp_path / "whole")
+
+
 def test_shards_that_do_not_fit_together_are_refused_naming_them(tmp_path):
     files = CLASS[:10]
     one = _book(tmp_path / "a" / "g_1.csv", files, (1, 2))

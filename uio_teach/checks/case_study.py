@@ -114,10 +114,14 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None
     if ok:
         result.add(True, f"(I - MC)B2 = 0{up_to(big, 'largest entry')}: u2 is projected out.")
     else:
-        if close(M, np.round(ref, 4), tols.CHECK_EXACT_RTOL) or close(
-            M, np.round(ref, 2), tols.CHECK_EXACT_RTOL
-        ):
-            hint = " Your M is the printed one, rounded: compute it at full precision."
+        rounded = next(
+            (k for k in (4, 2) if close(M, np.round(ref, k), tols.CHECK_EXACT_RTOL)), None
+        )
+        if rounded is not None:
+            hint = (
+                f" Your M is the right M rounded to {rounded} decimals: compute it at full "
+                "precision instead of typing printed digits."
+            )
         elif close(M, -ref, tols.CHECK_EXACT_RTOL):
             hint = " Your M is -[B2 0][CB2 D]^+: check the sign."
         else:

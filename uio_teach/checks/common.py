@@ -593,7 +593,7 @@ def rerun_without_unknown_inputs(resp: Any, *, keep_v: bool = False) -> tuple[fl
         The largest change of the error ``e``.
     same : bool
         Whether the change is round-off: at most ``tolerances.CHECK_RUN_RTOL`` times the
-        largest state (at least 1).
+        largest state in absolute value, or times 1 when every state stays below 1.
 
     Examples
     --------

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import examples
 from .. import tolerances as tols
 from .._display import format_matrix_line, format_poles
 from ..linalg import pinv, sort_poles
@@ -30,6 +31,7 @@ from .common import (
     maxdiff,
     never_raises,
     read_matrix,
+    same_plant,
     same_poles,
     stability,
     up_to,
@@ -153,7 +155,7 @@ def pa9_design(
     eig = _stable(result, plant, F if F_given else F_ref, F_given)
     if wanted is not None:
         which = "F" if F_given else "F = TA - K1C"
-        _poles_asked(result, eig, wanted, which, plant.A - K1 @ plant.C, F_ref, F_given)
+        _poles_asked(result, eig, wanted, which, plant.A - K1 @ plant.C, F_ref, F_given, tol)
     return result
 
 
@@ -167,10 +169,12 @@ def _cancels(result: CheckResult, plant: Any, H: np.ndarray, tol: float) -> None
         result.add(True, f"(I - HC)E = 0{up_to(big, 'largest entry')}: H cancels the disturbance.")
         return
     if looks_two_decimals(H, H_ref):
+        printed = same_plant(plant, examples.pa9())
         hint = (
-            " Your H has the 2 decimals printed in the assignment; those numbers are chopped, "
-            "not exact, so the disturbance is not fully cancelled. Compute H at full precision "
-            "from E and C instead of typing it."
+            " Your H has only 2 decimals"
+            + (", as the assignment prints it" if printed else "")
+            + "; numbers cut or rounded to 2 decimals are not exact, so the disturbance is "
+            "not fully cancelled. Compute H at full precision from E and C instead of typing it."
         )
     elif close(H, -H_ref, tols.CHECK_RTOL):
         hint = " Your H is -E(CE)^+: check the sign."
@@ -318,20 +322,22 @@ def _poles_asked(
     F_without_T: np.ndarray,
     F_ref: np.ndarray,
     F_given: bool,
+    tol: float,
 ) -> None:
-    """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for, else a ✗ with the cause."""
-    if same_poles(eig, wanted):
+    """A ✓ if the eigenvalues ``eig`` of ``F`` are the poles asked for (each to ``tol``
+    relative), else a ✗ with the cause."""
+    if same_poles(eig, wanted, tol):
         result.add(True, f"{which} has the poles asked for, {format_poles(wanted)}.")
         return
-    if same_poles(np.linalg.eigvals(F_without_T), wanted):
+    if same_poles(np.linalg.eigvals(F_without_T), wanted, tol):
         hint = (
             " Your K1 places the poles of A - K1C, not of TA - K1C: place them for the pair "
             "(TA, C)."
         )
     elif (
         F_given
-        and not same_poles(np.linalg.eigvals(F_ref), eig)
-        and same_poles(np.linalg.eigvals(F_ref), wanted)
+        and not same_poles(np.linalg.eigvals(F_ref), eig, tol)
+        and same_poles(np.linalg.eigvals(F_ref), wanted, tol)
     ):
         hint = " TA - K1C has them, so your F is not TA - K1C (see above)."
     else:

@@ -7,7 +7,8 @@
 * :func:`missile_reconstruction` -- ``v̂`` of a noise-free run follows ``v``;
 * :func:`missile_catch_times` -- the catch times of Table II, recomputed;
 * :func:`missile_noise` -- the RMS error of ``v̂`` with measurement noise,
-  against the prediction ``sigma rho_i / (sqrt(2) h)``.
+  against the prediction ``sigma beta_i / (sqrt(2) h)`` (``beta_i`` the length of row
+  ``i`` of ``(CE)^+``).
 
 Examples
 --------
@@ -145,14 +146,14 @@ def missile_pmo(
     wanted = as_poles(poles)
     fixed = _fixed_poles(plant)
     eig = np.linalg.eigvals(F_ref)
-    if same_poles(eig, np.concatenate([wanted, fixed])):
+    if same_poles(eig, np.concatenate([wanted, fixed]), tol):
         result.add(
             True,
             f"(I - MC)A - LC has the asked poles {format_poles(wanted)} and the fixed pair "
             f"{format_poles(fixed)}.",
         )
     else:
-        moved = same_poles(np.linalg.eigvals(A - L @ C), np.concatenate([wanted, fixed]))
+        moved = same_poles(np.linalg.eigvals(A - L @ C), np.concatenate([wanted, fixed]), tol)
         hint = (
             " L places them for A - LC, not for A1 - LC."
             if moved

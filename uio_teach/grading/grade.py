@@ -512,8 +512,14 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
     params = None if key is None else key.get((lab, group))
     if key is not None and params is None:
         sub.status = "check by hand"
-        why = identity[0] if not group and identity else f"group {group!r} is not in the answer key"
-        sub.reason = f"{why}; not run: name the file <lab>_<group>.ipynb or list it in --roster"
+        if group:
+            sub.reason = (
+                f"group {group!r} of lab {lab!r} is not in the answer key; not run: check the "
+                "group its file name or the roster gives against the key's groups"
+            )
+        else:
+            why = identity[0] if identity else "no group"
+            sub.reason = f"{why}; not run: name the file <lab>_<group>.ipynb or list it in --roster"
         sub.errors.append(sub.reason)
         return
     checks = run.checks[lab]

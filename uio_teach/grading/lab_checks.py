@@ -516,9 +516,17 @@ def setup_namespace(checks: LabChecks, params: Mapping[str, Any]) -> dict[str, A
 _HINTS = (
     (
         "LinAlgError",
-        ("singular", "square"),
-        "np.linalg.inv needs a square, invertible matrix; CE is not square here: a "
-        "generalized inverse (np.linalg.pinv) is what the formula asks for",
+        ("square",),
+        "np.linalg.inv takes only a square matrix, and this one is not square: where a formula "
+        "inverts a matrix that is not square (CE in Practical Assignment 9), it means a "
+        "generalized inverse (np.linalg.pinv)",
+    ),
+    (
+        "LinAlgError",
+        ("singular",),
+        "np.linalg.inv was given a singular matrix, which has no inverse: check how that "
+        "matrix was built, and whether the formula asks for a generalized inverse "
+        "(np.linalg.pinv) instead",
     ),
     (
         "ValueError",
@@ -529,7 +537,9 @@ _HINTS = (
     (
         "NameError",
         ("not defined",),
-        "a name used in that cell was never assigned: run the cells above it, in order",
+        "a name used in that cell is not assigned by any cell above it (the grader runs the "
+        "notebook from the top, in order): check its spelling, or move the cell that assigns "
+        "it above",
     ),
     (
         "TimeoutError",

@@ -39,6 +39,7 @@ from ..instructor.output import MANIFEST, read_manifest, sha256_file, write_mani
 from .gradebook import (
     COMMAND,
     check_gradebook_target,
+    export_path,
     feedback_folder,
     feedback_names,
     file_cell,
@@ -178,6 +179,9 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
     ----------
     gradebooks : sequence of path
         The gradebook CSV of every shard (``--shard 1/N`` ... ``N/N``), in any order.
+        The exports written beside a gradebook given here (``grades_1_groups.csv``,
+        ``grades_1_canvas.csv``, which a pattern such as ``marks/grades_*.csv`` also
+        matches) are left out.
     out : path
         The merged gradebook; its feedback folder and exports go beside it.
 
@@ -218,6 +222,8 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
         raise MergeError("no gradebook to merge")
     out = Path(out)
     paths = [Path(g) for g in gradebooks]
+    exports = {export_path(p, kind).resolve() for p in paths for kind in ("groups", "canvas")}
+    paths = [p for p in paths if p.resolve() not in exports]
     for path in paths:
         if path.resolve() == out.resolve():
             raise MergeError(f"--out {os.fspath(out)} is one of the gradebooks to merge")
