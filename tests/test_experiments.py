@@ -203,3 +203,44 @@ def test_plant_from_params_refuses_bad_input_clearly(lab, params, match):
 
     with pytest.raises(ValueError, match=match):
         plant_from_params(lab, params)
+
+
+def _bounded_fields():
+    from uio_teach.experiments import EXPERIMENTS as ALL
+    from uio_teach.experiments import experiment_params
+
+    for section, exp in sorted(ALL.items()):
+        for name, spec in experiment_params(exp):
+            init = {f.name: f.init for f in dataclasses.fields(exp)}[name]
+            if (
+                init
+                and spec.kind in ("int", "float")
+                and (spec.maximum is not None or spec.minimum is not None or spec.positive)
+            ):
+                yield pytest.param(exp, name, spec, id=f"{section}.{name}")
+
+
+@pytest.mark.parametrize(("exp", "name", "spec"), list(_bounded_fields()))
+def test_a_field_beyond_its_declared_bounds_is_refused_however_the_run_is_made(exp, name, spec):
+    """The term config checks the declared bounds; a run made in code must not slip past them."""
+    from uio_teach.experiments import out_of_bounds
+
+    if spec.maximum is not None:
+        beyond = spec.maximum + max(1.0, abs(spec.maximum)) * 0.5
+    else:
+        beyond = (spec.minimum if spec.minimum is not None else 0.0) - 1.0
+    if spec.kind == "int":
+        beyond = int(np.ceil(beyond)) if spec.maximum is not None else int(np.floor(beyond))
+    assert out_of_bounds(spec, beyond) is not None
+    with pytest.raises(ValueError, match=rf"{name} .* must be"):
+        exp.with_values(**{name: beyond})
+
+
+def test_bounds_are_written_in_full():
+    from uio_teach.experiments import Param, out_of_bounds
+
+    seed = Param("int", "the seed", minimum=0, maximum=2**32 - 1)
+    assert out_of_bounds(seed, 2**32) == "must be <= 4294967295, got 4294967296"
+    valve = Param("float", "a valve", minimum=0.0, maximum=0.99)
+    assert out_of_bounds(valve, 0.995) == "must be <= 0.99, got 0.995"
+    assert out_of_bounds(valve, 0.99) is None and out_of_bounds(valve, 0.0) is None

@@ -183,6 +183,69 @@ class Param:
         return f"{self.doc} [{self.unit}]" if self.unit else self.doc
 
 
+def number_text(x: float) -> str:
+    """A bound or value as a person reads it: a whole number in full, others as Python prints them.
+
+    Parameters
+    ----------
+    x : float
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import number_text
+    >>> number_text(2**32), number_text(0.99), number_text(4294967295.0), number_text(1e-9)
+    ('4294967296', '0.99', '4294967295', '1e-09')
+    """
+    x = float(x)
+    if x.is_integer() and abs(x) < 1e15:
+        return str(int(x))
+    return repr(x)
+
+
+def out_of_bounds(spec: Any, x: float) -> str | None:
+    """What a number breaks of a field's declared bounds, or ``None`` when it keeps them.
+
+    Parameters
+    ----------
+    spec : Param or ConfigKey
+        The field's declaration (its ``kind``, ``minimum``, ``maximum`` and
+        ``positive``, as :class:`Param` has them).
+    x : float
+        The value.
+
+    Returns
+    -------
+    str or None
+        ``"must be <= 0.99, got 0.995"`` and the like.
+
+    Examples
+    --------
+    >>> from uio_teach.experiments import experiment_params, out_of_bounds
+    >>> from uio_teach.worked.quadruple_tank import QUADRUPLE_TANK
+    >>> spec = dict(experiment_params(QUADRUPLE_TANK))["gamma1"]
+    >>> out_of_bounds(spec, 0.995), out_of_bounds(spec, 0.5)
+    ('must be <= 0.99, got 0.995', None)
+    """
+    if spec.positive and x <= 0:
+        return f"must be > 0, got {number_text(x)}"
+    if spec.minimum is not None and x < spec.minimum:
+        return f"must be >= {number_text(spec.minimum)}, got {number_text(x)}"
+    if spec.maximum is not None:
+        if spec.kind == "int" or spec.minimum is not None or spec.positive:
+            if x > spec.maximum:
+                return f"must be <= {number_text(spec.maximum)}, got {number_text(x)}"
+        elif abs(x) > spec.maximum:
+            return (
+                f"must be between -{number_text(spec.maximum)} and "
+                f"{number_text(spec.maximum)}, got {number_text(x)}"
+            )
+    return None
+
+
 def param(default: Any, kind: str, doc: str, **options: Any) -> Any:
     """An experiment field declared with its :class:`Param` (a ``dataclasses.field``).
 
@@ -385,6 +448,14 @@ class Experiment:
         object.__setattr__(self, "duration", float(self.timepts[-1]))
         object.__setattr__(self, "samples", int(self.timepts.size))
         object.__setattr__(self, "matrices", _matrices(self.matrices))
+        # a value beyond its declared bounds is refused however the experiment is made (the
+        # config checks the same bounds, naming its key)
+        for name, spec in experiment_params(self):
+            value = getattr(self, name)
+            if spec.kind in ("int", "float") and value is not None:
+                problem = out_of_bounds(spec, float(value))
+                if problem is not None:
+                    raise ValueError(f"{type(self).__name__}: {name} ({spec.doc}) {problem}")
 
     # the plant and the time grid ----------------------------------------------------------------
     def plant(self) -> Plant:

@@ -57,8 +57,10 @@ CAPS = {
     "string": 20_000,
     "items": 200_000,
 }
-"""The largest answer graded: entries of one array and of all arrays of an answer, axes of a
-figure, lines of an axes, characters of a string, items of a list (far above any lab's answer)."""
+"""The largest answer graded, far above any lab's answer.
+
+The keys name what is counted: entries of one array and of all arrays of an answer, axes of a
+figure, lines of an axes, characters of a string, items of a list."""
 _TAG = "__uio__"
 
 

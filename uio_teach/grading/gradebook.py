@@ -375,8 +375,8 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
 
 
 MAX_NAME_BYTES = 200
-"""The longest stem of a feedback file, in bytes: with its suffix and the temporary name it is
-written under (``.<name>.html.part``), within the 255 bytes a file name may have."""
+"""The longest stem of a feedback file, in bytes. With its suffix and the temporary name it is
+written under (``.<name>.html.part``), it stays within the 255 bytes a file name may have."""
 
 
 def _short(stem: str, whole: str) -> str:

@@ -82,7 +82,8 @@ OUTPUT_CUT = "output-cut"
 ERRORS = "errors.jsonl"
 """The runner's log of the cells that raised, one JSON line each, written as each cell ends."""
 RUNNER_FAILED = "runner-failed.json"
-"""What the runner writes when it fails itself (not the notebook): the grader's error."""
+"""The file the runner writes when it fails itself (not the notebook), holding the grader's
+error."""
 MAX_ANSWER_BYTES = 64 * 1024 * 1024
 """The largest answer file read back (a larger one is a row "over limits")."""
 _TAIL_BYTES = 64 * 1024

@@ -78,8 +78,9 @@ BWRAP = "bwrap"
 HOME = "/home/student"
 """Where the work folder appears inside the sandbox (also ``HOME`` and the working folder)."""
 UID_BASE = 1_700_000_000
-"""When the grader runs as root, hand-in ``k`` runs as user id ``UID_BASE + k``: far above any
-login account, one per hand-in, so the limit on processes of one never counts another's."""
+"""When the grader runs as root, hand-in ``k`` runs as user id ``UID_BASE + k``. These ids lie
+far above any login account, one per hand-in, so the limit on processes of one never counts
+another's."""
 _PACKAGE_ROOT = "/opt/uio-teach"
 TEMP_PREFIX = "uio-teach-grade-"
 """The name of every temporary folder of a grading run starts so (removed by the next run when

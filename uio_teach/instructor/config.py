@@ -41,6 +41,8 @@ from ..experiments import (
     Experiment,
     Param,
     experiment_params,
+    number_text,
+    out_of_bounds,
     pole_text,
 )
 from ..observers import design_pmo, design_uio
@@ -286,18 +288,9 @@ def _number(key: str, value: Any, what: str = "a number") -> float:
 
 
 def _bounds(key: str, opt: ConfigKey, x: float) -> None:
-    if opt.positive and x <= 0:
-        raise ConfigError(f"{key}: must be > 0, got {x:g}")
-    if opt.minimum is not None and x < opt.minimum:
-        raise ConfigError(f"{key}: must be >= {opt.minimum:g}, got {x:g}")
-    if opt.maximum is not None:
-        if opt.kind == "int" or opt.minimum is not None or opt.positive:
-            if x > opt.maximum:
-                raise ConfigError(f"{key}: must be <= {opt.maximum:g}, got {x:g}")
-        elif abs(x) > opt.maximum:
-            raise ConfigError(
-                f"{key}: must be between -{opt.maximum:g} and {opt.maximum:g}, got {x:g}"
-            )
+    problem = out_of_bounds(opt, x)
+    if problem is not None:
+        raise ConfigError(f"{key}: {problem}")
 
 
 def _pole(key: str, value: Any) -> complex:
@@ -490,8 +483,8 @@ class FigureConfig(Mapping[str, Any]):
                 problems.append(f"pa9.piecewise.times: must be strictly increasing, got {times}")
             elif "pa9.duration" not in skip and times and times[-1] >= self["pa9.duration"]:
                 problems.append(
-                    f"pa9.piecewise.times: {times[-1]:g} s is not before the end of the run "
-                    f"(pa9.duration = {self['pa9.duration']:g} s)"
+                    f"pa9.piecewise.times: {number_text(times[-1])} s is not before the end of "
+                    f"the run (pa9.duration = {number_text(self['pa9.duration'])} s)"
                 )
         if not {"pa9.samples", "pa9.duration", "pa9.sine.frequency"} & skip:
             nyquist = math.pi * (self["pa9.samples"] - 1) / self["pa9.duration"]
@@ -767,7 +760,7 @@ def design_observer(cfg: Mapping[str, Any], key: str) -> Any:
         why = "; ".join(f"{c.name}: {c.reason}" for c in report.failed)
         specs = dict(experiment_params(run))
         given = [
-            f"{specs[f].config_key(name, f)} = {getattr(run, f):g}"
+            f"{specs[f].config_key(name, f)} = {number_text(getattr(run, f))}"
             for f in run.plant_fields
             if f in specs and specs[f].config_key(name, f)
         ]

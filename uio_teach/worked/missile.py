@@ -88,7 +88,7 @@ class MissileExperiment(ContinuousExperiment):
     poles: tuple[complex, ...] | None = param(
         (-100.0, -120.0),
         "poles",
-        "PMO poles (the paper's are not given; see chapter 5)",
+        "PMO poles (the paper's are not given; see the missile chapter)",
         key="pmo_poles",
     )
     v_parameters: tuple[tuple[float, float, float, str], ...] = examples.MISSILE_INPUTS
@@ -171,7 +171,7 @@ def _runs(runs: Any) -> dict[str, Any]:
         # Both observers start from q(0) = -M y(0): the PMO knows nothing at t = 0
         # (xhat(0) = 0) and the g-inverse observer reads the measured states. Started at
         # q(0) = 0 instead, the PMO would give the g-inverse's estimates whatever its poles
-        # (chapter 5 explains both starts and Table II).
+        # (the missile chapter explains both starts and Table II).
         q0 = run.observer_state(pmo)
         for name, obs in (("pmo", pmo), ("ginverse", ginverse)):
             resp = run.simulate(obs, observer_state=q0)
