@@ -327,6 +327,18 @@ def test_a_pattern_that_also_matches_the_shards_exports_merges_the_gradebooks(tm
     assert _tree(tmp_path / "merged") == _tree(tmp_path / "whole")
 
 
+def test_the_merge_command_counts_the_gradebooks_not_their_exports(tmp_path, capsys):
+    from uio_teach.instructor import cli
+
+    files = CLASS[:8]
+    for k in (1, 2):
+        _book(tmp_path / "marks" / f"grades_{k}.csv", files, (k, 2), students={"g01": []})
+    matched = sorted(str(p) for p in (tmp_path / "marks").glob("grades_*.csv"))
+    assert len(matched) > 2
+    assert cli.main(["merge", *matched, "--out", str(tmp_path / "m" / "grades.csv")]) == 0
+    assert "2 gradebooks merged into" in capsys.readouterr().out
+
+
 def test_shards_that_do_not_fit_together_are_refused_naming_them(tmp_path):
     files = CLASS[:10]
     one = _book(tmp_path / "a" / "g_1.csv", files, (1, 2))

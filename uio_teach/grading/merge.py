@@ -172,6 +172,32 @@ class _Part:
             )
 
 
+def shard_gradebooks(gradebooks: Sequence[str | os.PathLike[str]]) -> list[Path]:
+    """The gradebooks among the files given, without the exports written beside them.
+
+    Parameters
+    ----------
+    gradebooks : sequence of path
+        Files as a pattern such as ``marks/grades_*.csv`` lists them.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The given files in their order, less every ``<gradebook>_groups.csv`` and
+        ``<gradebook>_canvas.csv`` of a gradebook among them.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.merge import shard_gradebooks
+    >>> files = ["grades_1.csv", "grades_1_canvas.csv", "grades_1_groups.csv", "grades_2.csv"]
+    >>> [p.name for p in shard_gradebooks(files)]
+    ['grades_1.csv', 'grades_2.csv']
+    """
+    paths = [Path(g) for g in gradebooks]
+    exports = {export_path(p, kind).resolve() for p in paths for kind in ("groups", "canvas")}
+    return [p for p in paths if p.resolve() not in exports]
+
+
 def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[str]) -> Path:
     """Merge shard gradebooks into the gradebook ``out`` one whole run would have written.
 
@@ -221,9 +247,7 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
     if not gradebooks:
         raise MergeError("no gradebook to merge")
     out = Path(out)
-    paths = [Path(g) for g in gradebooks]
-    exports = {export_path(p, kind).resolve() for p in paths for kind in ("groups", "canvas")}
-    paths = [p for p in paths if p.resolve() not in exports]
+    paths = shard_gradebooks(gradebooks)
     for path in paths:
         if path.resolve() == out.resolve():
             raise MergeError(f"--out {os.fspath(out)} is one of the gradebooks to merge")

@@ -840,7 +840,11 @@ def _summary(command: str, out: Path, *, roster: bool, quiet: bool) -> None:
 
 
 def _merge(args: argparse.Namespace) -> int:
-    from ..grading.merge import MergeError, merge  # deferred on purpose (see the imports)
+    from ..grading.merge import (  # deferred on purpose (see the imports)
+        MergeError,
+        merge,
+        shard_gradebooks,
+    )
 
     missing = [p for p in args.gradebooks if not os.path.isfile(p)]
     if missing:
@@ -858,7 +862,7 @@ def _merge(args: argparse.Namespace) -> int:
         _error("merge", f"cannot write the gradebook {args.out}: {_os_error(err)}")
         return 1
     if not args.quiet:
-        _say(f"{len(args.gradebooks)} gradebooks merged into {out}")
+        _say(f"{len(shard_gradebooks(args.gradebooks))} gradebooks merged into {out}")
     from ..grading.gradebook import export_path  # deferred on purpose (see the imports)
 
     _summary("merge", out, roster=export_path(out, "canvas").exists(), quiet=args.quiet)
