@@ -15,11 +15,12 @@ When a page is written, every ``data:image/png`` URL in those attributes (``src`
 (named by its content: a picture drawn twice is stored once), and the attribute its relative URL
 (``../_images/...`` from a chapter). The browser then fetches the one picture of a ``<picture>``
 that its screen's media query selects, an explorer's frame only when the slider shows it, and
-every picture below the first lazily (``loading="lazy"``, ``decoding="async"``): a reader who
-stops halfway never downloads the rest. The page's first picture loads at once: it is often in
-the first screen, where a lazy picture only arrives later. The URLs are relative, so the site
-works from a copy of its folder opened from disk, and ``_ext/pdf_print.py`` loads every picture
-before it prints. Files no page refers to any more are removed when the build finishes.
+every picture lazily (``loading="lazy"``, ``decoding="async"``): a reader who stops halfway
+never downloads the rest. Only a picture with less text before it than a phone's first screen
+holds (:data:`FIRST_SCREEN`) loads at once, where a lazy one would arrive later. The URLs are
+relative, so the site works from a copy of its folder opened from disk, and
+``_ext/pdf_print.py`` loads every picture before it prints. Files no page refers to any more
+are removed when the build finishes.
 """
 
 from __future__ import annotations
@@ -38,6 +39,10 @@ from sphinx.util import logging
 IMAGES = "_images"  # Sphinx's folder of the site's pictures
 PREFIX = "fig-"  # the files this extension writes (and removes when no page refers to them)
 ATTRIBUTES = ("src", "srcset", "data-src", "data-narrow")
+# About the characters of text a phone's first screen shows (390 x 844 CSS pixels, some 45
+# characters a line under the page's header): a picture with more text before it is further
+# down on every screen, and loads lazily.
+FIRST_SCREEN = 1200
 
 # an attribute holding a whole PNG data URL (a single candidate: no descriptor in srcset)
 _DATA_URL = re.compile(
@@ -104,15 +109,15 @@ def _decode(match: re.Match) -> bytes:
     return png
 
 
-def lazy_pictures(body: str) -> str:
-    """Every ``<img>`` of ``body`` after the first loads lazily, unless it says otherwise."""
-    seen = 0
+def lazy_pictures(body: str, first_screen: int = FIRST_SCREEN) -> str:
+    """Every ``<img>`` of ``body`` loads lazily, unless it says otherwise or less than
+    ``first_screen`` characters of text come before it (it is likely in the first screen)."""
 
     def mark(match: re.Match) -> str:
-        nonlocal seen
         tag = match[0]
-        seen += 1
-        if seen == 1 or re.search(r"\sloading=", tag, flags=re.IGNORECASE):
+        if re.search(r"\sloading=", tag, flags=re.IGNORECASE):
+            return tag
+        if len(_text(body[: match.start()])) < first_screen:
             return tag
         end = "/>" if tag.endswith("/>") else ">"
         extra = ' loading="lazy"'
@@ -121,6 +126,12 @@ def lazy_pictures(body: str) -> str:
         return tag[: -len(end)].rstrip() + extra + end
 
     return _IMG.sub(mark, body)
+
+
+def _text(html: str) -> str:
+    """The words of some HTML, roughly: its scripts, styles and tags left out."""
+    html = re.sub(r"<(script|style)\b.*?</\1>", "", html, flags=re.S | re.IGNORECASE)
+    return re.sub(r"\s+", " ", re.sub(r"<[^>]*>", "", html))
 
 
 def _page_context(
