@@ -18,6 +18,8 @@ A picture is fetched only when shown: a phone fetches the phone version of a fig
 wide one, a desktop the wide one only, an explorer only the frame on screen, and a picture far
 below the first screen only once the reader scrolls to it (``loading="lazy"``). The style
 sheets, scripts and fonts every page shares (cached after the first page) are not counted.
+Moving an explorer's slider fetches the frame it shows, and nothing else; a chapter opened from
+the site's folder on disk (``file://``) shows every picture.
 """
 
 from __future__ import annotations
@@ -28,6 +30,8 @@ from urllib.parse import urlsplit
 
 import pytest
 from test_book import BROWSER_TIMEOUT_MS, PAGES
+
+from uio_teach.worked import WORKED
 
 MIB = 1024 * 1024
 PAGE_BUDGET = int(1.25 * MIB)
@@ -170,3 +174,88 @@ def test_a_reader_downloads_only_what_is_shown(
     assert all(p["lazy"] for p in far), f"{page} at {width} px: pictures below not lazy: {far}"
     early = {p["current"] for p in far} & set(weight["first"]["urls"])
     assert not early, f"{page} at {width} px: fetched before the reader scrolled: {early}"
+
+
+# the chapters with a static explorer: every worked example's, and the existence chapter's
+EXPLORER_PAGES = [p for p in PAGES if p.split("/")[-1] in {*WORKED, "existence"}]
+
+# Move the page's first explorer to each position of its slider in turn; after each move, once
+# the picture has loaded, what it shows.
+_SLIDE_JS = """
+async () => {
+  const root = document.querySelector(".uio-static-explorer");
+  const form = root.querySelector("form"), img = root.querySelector("img.uio-frame");
+  img.scrollIntoView();
+  const seen = [];
+  for (let i = 0; i <= Number(form.main.max); i++) {
+    form.main.value = String(i);
+    form.main.dispatchEvent(new Event("input", {bubbles: true}));
+    if (!img.complete) {
+      await new Promise((resolve) => {
+        img.addEventListener("load", resolve, {once: true});
+        img.addEventListener("error", resolve, {once: true});
+      });
+    }
+    seen.push({current: img.currentSrc, width: img.naturalWidth, alt: img.alt});
+  }
+  return seen;
+}
+"""
+
+
+@pytest.mark.parametrize("width", sorted(WIDTHS))
+@pytest.mark.parametrize("page", EXPLORER_PAGES)
+def test_explorer_fetches_each_frame_when_shown(
+    page: str, width: int, book_server: str, browser
+) -> None:
+    options = {"viewport": WIDTHS[width]}
+    context = browser.new_context(**options)
+    context.set_default_timeout(BROWSER_TIMEOUT_MS)
+    tab = context.new_page()
+    try:
+        tab.goto(f"{book_server}/{page}.html", wait_until="load")
+        seen = tab.evaluate(_SLIDE_JS)
+        fetched = tab.evaluate(
+            "() => performance.getEntriesByType('resource').map((e) => e.name)"
+            ".filter((u) => u.includes('/_images/'))"
+        )
+        figures = tab.evaluate(
+            "() => Array.from(document.images).filter((i) => !i.closest('.uio-static-explorer'))"
+            ".map((i) => i.currentSrc)"
+        )
+    finally:
+        context.close()
+    assert len(seen) > 1
+    assert all(s["width"] > 0 for s in seen), f"{page} at {width} px: a frame did not load"
+    frames = {s["current"] for s in seen}
+    assert len(frames) == len(seen), f"{page} at {width} px: frames repeat"
+    assert frames <= set(fetched), f"{page} at {width} px: frames shown but not fetched"
+    # nothing else: neither the frames of the menu's other entries nor the other screen's
+    other = sorted(set(fetched) - frames - set(figures))
+    assert not other, f"{page} at {width} px: pictures fetched but never shown: {other[:3]}"
+
+
+def test_pages_work_from_a_folder_on_disk(built_book: Path, browser) -> None:
+    """A copy of the site opened from disk (``file://``) shows every picture of a chapter."""
+    page = next(p for p in PAGES if p.endswith("missile"))
+    context = browser.new_context(viewport=WIDTHS[390], is_mobile=True)
+    context.set_default_timeout(BROWSER_TIMEOUT_MS)
+    tab = context.new_page()
+    try:
+        tab.route(
+            "**/*",
+            lambda route: (
+                route.continue_() if route.request.url.startswith("file:") else route.abort()
+            ),
+        )
+        tab.goto((built_book / f"{page}.html").as_uri(), wait_until="load")
+        tab.evaluate(_READ_TO_END_JS)
+        shown = tab.evaluate(
+            "() => Array.from(document.images).filter((i) => i.checkVisibility())"
+            ".map((i) => [i.currentSrc, i.naturalWidth])"
+        )
+    finally:
+        context.close()
+    assert shown and all(url.startswith("file:") for url, _ in shown)
+    broken = [url for url, width in shown if not width]
+    assert not broken, f"pictures that do not load from disk: {broken}"
