@@ -195,22 +195,31 @@ SCREEN_JS = """
 """
 
 
-def _new_context(browser, width: int):
-    """A browser context of the given viewport width, with the safety-net timeouts."""
-    context = browser.new_context(viewport={"width": width, "height": 900})
+def _new_context(browser, width: int, scheme: str = "light"):
+    """A browser context of the given viewport width and colour scheme (the reader's system
+    setting, which the theme follows), with the safety-net timeouts."""
+    context = browser.new_context(viewport={"width": width, "height": 900}, color_scheme=scheme)
     context.set_default_timeout(BROWSER_TIMEOUT_MS)
     context.set_default_navigation_timeout(BROWSER_TIMEOUT_MS)
     return context
 
 
-def _open_local(browser, book_server: str, page: str, width: int, listen: dict | None = None):
+def _open_local(
+    browser,
+    book_server: str,
+    page: str,
+    width: int,
+    listen: dict | None = None,
+    scheme: str = "light",
+):
     """Open a page of the book (requests to other hosts aborted) once it is fully rendered.
 
     Waits on events and page state only: the load event, then the web fonts, every image and
     MathJax's typesetting. ``listen`` collects what went wrong while loading (requests blocked,
-    failed responses, console errors). Returns the context (close it) and the tab.
+    failed responses, console errors); ``scheme`` is the reader's colour setting, light or dark.
+    Returns the context (close it) and the tab.
     """
-    context = _new_context(browser, width)
+    context = _new_context(browser, width, scheme)
     tab = context.new_page()
     host = urlsplit(book_server).hostname
     found = listen if listen is not None else {}
@@ -313,6 +322,28 @@ def axe_violations(tab) -> list[dict]:
         }
         for v in found
     ]
+
+
+@pytest.mark.browser
+# colours do not change with the width: the phone layout's own elements are scanned in the slow set
+@pytest.mark.parametrize("width", [1280, pytest.param(390, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("page", PAGES)
+def test_dark_theme_meets_wcag_21_aa(page: str, width: int, book_server: str, browser) -> None:
+    """The page in the dark theme (a reader whose system is set to dark: the book follows it),
+    its dropdowns open: no WCAG 2.1 A or AA violation, as in the light theme."""
+    context, tab = _open_local(browser, book_server, page, width, scheme="dark")
+    try:
+        theme = tab.evaluate("document.documentElement.dataset.theme")
+        tab.evaluate("document.querySelectorAll('main details').forEach(d => d.open = true)")
+        violations = axe_violations(tab)
+    finally:
+        context.close()
+    assert theme == "dark", f"{page}: the theme is {theme!r} for a reader who chose dark"
+    assert not violations, f"{page} at {width} px, dark theme, WCAG 2.1 A/AA (axe-core):\n" + (
+        "\n".join(
+            f"{v['id']} ({v['count']}): {v['help']}; {v['where']}; {v['why']}" for v in violations
+        )
+    )
 
 
 # The page's structure for a screen reader: its language, its headings in order, its tables'
