@@ -324,6 +324,47 @@ def axe_violations(tab) -> list[dict]:
     ]
 
 
+# The text of the cells' HTML outputs (the figures' words, the explorers' controls and captions)
+# whose contrast with the box it sits on is under 4.5:1 (3:1 for large text), the colours mixed
+# with the element's opacity. In the dark theme the box is light: axe-core reports such text as
+# undecided ("partially obscured"), not as a violation, so the ratio is computed here.
+_OUTPUT_BOX_CONTRAST_JS = """
+() => {
+  const rgba = (c) => { const m = c.match(/rgba?\\(([^)]+)\\)/); if (!m) return null;
+    const p = m[1].split(/[ ,\\/]+/).filter(Boolean).map(Number);
+    return [p[0], p[1], p[2], p.length > 3 ? p[3] : 1]; };
+  const lum = (c) => { const f = (v) => { v /= 255;
+    return v <= 0.03928 ? v / 12.92 : ((v + 0.055) / 1.055) ** 2.4; };
+    return 0.2126 * f(c[0]) + 0.7152 * f(c[1]) + 0.0722 * f(c[2]); };
+  const box = (el) => { for (let e = el; e; e = e.parentElement) {
+    const c = rgba(getComputedStyle(e).backgroundColor); if (c && c[3] > 0.5) return c; }
+    return [255, 255, 255, 1]; };
+  const faint = [];
+  for (const out of document.querySelectorAll("main div.cell_output .text_html")) {
+    const walker = document.createTreeWalker(out, NodeFilter.SHOW_TEXT);
+    for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+      const el = n.parentElement;
+      if (!n.textContent.trim() || !el.checkVisibility() || el.closest("select, option")) continue;
+      if (el.closest("mjx-assistive-mml")) continue;
+      const s = getComputedStyle(el), fg = rgba(s.color), bg = box(el);
+      let alpha = fg[3];
+      for (let e = el; e; e = e.parentElement) alpha *= Number(getComputedStyle(e).opacity);
+      const mixed = [0, 1, 2].map((i) => fg[i] * alpha + bg[i] * (1 - alpha));
+      const [lo, hi] = [lum(mixed), lum(bg)].sort((a, b) => a - b);
+      const ratio = (hi + 0.05) / (lo + 0.05);
+      const size = parseFloat(s.fontSize), bold = Number(s.fontWeight) >= 700;
+      const needed = size >= 24 || (bold && size >= 18.66) ? 3 : 4.5;
+      if (ratio < needed) {
+        faint.push(`${el.tagName.toLowerCase()} "${n.textContent.trim().slice(0, 30)}": ` +
+                   `${ratio.toFixed(2)}:1 (${s.color} on rgb(${bg.slice(0, 3)}))`);
+      }
+    }
+  }
+  return faint;
+}
+"""
+
+
 @pytest.mark.browser
 # colours do not change with the width: the phone layout's own elements are scanned in the slow set
 @pytest.mark.parametrize("width", [1280, pytest.param(390, marks=pytest.mark.slow)])
@@ -336,9 +377,11 @@ def test_dark_theme_meets_wcag_21_aa(page: str, width: int, book_server: str, br
         theme = tab.evaluate("document.documentElement.dataset.theme")
         tab.evaluate("document.querySelectorAll('main details').forEach(d => d.open = true)")
         violations = axe_violations(tab)
+        faint = tab.evaluate(_OUTPUT_BOX_CONTRAST_JS)
     finally:
         context.close()
     assert theme == "dark", f"{page}: the theme is {theme!r} for a reader who chose dark"
+    assert not faint, f"{page} at {width} px, dark theme: text under 4.5:1 in output boxes: {faint}"
     assert not violations, f"{page} at {width} px, dark theme, WCAG 2.1 A/AA (axe-core):\n" + (
         "\n".join(
             f"{v['id']} ({v['count']}): {v['help']}; {v['where']}; {v['why']}" for v in violations
