@@ -8,7 +8,9 @@ output cell shows an error and the console stays clean; each page is opened once
 every check reads that load (``page_facts``), which saves a full-page screenshot in
 ``_build/screenshots/`` when ``UIO_TEACH_SCREENSHOTS`` is set. At 1280 px every display
 equation, every visible code line and every printed output fits its column. At both widths the
-page meets WCAG 2.1 A and AA as axe-core checks it (every dropdown opened), every picture says
+page meets WCAG 2.1 A and AA as axe-core checks it (every dropdown opened; in the dark theme as
+well, where the text of the cells' HTML outputs, in a light box, is checked for contrast by the
+test itself), every picture says
 what it shows, the headings go down one level at a time, every table has header cells and every
 formula carries MathJax's assistive MathML for screen readers. The browser tests
 wait on events and page state (the load event, fonts, images, MathJax), never on a fixed
@@ -326,8 +328,9 @@ def axe_violations(tab) -> list[dict]:
 
 # The text of the cells' HTML outputs (the figures' words, the explorers' controls and captions)
 # whose contrast with the box it sits on is under 4.5:1 (3:1 for large text), the colours mixed
-# with the element's opacity. In the dark theme the box is light: axe-core reports such text as
-# undecided ("partially obscured"), not as a violation, so the ratio is computed here.
+# with the element's opacity, and a box whose scroll shadows' covers (phone.css) are not its own
+# colour. In the dark theme the box is light: axe-core reports such text as undecided ("partially
+# obscured", "background gradient"), not as a violation, so the ratio is computed here.
 _OUTPUT_BOX_CONTRAST_JS = """
 () => {
   const rgba = (c) => { const m = c.match(/rgba?\\(([^)]+)\\)/); if (!m) return null;
@@ -341,6 +344,13 @@ _OUTPUT_BOX_CONTRAST_JS = """
     return [255, 255, 255, 1]; };
   const faint = [];
   for (const out of document.querySelectorAll("main div.cell_output .text_html")) {
+    // the covers of the box's scroll shadows (phone.css) are the box's own colour
+    const style = getComputedStyle(out), own = rgba(style.backgroundColor);
+    const cover = rgba(style.backgroundImage);
+    if (own && own[3] > 0.5 && cover && cover.slice(0, 3).join() !== own.slice(0, 3).join()) {
+      faint.push(`the scroll shadows' covers, rgb(${cover.slice(0, 3)}), on the output box, ` +
+                 `rgb(${own.slice(0, 3)}): bands over the text at its edges`);
+    }
     const walker = document.createTreeWalker(out, NodeFilter.SHOW_TEXT);
     for (let n = walker.nextNode(); n; n = walker.nextNode()) {
       const el = n.parentElement;
