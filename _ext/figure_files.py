@@ -29,6 +29,7 @@ import base64
 import binascii
 import hashlib
 import re
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -66,9 +67,10 @@ def _write(folder: Path, png: bytes) -> str:
     target = folder / name
     if not target.exists():
         folder.mkdir(parents=True, exist_ok=True)
-        partial = target.with_suffix(f".{id(png)}.part")  # whole or absent, if pages are written
-        partial.write_bytes(png)  # in parallel
-        partial.replace(target)
+        # whole or absent, when pages are written in parallel: a file of its own, then renamed
+        with tempfile.NamedTemporaryFile(dir=folder, suffix=".part", delete=False) as partial:
+            partial.write(png)
+        Path(partial.name).replace(target)
     return name
 
 
