@@ -248,7 +248,10 @@ async (opts) => {
   }
   const sources = [...document.querySelectorAll('picture > source[media]')];
   for (const s of sources) s.remove();
-  if (sources.length) {
+  // every picture loaded before printing, those the page leaves until the reader scrolls too
+  const lazy = [...document.images].filter((img) => img.loading === 'lazy');
+  for (const img of lazy) img.loading = 'eager';
+  if (sources.length || lazy.length) {
     await Promise.all([...document.images].map((img) => img.decode().catch(() => null)));
   }
   for (const e of document.querySelectorAll('.toggle-hidden')) e.classList.remove('toggle-hidden');

@@ -8,7 +8,9 @@ output cell shows an error and the console stays clean; each page is opened once
 every check reads that load (``page_facts``), which saves a full-page screenshot in
 ``_build/screenshots/`` when ``UIO_TEACH_SCREENSHOTS`` is set. At 1280 px every display
 equation, every visible code line and every printed output fits its column. At both widths the
-page meets WCAG 2.1 A and AA as axe-core checks it (every dropdown opened), every picture says
+page meets WCAG 2.1 A and AA as axe-core checks it (every dropdown opened; in the dark theme as
+well, where the text of the cells' HTML outputs, in a light box, is checked for contrast by the
+test itself), every picture says
 what it shows, the headings go down one level at a time, every table has header cells and every
 formula carries MathJax's assistive MathML for screen readers. The browser tests
 wait on events and page state (the load event, fonts, images, MathJax), never on a fixed
@@ -195,22 +197,31 @@ SCREEN_JS = """
 """
 
 
-def _new_context(browser, width: int):
-    """A browser context of the given viewport width, with the safety-net timeouts."""
-    context = browser.new_context(viewport={"width": width, "height": 900})
+def _new_context(browser, width: int, scheme: str = "light"):
+    """A browser context of the given viewport width and colour scheme (the reader's system
+    setting, which the theme follows), with the safety-net timeouts."""
+    context = browser.new_context(viewport={"width": width, "height": 900}, color_scheme=scheme)
     context.set_default_timeout(BROWSER_TIMEOUT_MS)
     context.set_default_navigation_timeout(BROWSER_TIMEOUT_MS)
     return context
 
 
-def _open_local(browser, book_server: str, page: str, width: int, listen: dict | None = None):
+def _open_local(
+    browser,
+    book_server: str,
+    page: str,
+    width: int,
+    listen: dict | None = None,
+    scheme: str = "light",
+):
     """Open a page of the book (requests to other hosts aborted) once it is fully rendered.
 
     Waits on events and page state only: the load event, then the web fonts, every image and
     MathJax's typesetting. ``listen`` collects what went wrong while loading (requests blocked,
-    failed responses, console errors). Returns the context (close it) and the tab.
+    failed responses, console errors); ``scheme`` is the reader's colour setting, light or dark.
+    Returns the context (close it) and the tab.
     """
-    context = _new_context(browser, width)
+    context = _new_context(browser, width, scheme)
     tab = context.new_page()
     host = urlsplit(book_server).hostname
     found = listen if listen is not None else {}
@@ -313,6 +324,79 @@ def axe_violations(tab) -> list[dict]:
         }
         for v in found
     ]
+
+
+# The text of the cells' HTML outputs (the figures' words, the explorers' controls and captions)
+# whose contrast with the box it sits on is under 4.5:1 (3:1 for large text), the colours mixed
+# with the element's opacity, and a box whose scroll shadows' covers (phone.css) are not its own
+# colour. In the dark theme the box is light: axe-core reports such text as undecided ("partially
+# obscured", "background gradient"), not as a violation, so the ratio is computed here.
+_OUTPUT_BOX_CONTRAST_JS = """
+() => {
+  const rgba = (c) => { const m = c.match(/rgba?\\(([^)]+)\\)/); if (!m) return null;
+    const p = m[1].split(/[ ,\\/]+/).filter(Boolean).map(Number);
+    return [p[0], p[1], p[2], p.length > 3 ? p[3] : 1]; };
+  const lum = (c) => { const f = (v) => { v /= 255;
+    return v <= 0.03928 ? v / 12.92 : ((v + 0.055) / 1.055) ** 2.4; };
+    return 0.2126 * f(c[0]) + 0.7152 * f(c[1]) + 0.0722 * f(c[2]); };
+  const box = (el) => { for (let e = el; e; e = e.parentElement) {
+    const c = rgba(getComputedStyle(e).backgroundColor); if (c && c[3] > 0.5) return c; }
+    return [255, 255, 255, 1]; };
+  const faint = [];
+  for (const out of document.querySelectorAll("main div.cell_output .text_html")) {
+    // the covers of the box's scroll shadows (phone.css) are the box's own colour
+    const style = getComputedStyle(out), own = rgba(style.backgroundColor);
+    const cover = rgba(style.backgroundImage);
+    if (own && own[3] > 0.5 && cover && cover.slice(0, 3).join() !== own.slice(0, 3).join()) {
+      faint.push(`the scroll shadows' covers, rgb(${cover.slice(0, 3)}), on the output box, ` +
+                 `rgb(${own.slice(0, 3)}): bands over the text at its edges`);
+    }
+    const walker = document.createTreeWalker(out, NodeFilter.SHOW_TEXT);
+    for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+      const el = n.parentElement;
+      if (!n.textContent.trim() || !el.checkVisibility() || el.closest("select, option")) continue;
+      if (el.closest("mjx-assistive-mml")) continue;
+      const s = getComputedStyle(el), fg = rgba(s.color), bg = box(el);
+      let alpha = fg[3];
+      for (let e = el; e; e = e.parentElement) alpha *= Number(getComputedStyle(e).opacity);
+      const mixed = [0, 1, 2].map((i) => fg[i] * alpha + bg[i] * (1 - alpha));
+      const [lo, hi] = [lum(mixed), lum(bg)].sort((a, b) => a - b);
+      const ratio = (hi + 0.05) / (lo + 0.05);
+      const size = parseFloat(s.fontSize), bold = Number(s.fontWeight) >= 700;
+      const needed = size >= 24 || (bold && size >= 18.66) ? 3 : 4.5;
+      if (ratio < needed) {
+        faint.push(`${el.tagName.toLowerCase()} "${n.textContent.trim().slice(0, 30)}": ` +
+                   `${ratio.toFixed(2)}:1 (${s.color} on rgb(${bg.slice(0, 3)}))`);
+      }
+    }
+  }
+  return faint;
+}
+"""
+
+
+@pytest.mark.browser
+# colours do not change with the width: the phone layout's own elements are scanned in the slow set
+@pytest.mark.parametrize("width", [1280, pytest.param(390, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("page", PAGES)
+def test_dark_theme_meets_wcag_21_aa(page: str, width: int, book_server: str, browser) -> None:
+    """The page in the dark theme (a reader whose system is set to dark: the book follows it),
+    its dropdowns open: no WCAG 2.1 A or AA violation, as in the light theme."""
+    context, tab = _open_local(browser, book_server, page, width, scheme="dark")
+    try:
+        theme = tab.evaluate("document.documentElement.dataset.theme")
+        tab.evaluate("document.querySelectorAll('main details').forEach(d => d.open = true)")
+        violations = axe_violations(tab)
+        faint = tab.evaluate(_OUTPUT_BOX_CONTRAST_JS)
+    finally:
+        context.close()
+    assert theme == "dark", f"{page}: the theme is {theme!r} for a reader who chose dark"
+    assert not faint, f"{page} at {width} px, dark theme: text under 4.5:1 in output boxes: {faint}"
+    assert not violations, f"{page} at {width} px, dark theme, WCAG 2.1 A/AA (axe-core):\n" + (
+        "\n".join(
+            f"{v['id']} ({v['count']}): {v['help']}; {v['where']}; {v['why']}" for v in violations
+        )
+    )
 
 
 # The page's structure for a screen reader: its language, its headings in order, its tables'
