@@ -219,7 +219,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     (one worker opens the page once per width). The first test that needs the book build comes
     first, so that one worker builds the book (``book_build``: one build for all workers) while
     the others run the groups and then the rest; the tests that read the built book come last,
-    when the build is done. Without ``-n`` the order is the same and the marks change nothing.
+    when the build is done, those of a module's costly fixture (its group) first. Without
+    ``-n`` the order is the same and the marks change nothing.
     """
     first_book = next((i for i in items if "book_build" in getattr(i, "fixturenames", ())), None)
 
@@ -227,7 +228,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if item is first_book:
             return 0
         if "book_build" in getattr(item, "fixturenames", ()):
-            return 3
+            # the longest of them first (a module's costly fixture: the wheel installed from
+            # the book and every notebook run, the printed PDFs), the short page checks after
+            return 3 if _shares_module_fixture(item) else 4
         return 1 if _shares_module_fixture(item) else 2
 
     for item in items:
