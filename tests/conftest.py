@@ -64,6 +64,7 @@ BOOK_BUILD_LIMIT = 1800  # seconds
 sys.path.insert(0, str(ROOT / "_ext"))
 
 from pdf_print import CHROMIUM, CHROMIUM_ARGS, serve  # noqa: E402
+from venvs import new_venv  # noqa: E402
 
 # --- what a process needs ----------------------------------------------------------------------
 
@@ -460,19 +461,12 @@ def wheel_env(tmp_path_factory: pytest.TempPathFactory) -> WheelEnv:
 
         wheel = build_wheel(ROOT, folder / "dist", folder / "stamps")
         venv = folder / "venv"
-        subprocess.run([sys.executable, "-m", "venv", "--without-pip", venv], check=True)
-        python = venv / "bin" / "python"
-        site = subprocess.run(
-            [python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout.strip()
+        python, site = new_venv(venv, pip=False)
         pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q", "install"]
         subprocess.run([*pip, "--no-deps", "--no-index", "--target", site, wheel], check=True)
         # the course's dependencies from this environment, after the wheel
         Path(site, "zz_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
-        return {"wheel": str(wheel), "venv": str(venv), "python": str(python), "site": site}
+        return {"wheel": str(wheel), "venv": str(venv), "python": str(python), "site": str(site)}
 
     made = {k: Path(v) for k, v in once_per_run(tmp_path_factory, "wheel", make).items()}
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

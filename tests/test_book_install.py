@@ -31,6 +31,7 @@ from pathlib import Path
 import nbformat
 import pytest
 from lab_outputs import assert_checks_say_what_is_missing
+from venvs import new_venv
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "_ext"))
@@ -125,14 +126,7 @@ def student(built_book: Path, book_server: str, tmp_path_factory) -> dict:
                 target.write_bytes(_get(url))
                 notebooks.append(target)
     env_dir = base / "env"
-    subprocess.run([sys.executable, "-m", "venv", env_dir], check=True, timeout=300)
-    python = env_dir / "bin" / "python"
-    purelib = subprocess.run(
-        [python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout.strip()
+    python, purelib = new_venv(env_dir, pip=True)  # pip: the introduction's commands use it
     overlay = _overlay(base / "lock")
     Path(purelib, "uio_teach_test_lock.pth").write_text(f"{overlay}\n", encoding="utf-8")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
