@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_explorers import pa9_run
 from tolerance import assert_rounding_close, size_of
 
 import uio_teach as ut
@@ -75,13 +76,7 @@ def test_pa9_pole_slider_redraws_with_what_simulate_returns():
     ex.controls["pole 1"].value = -4.0  # as a student's slider does
     after = ydata(ex, "uio.error")
     assert not np.allclose(before, after)
-    plant = ut.examples.pa9()
-    t = np.linspace(0, 10, 1001)
-    kwargs = dict(
-        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
-        d=ut.signals.sinusoid(1.0, 2.0),
-        initial_state=[1.0, -1.0, 0.5],
-    )
+    plant, t, kwargs = pa9_run(d=ut.signals.sinusoid(1.0, 2.0))
     obs = ut.design_uio(plant, poles=[-4, -2, -3])
     # the default start: a zero estimate, xhat(0) = z(0) + H y(0) = 0
     z0 = -obs.H @ plant.C @ np.array(kwargs["initial_state"])
@@ -103,19 +98,11 @@ def test_pa9_complex_pair_and_disturbance_controls():
     assert ex.controls["frequency"].layout.display == "none"
     assert ex.controls["period"].layout.display is None
     assert ex.settings.poles == (-3.0, -1 + 2j)
-    plant = ut.examples.pa9()
-    t = np.linspace(0, 10, 1001)
     rng = np.random.default_rng([0, 0])
     times = 1.5 * np.arange(8)
     d = ut.signals.piecewise_constant(times, 2.0 * rng.uniform(-1, 1, 8))
-    uio = ut.simulate(
-        plant,
-        ut.design_uio(plant, poles=[-3, -1 + 2j, -1 - 2j]),
-        t,
-        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
-        d=d,
-        initial_state=[1.0, -1.0, 0.5],
-    )
+    plant, t, kwargs = pa9_run(d=d)
+    uio = ut.simulate(plant, ut.design_uio(plant, poles=[-3, -1 + 2j, -1 - 2j]), t, **kwargs)
     assert_same(ex.figure.lines["d"][0].get_ydata(), d(t))
     assert_same(ydata(ex, "uio.error"), np.abs(uio.error))
     # a zero imaginary part is a double real pole
