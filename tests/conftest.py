@@ -63,7 +63,8 @@ BOOK_BUILD_LIMIT = 1800  # seconds
 # tests do, and the book's download builds the wheel the tests install.
 sys.path.insert(0, str(ROOT / "_ext"))
 
-from pdf_print import CHROMIUM, CHROMIUM_ARGS, serve  # noqa: E402
+from browsers import launch, require_chromium  # noqa: E402
+from pdf_print import serve  # noqa: E402
 from venvs import new_venv  # noqa: E402
 
 # --- what a process needs ----------------------------------------------------------------------
@@ -414,18 +415,12 @@ def book_server(built_book: Path) -> Iterator[str]:
 
 @pytest.fixture(scope="session")
 def browser() -> Iterator[object]:
-    if not CHROMIUM.exists():
-        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(message, pytrace=False)
-        pytest.skip(message)
+    require_chromium()
     from playwright.sync_api import sync_playwright
 
     # Playwright gives the browser a fresh temporary profile of its own.
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(
-            executable_path=str(CHROMIUM), args=CHROMIUM_ARGS, headless=True
-        )
+        browser = launch(playwright)
         try:
             yield browser
         finally:
