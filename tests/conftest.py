@@ -60,12 +60,11 @@ HTML = ROOT / "_build" / "html"
 BOOK_BUILD_LIMIT = 1800  # seconds
 
 # The book's own extensions (_ext/): the printer serves the site and starts Chromium as the
-# tests do, and the book's download builds the wheel the tests install.
+# tests do, and the book's download builds the wheel the tests install. They and the tests'
+# helpers (browsers, venvs) are imported by the fixtures that use them, so that this file
+# also runs on its own (tests/test_scheduling.py runs a copy of it).
 sys.path.insert(0, str(ROOT / "_ext"))
 
-from browsers import launch, require_chromium  # noqa: E402
-from pdf_print import serve  # noqa: E402
-from venvs import new_venv  # noqa: E402
 
 # --- what a process needs ----------------------------------------------------------------------
 
@@ -409,12 +408,16 @@ def built_book(book_build: BookBuild) -> Path:
 def book_server(built_book: Path) -> Iterator[str]:
     """Serve the built book on 127.0.0.1 at a free port, as the printer does; yield its base
     URL (without the last ``/``)."""
+    from pdf_print import serve
+
     with serve(built_book) as url:
         yield url.rstrip("/")
 
 
 @pytest.fixture(scope="session")
 def browser() -> Iterator[object]:
+    from browsers import launch, require_chromium
+
     require_chromium()
     from playwright.sync_api import sync_playwright
 
@@ -453,6 +456,7 @@ def wheel_env(tmp_path_factory: pytest.TempPathFactory) -> WheelEnv:
 
     def make(folder: Path) -> dict:
         from downloads import build_wheel  # the book's: imports Sphinx
+        from venvs import new_venv
 
         wheel = build_wheel(ROOT, folder / "dist", folder / "stamps")
         venv = folder / "venv"
