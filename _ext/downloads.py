@@ -43,7 +43,7 @@ from sphinx.util.docutils import SphinxDirective
 PDF_VAR = "UIO_TEACH_PDF"
 DOWNLOADS = "_downloads"  # the wheel, in the site
 PDF_DIR = "_pdf"  # the printed pages, in the site
-# What the wheel is built from (as tests/test_packaging.py builds it).
+# What the wheel is built from (the tests install the wheel build_wheel makes, too).
 WHEEL_SOURCES = ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]
 WHEEL_SOURCES += ["_toc.yml", "references.bib", "LICENSE", "LICENSE-BOOK.md"]
 WHEEL_LIMIT = 600  # seconds: a limit against a hung build, not a timing

@@ -15,45 +15,22 @@ machine: clean under 90 s, cached under 15 s.
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
 import statistics
-import subprocess
-import sys
 import tempfile
-import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-COPY = ["_config.yml", "_toc.yml", "references.bib", "book", "_ext", "_static", "uio_teach"]
-COPY += ["pyproject.toml"]
+from book_copy import book_commands, copy_sources, environment, run
 
 
 def build(src: Path) -> float:
-    bindir = Path(sys.executable).parent
-    env = dict(os.environ, PATH=f"{bindir}{os.pathsep}{os.environ.get('PATH', '')}")
-    start = time.perf_counter()
-    # as `make book`: the chapters that changed run on every core, then the build
-    for command in (
-        [sys.executable, str(src / "_ext" / "run_chapters.py")],
-        [str(bindir / "jupyter-book"), "build", str(src), "-W", "-n", "--keep-going"],
-    ):
-        proc = subprocess.run(command, env=env, capture_output=True, text=True)
-        if proc.returncode:
-            sys.exit(f"the book build failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    return time.perf_counter() - start
+    """`make book` on ``src``; its seconds."""
+    env = environment()
+    return sum(run(command, env)[0] for command in book_commands(src))
 
 
 def one_run() -> tuple[float, float]:
     with tempfile.TemporaryDirectory() as tmp:
-        src = Path(tmp) / "book-src"
-        src.mkdir()
-        for name in COPY:
-            path = ROOT / name
-            if path.is_dir():
-                shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-            else:
-                shutil.copy2(path, src / name)
+        src = copy_sources(Path(tmp) / "book-src")
         clean = build(src)
         chapter = src / "book" / "pa9.md"
         chapter.write_text(chapter.read_text() + "\nA sentence added to time a rebuild.\n")

@@ -16,45 +16,23 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-COPY = ["_config.yml", "_toc.yml", "references.bib", "book", "_ext", "_static", "uio_teach"]
-COPY += ["pyproject.toml", "setup.py", "MANIFEST.in", "README.md", "LICENSE", "LICENSE-BOOK.md"]
+from book_copy import book_commands, copy_sources, environment, run
+
 PRINTED = re.compile(r"printed (\d+) PDF\(s\), (\d+) pages, into .* in ([\d.]+) s")
 
 
-def run(command: list[str], env: dict[str, str]) -> tuple[float, str]:
-    start = time.perf_counter()
-    proc = subprocess.run(command, env=env, capture_output=True, text=True)
-    seconds = time.perf_counter() - start
-    if proc.returncode:
-        sys.exit(f"`{' '.join(command)}` failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    return seconds, proc.stdout + proc.stderr
-
-
 def main() -> None:
-    bindir = Path(sys.executable).parent
-    env = dict(os.environ, PATH=f"{bindir}{os.pathsep}{os.environ.get('PATH', '')}")
-    env.pop("UIO_TEACH_PDF", None)
+    env = environment()
     with tempfile.TemporaryDirectory() as tmp:
-        src = Path(tmp) / "book-src"
-        src.mkdir()
-        for name in COPY:
-            path = ROOT / name
-            if path.is_dir():
-                shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-            else:
-                shutil.copy2(path, src / name)
-        book = [str(bindir / "jupyter-book"), "build", str(src), "-W", "-n", "--keep-going"]
-        run([sys.executable, str(src / "_ext" / "run_chapters.py")], env)
-        run(book, env)  # make book
-        total, log = run(book, {**env, "UIO_TEACH_PDF": "1"})  # make pdf, after make book
+        src = copy_sources(Path(tmp) / "book-src")
+        commands = book_commands(src)
+        for command in commands:  # make book
+            run(command, env)
+        total, log = run(commands[-1], environment(UIO_TEACH_PDF="1"))  # make pdf, after make book
         found = PRINTED.search(log)
         if not found:
             sys.exit(f"no 'printed N PDF(s)' line in the build's output:\n{log[-3000:]}")

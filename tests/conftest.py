@@ -32,17 +32,15 @@ test module that starts one at import time fails its collection.
 from __future__ import annotations
 
 import fcntl
-import functools
 import json
 import os
 import shlex
 import shutil
 import subprocess
 import sys
+import sysconfig
 import tempfile
-import threading
-from collections.abc import Iterator, Sequence
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
@@ -60,16 +58,12 @@ ROOT = Path(__file__).resolve().parents[1]
 HTML = ROOT / "_build" / "html"
 # A clean build executes every chapter; this is a limit against a hung kernel, not a timing.
 BOOK_BUILD_LIMIT = 1800  # seconds
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
+
+# The book's own extensions (_ext/): the printer serves the site and starts Chromium as the
+# tests do, and the book's download builds the wheel the tests install. They and the tests'
+# helpers (browsers, venvs) are imported by the fixtures that use them, so that this file
+# also runs on its own (tests/test_scheduling.py runs a copy of it).
+sys.path.insert(0, str(ROOT / "_ext"))
 
 
 # --- what a process needs ----------------------------------------------------------------------
@@ -226,7 +220,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     (one worker opens the page once per width). The first test that needs the book build comes
     first, so that one worker builds the book (``book_build``: one build for all workers) while
     the others run the groups and then the rest; the tests that read the built book come last,
-    when the build is done. Without ``-n`` the order is the same and the marks change nothing.
+    when the build is done, those of a module's costly fixture (its group) first. Without
+    ``-n`` the order is the same and the marks change nothing.
     """
     first_book = next((i for i in items if "book_build" in getattr(i, "fixturenames", ())), None)
 
@@ -234,7 +229,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         if item is first_book:
             return 0
         if "book_build" in getattr(item, "fixturenames", ()):
-            return 3
+            # the longest of them first (a module's costly fixture: the wheel installed from
+            # the book and every notebook run, the printed PDFs), the short page checks after
+            return 3 if _shares_module_fixture(item) else 4
         return 1 if _shares_module_fixture(item) else 2
 
     for item in items:
@@ -332,6 +329,30 @@ class BookBuild(NamedTuple):
     log: str
 
 
+def run_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The test run's temporary folder, shared by every pytest-xdist worker."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+def once_per_run(tmp_path_factory: pytest.TempPathFactory, name: str, make: Callable[[Path], dict]):
+    """``make(folder)`` once per test run, its result (JSON) shared by every worker.
+
+    With ``pytest -n`` the first worker to need it makes it in ``folder`` (in the run's shared
+    temporary folder) and writes down the result; the others wait for it (a lock in that
+    folder) and read it. A ``make`` that raises writes nothing: the next one to ask tries again.
+    """
+    shared = run_folder(tmp_path_factory)
+    record = shared / f"{name}.json"
+    with open(shared / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
+        if record.is_file():
+            return json.loads(record.read_text(encoding="utf-8"))
+        result = make(shared / name)
+        record.write_text(json.dumps(result), encoding="utf-8")
+        return result
+
+
 @pytest.fixture(scope="session")
 def book_build(tmp_path_factory: pytest.TempPathFactory) -> BookBuild:
     """Build the book once per test run, as ``make book`` does, every chapter executed afresh.
@@ -340,20 +361,11 @@ def book_build(tmp_path_factory: pytest.TempPathFactory) -> BookBuild:
     against the package as it is now, not as it was when the cache was filled: this build is
     what proves the chapters run (``test_chapters.py``), not a second execution of each.
 
-    With ``pytest -n`` the first worker to need it builds the book and writes down the result;
-    the others wait for it (a lock in the run's shared temporary folder) and read it.
+    With ``pytest -n`` the first worker to need it builds the book; the others wait for it and
+    read its result (:func:`once_per_run`).
     """
-    shared = tmp_path_factory.getbasetemp()
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        shared = shared.parent  # the run's folder, above each worker's own
-    record = shared / "book_build.json"
-    with open(shared / "book_build.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
-        if record.is_file():
-            return BookBuild(**json.loads(record.read_text(encoding="utf-8")))
-        build = _build_book()
-        record.write_text(json.dumps(build._asdict()), encoding="utf-8")
-        return build
+    made = once_per_run(tmp_path_factory, "book_build", lambda _: _build_book()._asdict())
+    return BookBuild(**made)
 
 
 def _build_book() -> BookBuild:
@@ -392,40 +404,70 @@ def built_book(book_build: BookBuild) -> Path:
 # --- the built book served, and one browser for every page test -----------------------------
 
 
-class _QuietHandler(SimpleHTTPRequestHandler):
-    def log_message(self, format: str, *args: object) -> None:
-        pass
-
-
 @pytest.fixture(scope="session")
 def book_server(built_book: Path) -> Iterator[str]:
-    """Serve the built book on 127.0.0.1 at a free port; yield its base URL."""
-    handler = functools.partial(_QuietHandler, directory=str(built_book))
-    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}"
-    finally:
-        server.shutdown()
-        server.server_close()
+    """Serve the built book on 127.0.0.1 at a free port, as the printer does; yield its base
+    URL (without the last ``/``)."""
+    from pdf_print import serve
+
+    with serve(built_book) as url:
+        yield url.rstrip("/")
 
 
 @pytest.fixture(scope="session")
 def browser() -> Iterator[object]:
-    if not CHROMIUM.exists():
-        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(message, pytrace=False)
-        pytest.skip(message)
+    from browsers import launch, require_chromium
+
+    require_chromium()
     from playwright.sync_api import sync_playwright
 
     # Playwright gives the browser a fresh temporary profile of its own.
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(
-            executable_path=str(CHROMIUM), args=CHROMIUM_ARGS, headless=True
-        )
+        browser = launch(playwright)
         try:
             yield browser
         finally:
             browser.close()
+
+
+# --- the package's wheel, built once per run and installed in a virtual environment --------------
+
+
+class WheelEnv(NamedTuple):
+    """The package's wheel, as the book's build makes it, installed in a new virtual environment.
+
+    ``python`` imports ``uio_teach`` from the wheel in ``site`` (the environment's
+    site-packages, whose ``bin`` holds the wheel's command ``uio-teach``) and every other package
+    from the test's own environment, after it; ``env`` runs it with no ``PYTHONPATH`` (so not
+    from the checkout) and matplotlib off screen.
+    """
+
+    wheel: Path
+    venv: Path
+    python: Path
+    site: Path
+    env: dict[str, str]
+
+
+@pytest.fixture(scope="session")
+def wheel_env(tmp_path_factory: pytest.TempPathFactory) -> WheelEnv:
+    """The one wheel of a test run (tests marked ``wheel``), built from a copy of the sources by
+    the book's own ``_ext/downloads.py``, installed in one virtual environment for every test."""
+
+    def make(folder: Path) -> dict:
+        from downloads import build_wheel  # the book's: imports Sphinx
+        from venvs import new_venv
+
+        wheel = build_wheel(ROOT, folder / "dist", folder / "stamps")
+        venv = folder / "venv"
+        python, site = new_venv(venv, pip=False)
+        pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q", "install"]
+        subprocess.run([*pip, "--no-deps", "--no-index", "--target", site, wheel], check=True)
+        # the course's dependencies from this environment, after the wheel
+        Path(site, "zz_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+        return {"wheel": str(wheel), "venv": str(venv), "python": str(python), "site": str(site)}
+
+    made = {k: Path(v) for k, v in once_per_run(tmp_path_factory, "wheel", make).items()}
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["MPLBACKEND"] = "Agg"
+    return WheelEnv(**made, env=env)

@@ -763,13 +763,11 @@ def test_the_instructor_edition_meets_wcag_21_aa(built_book: Path, browser) -> N
     execution cache of the student edition built for this run (``built_book``): no chapter runs
     again, and the build costs the writing of the pages only.
     """
-    import functools
     import shutil
     import subprocess
-    import threading
-    from http.server import ThreadingHTTPServer
 
-    from conftest import _QuietHandler, jupyter_book
+    from conftest import jupyter_book
+    from pdf_print import serve
 
     cache = INSTRUCTOR / "_build" / ".jupyter_cache"
     shutil.rmtree(cache, ignore_errors=True)
@@ -785,12 +783,9 @@ def test_the_instructor_edition_meets_wcag_21_aa(built_book: Path, browser) -> N
     )
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
     html = INSTRUCTOR / "_build" / "html"
-    handler = functools.partial(_QuietHandler, directory=str(html))
-    server = ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
     found = {}
-    try:
-        base = f"http://127.0.0.1:{server.server_address[1]}"
+    with serve(html) as url:
+        base = url.rstrip("/")
         for page in PAGES:
             for width in (1280, 390):
                 context, tab = _open_local(browser, base, page, width)
@@ -807,7 +802,4 @@ def test_the_instructor_edition_meets_wcag_21_aa(built_book: Path, browser) -> N
                     found[f"{page} at {width} px"] = [
                         f"{v['id']} ({v['count']}): {v['where']}" for v in violations
                     ] + [f"picture without words: {s}" for s in silent]
-    finally:
-        server.shutdown()
-        server.server_close()
     assert not found, "instructor edition: " + "\n".join(f"{k}: {v}" for k, v in found.items())

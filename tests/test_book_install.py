@@ -3,7 +3,8 @@
 The built book is served on 127.0.0.1. The package's wheel and every page's notebook are
 downloaded from it over HTTP, as a browser saves them; the commands the introduction shows (read
 from the built page) install the wheel into a new virtual environment; every notebook then runs
-there from top to bottom, in a fresh folder, importing the package from the new environment.
+there from top to bottom, in a fresh folder, importing the package from the new environment; a
+lab's notebook (its student version) runs with every check saying what is still missing.
 
 Offline, the packages the wheel asks for (NumPy ... ipywidgets, JupyterLab) come from the test's
 own environment, the one the lock installed: a folder of links to its installed distributions,
@@ -27,7 +28,10 @@ import urllib.request
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import nbformat
 import pytest
+from lab_outputs import assert_checks_say_what_is_missing
+from venvs import new_venv
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "_ext"))
@@ -122,14 +126,7 @@ def student(built_book: Path, book_server: str, tmp_path_factory) -> dict:
                 target.write_bytes(_get(url))
                 notebooks.append(target)
     env_dir = base / "env"
-    subprocess.run([sys.executable, "-m", "venv", env_dir], check=True, timeout=300)
-    python = env_dir / "bin" / "python"
-    purelib = subprocess.run(
-        [python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout.strip()
+    python, purelib = new_venv(env_dir, pip=True)  # pip: the introduction's commands use it
     overlay = _overlay(base / "lock")
     Path(purelib, "uio_teach_test_lock.pth").write_text(f"{overlay}\n", encoding="utf-8")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
@@ -210,3 +207,9 @@ def test_every_chapter_and_lab_notebook_runs_from_the_installed_wheel(student: d
         where = json.loads(proc.stdout.strip().splitlines()[-1])
         assert Path(where["prefix"]) == student["env_dir"], (notebook.name, where)
         assert Path(where["package"]).is_relative_to(student["env_dir"]), (notebook.name, where)
+    # a lab's notebook is its student version, as `uio-teach labs` writes it with the course's
+    # numbers (test_labs.py runs the solution version): every check says what is still missing
+    for notebook in notebooks:
+        if notebook.stem.startswith("lab_"):
+            ran = nbformat.read(notebook.with_suffix(".run.ipynb"), as_version=4)
+            assert_checks_say_what_is_missing(ran)

@@ -1,4 +1,6 @@
-"""Feedback that teaches without answering: no message of a check gives a solution away.
+"""The three labs' catalogues of answers (``test_catalogue_<lab>.py``), and feedback that
+teaches without answering: every wrong answer fails with a message that names the mistake, every
+right but different answer passes, and no message of a check gives a solution away.
 
 Every message the three lab catalogues produce (wrong answers and right-but-different ones) is
 scanned for code that computes a graded quantity (a solution line such as a pseudo-inverse or a
@@ -18,6 +20,10 @@ import test_catalogue_missile as missile
 import test_catalogue_pa9 as pa9
 
 LABS = {"pa9": pa9, "case_study": case_study, "missile": missile}
+# the least each catalogue holds: wrong answers, right but different ones
+SIZES = {"pa9": (65, 14), "case_study": (45, 10), "missile": (55, 9)}
+WRONG = [(lab, name) for lab, module in LABS.items() for name in module.CATALOGUE]
+RIGHT = [(lab, name) for lab, module in LABS.items() for name in module.RIGHT_BUT_DIFFERENT]
 
 # code that computes a graded quantity: a matrix product, a call of a numerical routine, or an
 # assignment from a library call
@@ -31,17 +37,21 @@ NUMBER = re.compile(r"(?<![\w.\[])-?\d+\.\d+(?:e[-+]?\d+)?|(?<![\w.\[])-?\d+e[-+
 
 
 @functools.cache
-def messages(lab: str) -> list[tuple[str, bool | None, str]]:
-    """Every message of ``lab``'s catalogue, computed on first use (not at collection)."""
+def result(lab: str, name: str):
+    """The check's result on an answer of ``lab``'s catalogue (wrong, or right but different),
+    computed on first use (not at collection), once for every test here."""
     module = LABS[lab]
-    out = []
-    for name, (make, _) in module.CATALOGUE.items():
-        for ok, msg in make().items:
-            out.append((name, ok, msg))
-    for name, make in getattr(module, "RIGHT_BUT_DIFFERENT", {}).items():
-        for ok, msg in make().items:
-            out.append((name, ok, msg))
-    return out
+    if name in module.CATALOGUE:
+        return module.CATALOGUE[name][0]()
+    return module.RIGHT_BUT_DIFFERENT[name]()
+
+
+@functools.cache
+def messages(lab: str) -> list[tuple[str, bool | None, str]]:
+    """Every message of ``lab``'s catalogue."""
+    module = LABS[lab]
+    names = [*module.CATALOGUE, *module.RIGHT_BUT_DIFFERENT]
+    return [(name, ok, msg) for name in names for ok, msg in result(lab, name).items]
 
 
 def expected_values(lab: str) -> np.ndarray:
@@ -60,6 +70,26 @@ def expected_values(lab: str) -> np.ndarray:
 def significant(text: str) -> int:
     digits = re.sub(r"e[-+]?\d+$", "", text).lstrip("-").replace(".", "").lstrip("0")
     return len(digits)
+
+
+@pytest.mark.parametrize(("lab", "name"), WRONG, ids=[f"{lab}: {name}" for lab, name in WRONG])
+def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(lab, name):
+    gist = LABS[lab].CATALOGUE[name][1]
+    got = result(lab, name)
+    assert not got.passed, f"{name}: passed\n{got}"
+    assert any(gist in msg for msg in got.failures), f"{name}: expected {gist!r}\n{got}"
+
+
+@pytest.mark.parametrize(("lab", "name"), RIGHT, ids=[f"{lab}: {name}" for lab, name in RIGHT])
+def test_a_right_but_different_answer_passes(lab, name):
+    got = result(lab, name)
+    assert got.passed, f"{name}: failed\n{got}"
+
+
+@pytest.mark.parametrize("lab", list(LABS))
+def test_the_catalogue_is_large_enough(lab):
+    wrong, right = SIZES[lab]
+    assert len(LABS[lab].CATALOGUE) >= wrong and len(LABS[lab].RIGHT_BUT_DIFFERENT) >= right
 
 
 @pytest.mark.parametrize("lab", list(LABS))
@@ -99,11 +129,11 @@ def test_no_catch_time_failure_names_a_time():
     """The expected catch times are not in any ✗ (typing them in would pass the check)."""
     times = np.array(list(missile.CATCH.values()))
     h = missile.T[1] - missile.T[0]
-    for name, (make, _) in missile.CATALOGUE.items():
-        result = make()
-        if result.check_id != "missile.catch_times":
+    for name in missile.CATALOGUE:
+        got = result("missile", name)
+        if got.check_id != "missile.catch_times":
             continue
-        for msg in result.failures:
+        for msg in got.failures:
             for text in NUMBER.findall(msg):
                 x = float(text)
                 assert not np.any(np.abs(times - x) <= 1.5 * h), f"{name}: {text} in {msg}"

@@ -1,10 +1,12 @@
-"""A catalogue of wrong answers to the missile lab: each gets a ✗ that names the mistake."""
+"""A catalogue of wrong answers to the missile lab: each gets a ✗ that names the mistake.
+
+``test_catalogue_feedback.py`` runs every entry (and the right but different answers): this
+module holds the catalogue and the right answer."""
 
 from __future__ import annotations
 
 import matplotlib
 import numpy as np
-import pytest
 from matplotlib.figure import Figure
 from tolerance import assert_same_run
 
@@ -335,24 +337,6 @@ RIGHT_BUT_DIFFERENT = {
     ),
     "rms as a list": lambda: checks.missile_noise(list(RMS), NOISY, sigma=SIGMA, seed=SEED),
 }
-
-
-@pytest.mark.parametrize("name", list(RIGHT_BUT_DIFFERENT))
-def test_a_right_but_different_answer_passes(name):
-    result = RIGHT_BUT_DIFFERENT[name]()
-    assert result.passed, f"{name}: failed\n{result}"
-
-
-def test_the_catalogue_is_large_enough():
-    assert len(CATALOGUE) >= 55 and len(RIGHT_BUT_DIFFERENT) >= 9
-
-
-@pytest.mark.parametrize("name", list(CATALOGUE))
-def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
-    make, gist = CATALOGUE[name]
-    result = make()
-    assert not result.passed, f"{name}: passed\n{result}"
-    assert any(gist in msg for msg in result.failures), f"{name}: expected {gist!r}\n{result}"
 
 
 def test_the_right_answer_passes_every_check():

@@ -2,14 +2,14 @@
 
 Every entry is what a lab group could hand in (a matrix left out, a sign flipped, poles other
 than the asked ones, a figure with the wrong curves in a panel, ...) with the gist of the message
-the check must give. The right answer passes every check.
+the check must give (``test_catalogue_feedback.py`` runs every entry, and the right but
+different answers). The right answer passes every check.
 """
 
 from __future__ import annotations
 
 import control as ct
 import numpy as np
-import pytest
 from matplotlib.figure import Figure
 
 import uio_teach as ut
@@ -421,24 +421,6 @@ RIGHT_BUT_DIFFERENT = {
     "requirement 4 without the d panel": lambda: steps_plot(steps_figure(d_panel=False)),
     "the observer built with ut.UIO from the book's H": lambda: simulation(sim(OBS_OTHER_K1)),
 }
-
-
-@pytest.mark.parametrize("name", list(RIGHT_BUT_DIFFERENT))
-def test_a_right_but_different_answer_passes(name):
-    result = RIGHT_BUT_DIFFERENT[name]()
-    assert result.passed, f"{name}: failed\n{result}"
-
-
-def test_the_catalogue_is_large_enough():
-    assert len(CATALOGUE) >= 65 and len(RIGHT_BUT_DIFFERENT) >= 14
-
-
-@pytest.mark.parametrize("name", list(CATALOGUE))
-def test_a_wrong_answer_fails_with_a_message_that_names_the_mistake(name):
-    make, gist = CATALOGUE[name]
-    result = make()
-    assert not result.passed, f"{name}: passed\n{result}"
-    assert any(gist in msg for msg in result.failures), f"{name}: expected {gist!r}\n{result}"
 
 
 def test_the_right_answer_passes_every_check():

@@ -55,19 +55,26 @@ def assert_same(actual, expected, *, gain=1.0):
 # frames equal what simulate returns -------------------------------------------------------
 
 
+def pa9_run(d) -> tuple[ut.Plant, np.ndarray, dict]:
+    """The PA9 explorer's run, written out for ``simulate``: the plant, the time points and the
+    inputs (a known input, the disturbance ``d``, the plant's initial state)."""
+    plant = ut.examples.pa9()
+    t = np.linspace(0, 10, 1001)
+    kwargs = dict(
+        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
+        d=d,
+        initial_state=[1.0, -1.0, 0.5],
+    )
+    return plant, t, kwargs
+
+
 def test_pa9_frame_equals_direct_simulation():
     sc = scenario_of("pa9")
     s = sc.defaults.replace(
         poles=(-1.5 + 2j, -4.0), amplitude=2.0, frequency=3.0, start="zero observer state"
     )
     frame = compute_frame(sc, s)
-    plant = ut.examples.pa9()
-    t = np.linspace(0, 10, 1001)
-    kwargs = dict(
-        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
-        d=ut.signals.sinusoid(2.0, 3.0),
-        initial_state=[1.0, -1.0, 0.5],
-    )
+    plant, t, kwargs = pa9_run(d=ut.signals.sinusoid(2.0, 3.0))
     uio = ut.simulate(plant, ut.design_uio(plant, poles=[-1.5 + 2j, -1.5 - 2j, -4]), t, **kwargs)
     lb = ut.simulate(
         plant, ut.design_luenberger(plant, poles=[-1.5 + 2j, -1.5 - 2j, -4]), t, **kwargs

@@ -4,19 +4,25 @@ whether the package is a checkout or a wheel installed in a virtual environment.
 
 One small class (five hand-ins, four of which run) is graded through the command line as a
 whole, then as two shards listed in another order, and merged: every file written must be the
-same. Its hand-ins: the lab's solution under a Canvas bulk-download name marked late, a notebook
-with a 255-byte name that walks every readable path of the sandbox and prints past the output
-cap, a notebook of format 3, a disguised copy of it from another group, and a file that is not a
+same. The shards give each notebook they run the outcome of its kernel run in the whole run
+(the same prepared notebook, recorded there): what a shard adds to the whole run is which
+hand-ins it grades, what it reads of the others, the checking of the answers, its gradebook and
+the merge, all of which run as they are; running the same notebooks in a kernel again would
+check only that a notebook gives its answers twice.
+
+Its hand-ins: the lab's solution under a Canvas bulk-download name marked late, a notebook with a
+255-byte name that walks every readable path of the sandbox and prints past the output cap, a
+notebook of format 3, a disguised copy of it from another group, and a file that is not a
 notebook. No test here decides on how long anything took.
 """
 
 from __future__ import annotations
 
 import contextlib
+import copy
 import csv
 import io
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -146,11 +152,30 @@ def handed_in(tmp_path_factory) -> Path:
     return folder
 
 
-def run(*args: str) -> tuple[int, str]:
+def _key(nb) -> str:
+    """A prepared notebook's cells (their kinds and sources; each copy's cells get new ids)."""
+    return json.dumps([[cell.cell_type, cell.source] for cell in nb.cells])
+
+
+def run(*args: str, outcomes: dict | None = None, replay: bool = False) -> tuple[int, str]:
+    """The command line; every kernel run of a hand-in recorded in ``outcomes`` (by its prepared
+    notebook), or with ``replay`` given the outcome recorded there instead of a new run."""
     err = io.StringIO()
+    real = grade.run_notebook
+
+    def run_notebook(nb, folder, **kwargs):
+        if replay and _key(nb) in outcomes:
+            outcomes["replayed"] += 1
+            return copy.deepcopy(outcomes[_key(nb)])
+        outcome = real(nb, folder, **kwargs)
+        if outcomes is not None and not replay:
+            outcomes[_key(nb)] = copy.deepcopy(outcome)
+        return outcome
+
     with pytest.MonkeyPatch.context() as mp:
         # the output cap lowered so a 3 MB print crosses it; generous time limits
         mp.setattr(grade, "Limits", lambda **kw: Limits(output_mb=1, processes=128, **kw))
+        mp.setattr(grade, "run_notebook", run_notebook)
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             code = cli.main([*args, "--timeout", "300", "--cell-timeout", "150", "-q"])
     return code, err.getvalue()
@@ -164,12 +189,15 @@ def graded(sandbox_here, handed_in) -> dict:
     roster = str(base / "groups.csv")
     files = sorted(str(p) for p in handed_in.iterdir())
     whole = base / "whole" / "grades.csv"
-    code, err = run("grade", *files, "--out", str(whole), "--roster", roster, "--jobs", "2")
+    outcomes = {"replayed": 0}
+    code, err = run(
+        "grade", *files, "--out", str(whole), "--roster", roster, "--jobs", "2", outcomes=outcomes
+    )
     shards = []
     for k in (1, 2):
         out = base / "shards" / f"grades_{k}.csv"
         args = ["grade", *files[::-1], "--out", str(out), "--roster", roster, "--shard", f"{k}/2"]
-        assert run(*args)[0] == 0
+        assert run(*args, outcomes=outcomes, replay=True)[0] == 0
         shards.append(out)
     merged = base / "merged" / "grades.csv"
     merge_code, merge_err = run_merge(shards[::-1], merged)
@@ -184,6 +212,7 @@ def graded(sandbox_here, handed_in) -> dict:
         "merged": merged,
         "merge": (merge_code, merge_err),
         "folder": handed_in,
+        "replayed": outcomes["replayed"],
     }
 
 
@@ -208,6 +237,7 @@ def row(graded: dict, name: str) -> dict[str, str]:
 
 def test_merged_shards_are_the_whole_run(graded):
     assert graded["code"] == 0 and graded["merge"][0] == 0, graded["merge"][1]
+    assert graded["replayed"] == 4  # every notebook the shards ran, as prepared in the whole run
     shard_rows = [len(read_gradebook(s)[1]) for s in graded["shards"]]
     assert sum(shard_rows) == 5 and all(shard_rows)  # each hand-in in exactly one shard
     assert {shard_of(f, 2) for f in graded["rows"]} == {1, 2}
@@ -280,46 +310,12 @@ def test_a_failure_of_the_runner_is_the_graders_not_the_notebooks(tmp_path, monk
 @pytest.mark.wheel
 @pytest.mark.subprocess
 def test_no_course_file_is_readable_in_the_sandbox_of_a_wheel_in_a_venv(
-    sandbox_here, tmp_path, handed_in
+    sandbox_here, tmp_path, handed_in, wheel_env
 ):
     """The wheel carries the lab chapters (for `uio-teach labs`): installed in a virtual
     environment that the sandbox mounts, they must still be out of reach."""
-    import shutil
-    import sysconfig
-
-    src = tmp_path / "src"
-    for name in ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]:
-        path = ROOT / name
-        if path.is_dir():
-            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            src.mkdir(exist_ok=True)
-            shutil.copy2(path, src / name)
-    for name in ["_toc.yml", "references.bib", "LICENSE", "LICENSE-BOOK.md"]:
-        shutil.copy2(ROOT / name, src / name)
-    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
-    subprocess.run(
-        [*pip, "wheel", "--no-deps", "--no-build-isolation", "-w", tmp_path / "dist", src],
-        check=True,
-        timeout=600,
-    )
-    (wheel,) = (tmp_path / "dist").glob("uio_teach-*.whl")
-    venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", "--without-pip", venv], check=True)
-    python = venv / "bin" / "python"
-    site = Path(
-        subprocess.run(
-            [python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout.strip()
-    )
-    subprocess.run([*pip, "install", "--no-deps", "--target", site, wheel], check=True)
-    # the course's dependencies from this environment, after the wheel
-    (site / "zz_dependencies.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    python, site, env = wheel_env.python, wheel_env.site, wheel_env.env
     assert (site / "uio_teach" / "_course" / "book" / "lab_pa9.md").is_file()
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     out = tmp_path / "marks" / "grades.csv"
     proc = subprocess.run(
         [python, "-m", "uio_teach", "grade", str(handed_in / LONG), "--out", str(out), "-q"],

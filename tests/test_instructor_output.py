@@ -564,11 +564,16 @@ See {ref}`sec-demo-instructor`.
 """
 
 
-def build_edition(tmp_path: Path, edition: str) -> subprocess.CompletedProcess:
-    """Build LAB_PAGE with Sphinx (myst-nb, sphinx-exercise, the book's editions extension)."""
+def build_edition(
+    tmp_path: Path, edition: str, pages: dict[str, str] | None = None, *flags: str
+) -> subprocess.CompletedProcess:
+    """Build ``pages`` (file name -> text; LAB_PAGE as ``index.md`` by default) with Sphinx
+    (myst-nb, sphinx-exercise, the book's editions extension), warnings as errors, ``flags``
+    added."""
     src = tmp_path / "src"
     src.mkdir(exist_ok=True)
-    (src / "index.md").write_text(LAB_PAGE)
+    for name, text in (pages or {"index.md": LAB_PAGE}).items():
+        (src / name).write_text(text)
     (src / "conf.py").write_text(
         "import sys\n"
         f"sys.path.insert(0, {str(ROOT / '_ext')!r})\n"
@@ -577,7 +582,7 @@ def build_edition(tmp_path: Path, edition: str) -> subprocess.CompletedProcess:
     )
     env = dict(os.environ, UIO_TEACH_EDITION=edition)
     return subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "-E", "-q", "-b", "html", str(src),
+        [sys.executable, "-m", "sphinx", "-W", *flags, "-E", "-q", "-b", "html", str(src),
          str(tmp_path / "html")],
         capture_output=True, text=True, env=env, check=False,
     )  # fmt: skip
@@ -648,22 +653,7 @@ def test_a_reference_into_the_instructors_page_reads_as_its_title_in_the_student
     """The instructors' page is a stub for students: its sections go with their labels, and a
     reference to one from another page is its title in plain text (no warning under -W -n); a
     tutors' section goes with the label in front of its heading."""
-    src = tmp_path / "src"
-    src.mkdir()
-    for name, text in STUB_BOOK.items():
-        (src / name).write_text(text)
-    (src / "conf.py").write_text(
-        "import sys\n"
-        f"sys.path.insert(0, {str(ROOT / '_ext')!r})\n"
-        "extensions = ['myst_nb', 'sphinx_exercise', 'editions']\n"
-        "nb_execution_mode = 'off'\n"
-    )
-    env = dict(os.environ, UIO_TEACH_EDITION=edition)
-    proc = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "-n", "-E", "-q", "-b", "html", str(src),
-         str(tmp_path / "html")],
-        capture_output=True, text=True, env=env, check=False,
-    )  # fmt: skip
+    proc = build_edition(tmp_path, edition, STUB_BOOK, "-n")
     assert proc.returncode == 0, proc.stderr
     index = (tmp_path / "html" / "index.html").read_text(encoding="utf-8")
     stub = (tmp_path / "html" / "instructors.html").read_text(encoding="utf-8")

@@ -13,6 +13,7 @@ import jupytext
 import nbformat
 import numpy as np
 import pytest
+from lab_outputs import tags
 
 import uio_teach as ut
 from uio_teach import checks
@@ -23,10 +24,6 @@ from uio_teach.worked.missile import MissileParams
 from uio_teach.worked.pa9 import PA9Params
 
 BOOK = labs.default_book_dir()
-
-
-def tags(cell) -> list[str]:
-    return list(cell.metadata.get("tags", []))
 
 
 def params_cell(nb):

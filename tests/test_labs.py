@@ -1,8 +1,10 @@
 """`uio-teach labs`: student and solution notebooks from one MyST lab chapter.
 
 The student notebook runs from top to bottom, and each check cell says what is still
-missing; the solution notebook runs and every check passes. Both are valid nbformat 4
-notebooks with empty outputs and no MyST syntax left that Jupyter would show raw.
+missing (with a group's numbers here; with the course's, it is the notebook the built book
+offers, which ``test_book_install.py`` runs); the solution notebook runs and every check
+passes. Both are valid nbformat 4 notebooks with empty outputs and no MyST syntax left that
+Jupyter would show raw.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import jupytext
 import nbclient
 import nbformat
 import pytest
+from lab_outputs import assert_checks_say_what_is_missing, assert_every_check_passes, tags
 
 from uio_teach.instructor import cli, labs
 from uio_teach.instructor.config import FigureConfig, load_config
@@ -26,22 +29,6 @@ LABS = labs.find_labs(BOOK)
 CELL_TIMEOUT = 300
 
 pytestmark = pytest.mark.skipif(not LABS, reason="no lab chapter (book/*lab*.md) yet")
-
-
-def tags(cell) -> list[str]:
-    return list(cell.metadata.get("tags", []))
-
-
-def text_output(cell) -> str:
-    parts = []
-    for out in cell.get("outputs", []):
-        if out.output_type == "stream":
-            parts.append(out.text)
-        elif out.output_type in ("execute_result", "display_data"):
-            parts.append(out.data.get("text/plain", ""))
-        elif out.output_type == "error":
-            parts.append("\n".join(out.traceback))
-    return "\n".join(parts)
 
 
 def execute(nb, folder: Path):
@@ -217,27 +204,10 @@ def test_no_raw_myst_is_left_in_the_markdown(lab, version):
 
 @pytest.mark.book
 @pytest.mark.kernel
-def test_the_student_version_runs_and_its_checks_say_what_is_missing(lab, tmp_path):
-    nb = execute(lab["student"], tmp_path)  # no cell may fail: TODO cells define placeholders
-    checks = [c for c in nb.cells if "check" in tags(c)]
-    assert checks
-    for cell in checks:
-        out = text_output(cell)
-        assert "Traceback" not in out and "Error" not in out.split("\n")[0]
-        assert "✗" in out and "checks failed" in out, out
-        assert "missing" in out or "got None" in out or "got NoneType" in out, out
-
-
-@pytest.mark.book
-@pytest.mark.kernel
 def test_the_solution_version_runs_and_every_check_passes(lab, tmp_path):
-    nb = execute(lab["solution"], tmp_path)
-    checks = [c for c in nb.cells if "check" in tags(c)]
-    assert checks
-    for cell in checks:
-        out = text_output(cell)
-        assert re.search(r"All \d+ checks passed\.", out), f"{cell.source}\n{out}"
-        assert "✗" not in out
+    """(Its student version, with the same numbers, is the notebook the book offers:
+    ``test_book_install.py`` runs it, and its checks say what is missing.)"""
+    assert_every_check_passes(execute(lab["solution"], tmp_path))
 
 
 # the conversion, on a small made-up lab ---------------------------------------------------------
@@ -488,13 +458,10 @@ def test_a_variant_solves_with_every_check_passing_and_its_student_form_runs(
     lab_id, variant_dir, tmp_path
 ):
     solution = execute(read(variant_dir / lab_id / "solution" / f"{lab_id}_g02.ipynb"), tmp_path)
-    for cell in solution.cells:
-        if "check" in tags(cell):
-            assert re.search(r"All \d+ checks passed\.", text_output(cell)), text_output(cell)
+    assert_every_check_passes(solution)
+    # no cell may fail: TODO cells define placeholders
     student = execute(read(variant_dir / lab_id / "student" / f"{lab_id}_g02.ipynb"), tmp_path)
-    for cell in student.cells:
-        if "check" in tags(cell):
-            assert "✗" in text_output(cell) and "Traceback" not in text_output(cell)
+    assert_checks_say_what_is_missing(student)
 
 
 def test_a_source_that_is_not_a_lab_is_a_usage_error(tmp_path, capsys):
@@ -631,9 +598,4 @@ def test_every_config_key_reaches_a_lab_that_reads_it_or_the_help_says_why_not(
 def test_a_term_configs_solution_runs_with_every_check_passing(term_labs, lab_id, tmp_path):
     """The term's numbers (TERM_CHANGES) run through the lab: its checks pass with them."""
     nb = nbformat.read(term_labs["results"][lab_id].solution, as_version=4)
-    nb = execute(nb, tmp_path)
-    checks = [c for c in nb.cells if "check" in tags(c)]
-    assert checks
-    for cell in checks:
-        out = text_output(cell)
-        assert re.search(r"All \d+ checks passed\.", out), f"{cell.source}\n{out}"
+    assert_every_check_passes(execute(nb, tmp_path))

@@ -6,9 +6,7 @@ from __future__ import annotations
 import ast
 import importlib
 import importlib.metadata
-import os
 import re
-import shutil
 import subprocess
 import sys
 import tomllib
@@ -125,45 +123,26 @@ def test_the_lock_holds_every_pin_at_its_version_with_hashes():
 
 # the wheel, installed away from the checkout ---------------------------------------------------
 
-SOURCES = ["uio_teach", "book", "setup.py", "pyproject.toml", "MANIFEST.in", "README.md"]
-SOURCES += ["_toc.yml", "references.bib", "LICENSE", "LICENSE-BOOK.md"]
-
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory):
-    """The wheel built from a copy of the sources, unpacked into a folder of its own."""
-    base = tmp_path_factory.mktemp("wheel")
-    src = base / "src"
-    for name in SOURCES:
-        path = ROOT / name
-        if path.is_dir():
-            shutil.copytree(path, src / name, ignore=shutil.ignore_patterns("__pycache__"))
-        else:
-            src.mkdir(exist_ok=True)
-            shutil.copy2(path, src / name)
-    dist, target = base / "dist", base / "site"
-    pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
-    subprocess.run(
-        [*pip, "wheel", "--no-deps", "--no-build-isolation", "-w", dist, src],
-        check=True,
-        timeout=600,
-    )
-    (wheel,) = dist.glob("uio_teach-*.whl")
-    subprocess.run([*pip, "install", "--no-deps", "--target", target, wheel], check=True)
-    # Only the wheel's files and the environment's dependencies are importable: not the
-    # checkout (the current folder is a fresh one, PYTHONPATH names the unpacked wheel).
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
-    env["PYTHONPATH"] = str(target)
-    env["MPLBACKEND"] = "Agg"
-    work = base / "elsewhere"
-    work.mkdir()
-    return target, work, env
+def installed(wheel_env, tmp_path_factory):
+    """The run's wheel (``wheel_env``: built as the book builds it, installed in a virtual
+    environment), run from a fresh folder: only the wheel's files and the environment's
+    dependencies are importable, not the checkout."""
+    work = tmp_path_factory.mktemp("elsewhere")
+    return wheel_env.site, work, wheel_env
 
 
 def _run(args, installed, **kwargs):
-    _, work, env = installed
+    _, work, wheel_env = installed
     proc = subprocess.run(
-        args, cwd=work, env=env, capture_output=True, text=True, timeout=600, **kwargs
+        [wheel_env.python, *args],
+        cwd=work,
+        env=wheel_env.env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        **kwargs,
     )
     assert proc.returncode == 0, proc.stderr
     return proc
@@ -173,7 +152,7 @@ def _run(args, installed, **kwargs):
 @pytest.mark.wheel
 def test_the_wheel_is_the_package_imported(installed):
     target = installed[0]
-    proc = _run([sys.executable, "-c", "import uio_teach; print(uio_teach.__file__)"], installed)
+    proc = _run(["-c", "import uio_teach; print(uio_teach.__file__)"], installed)
     assert Path(proc.stdout.strip()).is_relative_to(target)
     assert (target / "uio_teach" / "_course" / "book" / "lab_pa9.md").is_file()
     assert (target / "uio_teach" / "_course" / "references.bib").is_file()
@@ -184,7 +163,7 @@ def test_the_wheel_is_the_package_imported(installed):
 def test_the_wheel_lists_the_figures_from_any_folder(installed):
     target = installed[0]
     script = target / "bin" / "uio-teach"
-    proc = _run([sys.executable, script, "figures", "--list"], installed)
+    proc = _run([script, "figures", "--list"], installed)
     assert proc.stdout.split()[0] == "pa9_sine"
 
 
@@ -195,7 +174,7 @@ def test_the_wheel_writes_the_lab_notebooks_from_any_folder(installed):
 
     chapter = BookIndex.from_book(ROOT / "book").chapters["lab_pa9"]
     target, work, _ = installed
-    _run([sys.executable, target / "bin" / "uio-teach", "labs", "--out", "labs", "-q"], installed)
+    _run([target / "bin" / "uio-teach", "labs", "--out", "labs", "-q"], installed)
     for version in ("student", "solution"):
         notebooks = sorted((work / "labs" / version).glob("*.ipynb"))
         assert [p.name for p in notebooks] == [
@@ -215,7 +194,7 @@ def test_the_wheel_shows_the_pa9_explorer(installed):
         "assert ex.frame is not None and 'text/html' in ex._repr_mimebundle_(); "
         "print(ut.__file__)"
     )
-    proc = _run([sys.executable, "-c", code], installed)
+    proc = _run(["-c", code], installed)
     assert Path(proc.stdout.strip()).is_relative_to(installed[0])
 
 

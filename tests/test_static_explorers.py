@@ -14,11 +14,10 @@ from __future__ import annotations
 
 import functools
 import itertools
-import os
-import threading
 from pathlib import Path
 
 import pytest
+from browsers import in_chromium
 
 import uio_teach as ut
 from uio_teach.explorers import ExplorerFigure, make_scenario, scenario_of
@@ -30,8 +29,6 @@ from uio_teach.explorers.static import (
 )
 from uio_teach.worked import WORKED
 
-CHROMIUM = Path("/usr/bin/chromium")
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
 MAX_PAGE = 2 * 1024 * 1024
 MAX_BUILT_PAGE = 512 * 1024  # a page of the book with an explorer, its pictures files
 
@@ -48,39 +45,6 @@ SCENARIOS = {
     **{name: functools.partial(scenario_of, name) for name in WORKED},
     "existence": _own,
 }
-
-
-def _in_chromium(work) -> None:
-    """Run ``work(browser)`` in headless Chromium, in a thread of its own (an earlier test may
-    leave an asyncio loop running in the main thread, where Playwright's sync API will not
-    start)."""
-    if not CHROMIUM.exists():
-        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(message, pytrace=False)
-        pytest.skip(message)
-    from playwright.sync_api import sync_playwright
-
-    failure: list[BaseException] = []
-
-    def drive() -> None:
-        try:
-            with sync_playwright() as playwright:
-                browser = playwright.chromium.launch(
-                    executable_path=str(CHROMIUM), args=ARGS, headless=True
-                )
-                try:
-                    work(browser)
-                finally:
-                    browser.close()
-        except BaseException as exc:  # re-raised in the test's thread
-            failure.append(exc)
-
-    thread = threading.Thread(target=drive)
-    thread.start()
-    thread.join()
-    if failure:
-        raise failure[0]
 
 
 _STATE_JS = """() => {
@@ -125,7 +89,7 @@ def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
                 seen.append(state)
         page.close()
 
-    _in_chromium(work)
+    in_chromium(work)
     assert len(seen) == values * kinds
     for key in ("src", "current", "alt", "caption"):
         assert len({s[key] for s in seen}) == len(seen), f"{key} repeats between positions"
@@ -310,7 +274,7 @@ def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
         measured["seen"] = _phone_walk(page, 0, name, kinds)
         context.close()
 
-    _in_chromium(work)
+    in_chromium(work)
     first = measured["seen"][0]
     print(
         f"{name} at 390 px: explorer {first['box']['width']:.0f} px, picture "
@@ -336,7 +300,7 @@ def test_wide_layout_is_kept(name, tmp_path):
         measured["m"] = page.evaluate(_LAYOUT_JS, 0)
         context.close()
 
-    _in_chromium(work)
+    in_chromium(work)
     m = measured["m"]
     assert m["box"]["width"] == 780 and m["img"]["width"] == 780, m
     assert m["natural"] > m["naturalHeight"]  # the wide picture
@@ -368,7 +332,7 @@ def test_built_explorer_pages_read_on_a_phone(chapter, built_book):
             seen[k] = _phone_walk(page, k, f"{chapter} explorer {k + 1}", kinds)[0]
         context.close()
 
-    _in_chromium(work)
+    in_chromium(work)
     for k, m in seen.items():
         print(
             f"{chapter} explorer {k + 1} at 390 px: column {m['column']:.0f} px, picture "
@@ -427,7 +391,7 @@ def test_controls_work_from_the_keyboard_with_focus_labels_and_announcements(nam
             seen.append(page.evaluate(_CONTROLS_JS, 0))
         context.close()
 
-    _in_chromium(work)
+    in_chromium(work)
     first, moved = seen[0], seen[1]
     assert first["group"].startswith("group ") and "explorer" in first["group"], first
     for state in seen:

@@ -8,16 +8,15 @@ the slider swaps the displayed frame.
 
 from __future__ import annotations
 
-import concurrent.futures
-import os
 import re
 from html.parser import HTMLParser
-from pathlib import Path
 
 import numpy as np
 import pytest
+from browsers import in_chromium
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_explorers import pa9_run
 from tolerance import assert_rounding_close, size_of
 
 import uio_teach as ut
@@ -75,13 +74,7 @@ def test_pa9_pole_slider_redraws_with_what_simulate_returns():
     ex.controls["pole 1"].value = -4.0  # as a student's slider does
     after = ydata(ex, "uio.error")
     assert not np.allclose(before, after)
-    plant = ut.examples.pa9()
-    t = np.linspace(0, 10, 1001)
-    kwargs = dict(
-        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
-        d=ut.signals.sinusoid(1.0, 2.0),
-        initial_state=[1.0, -1.0, 0.5],
-    )
+    plant, t, kwargs = pa9_run(d=ut.signals.sinusoid(1.0, 2.0))
     obs = ut.design_uio(plant, poles=[-4, -2, -3])
     # the default start: a zero estimate, xhat(0) = z(0) + H y(0) = 0
     z0 = -obs.H @ plant.C @ np.array(kwargs["initial_state"])
@@ -103,19 +96,11 @@ def test_pa9_complex_pair_and_disturbance_controls():
     assert ex.controls["frequency"].layout.display == "none"
     assert ex.controls["period"].layout.display is None
     assert ex.settings.poles == (-3.0, -1 + 2j)
-    plant = ut.examples.pa9()
-    t = np.linspace(0, 10, 1001)
     rng = np.random.default_rng([0, 0])
     times = 1.5 * np.arange(8)
     d = ut.signals.piecewise_constant(times, 2.0 * rng.uniform(-1, 1, 8))
-    uio = ut.simulate(
-        plant,
-        ut.design_uio(plant, poles=[-3, -1 + 2j, -1 - 2j]),
-        t,
-        u=ut.signals.stack(ut.signals.step(1.0), ut.signals.sinusoid(0.5, 1.0)),
-        d=d,
-        initial_state=[1.0, -1.0, 0.5],
-    )
+    plant, t, kwargs = pa9_run(d=d)
+    uio = ut.simulate(plant, ut.design_uio(plant, poles=[-3, -1 + 2j, -1 - 2j]), t, **kwargs)
     assert_same(ex.figure.lines["d"][0].get_ydata(), d(t))
     assert_same(ydata(ex, "uio.error"), np.abs(uio.error))
     # a zero imaginary part is a double real pole
@@ -322,22 +307,12 @@ def test_static_rejects_bad_grids():
         static_explorer(scenario_of("pa9"), values=())
 
 
-CHROMIUM = Path("/usr/bin/chromium")
-
-
 SET_RANGE = "el => { el.value = 'VALUE'; el.dispatchEvent(new Event('input', {bubbles: true})); }"
 
 
 @pytest.mark.browser
 @pytest.mark.slow
 def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
-    if not CHROMIUM.exists():
-        message = f"chromium missing: {CHROMIUM} not found (apt-get install chromium)"
-        if os.environ.get("CI") == "true":
-            pytest.fail(message, pytrace=False)
-        pytest.skip(message)
-    from playwright.sync_api import sync_playwright
-
     page_file = tmp_path / "explorer.html"
     page_file.write_text(
         f"<!doctype html><html><body>{pa9_static.html}</body></html>", encoding="utf-8"
@@ -347,52 +322,40 @@ def test_static_slider_swaps_the_frame_in_chromium(tmp_path, pa9_static):
     requests: list[str] = []
     errors: list[str] = []
 
-    def drive() -> None:
-        # a thread of its own: earlier tests (notebook execution) may leave an asyncio
-        # loop running in the main thread, where playwright's sync API refuses to start
-        with sync_playwright() as pw:
-            browser = pw.chromium.launch(
-                executable_path=str(CHROMIUM),
-                args=["--headless", "--no-sandbox", "--disable-gpu"],
-                headless=True,
-            )
-            try:
-                tab = browser.new_page()
-                tab.on("request", lambda r: requests.append(r.url))
-                tab.on("pageerror", lambda exc: errors.append(str(exc)))
-                tab.goto(page_file.as_uri())
-                img = f"#{eid} img.uio-frame"
-                start = tab.get_attribute(img, "src")
-                assert start == frames[(3, 0)].data_url  # the default pole -1, sinusoid
+    def work(browser) -> None:
+        tab = browser.new_page()
+        tab.on("request", lambda r: requests.append(r.url))
+        tab.on("pageerror", lambda exc: errors.append(str(exc)))
+        tab.goto(page_file.as_uri())
+        img = f"#{eid} img.uio-frame"
+        start = tab.get_attribute(img, "src")
+        assert start == frames[(3, 0)].data_url  # the default pole -1, sinusoid
 
-                tab.eval_on_selector(
-                    f"#{eid} input[type=range]",
-                    SET_RANGE.replace("VALUE", "1"),
-                )
-                moved = tab.get_attribute(img, "src")
-                assert moved != start and moved == frames[(1, 0)].data_url
-                assert tab.inner_text(f"#{eid} output") == "-4"
-                assert tab.inner_text(f"#{eid} .uio-caption") == frames[(1, 0)].caption
-                assert tab.get_attribute(img, "alt") == frames[(1, 0)].alt
-                source = f"#{eid} source"  # the phone picture follows the slider too
-                assert tab.get_attribute(source, "srcset") == frames[(1, 0)].narrow_url
+        tab.eval_on_selector(
+            f"#{eid} input[type=range]",
+            SET_RANGE.replace("VALUE", "1"),
+        )
+        moved = tab.get_attribute(img, "src")
+        assert moved != start and moved == frames[(1, 0)].data_url
+        assert tab.inner_text(f"#{eid} output") == "-4"
+        assert tab.inner_text(f"#{eid} .uio-caption") == frames[(1, 0)].caption
+        assert tab.get_attribute(img, "alt") == frames[(1, 0)].alt
+        source = f"#{eid} source"  # the phone picture follows the slider too
+        assert tab.get_attribute(source, "srcset") == frames[(1, 0)].narrow_url
 
-                tab.select_option(f"#{eid} select", "1")  # random steps
-                assert tab.get_attribute(img, "src") == frames[(1, 1)].data_url
+        tab.select_option(f"#{eid} select", "1")  # random steps
+        assert tab.get_attribute(img, "src") == frames[(1, 1)].data_url
 
-                # the slider's right end is the pole map's right: the unstable pole 0.5
-                tab.eval_on_selector(
-                    f"#{eid} input[type=range]",
-                    SET_RANGE.replace("VALUE", "7"),
-                )
-                assert "unstable" in tab.inner_text(f"#{eid} .uio-caption")
-                natural = tab.eval_on_selector(img, "el => el.naturalWidth")
-                assert natural >= 1200
-            finally:
-                browser.close()
+        # the slider's right end is the pole map's right: the unstable pole 0.5
+        tab.eval_on_selector(
+            f"#{eid} input[type=range]",
+            SET_RANGE.replace("VALUE", "7"),
+        )
+        assert "unstable" in tab.inner_text(f"#{eid} .uio-caption")
+        natural = tab.eval_on_selector(img, "el => el.naturalWidth")
+        assert natural >= 1200
 
-    with concurrent.futures.ThreadPoolExecutor(1) as pool:
-        pool.submit(drive).result()
+    in_chromium(work)
     assert not errors, errors
     assert all(u.startswith(("file:", "data:")) for u in requests), requests
 
