@@ -186,7 +186,7 @@ def table(rows: list[dict], repeat: int) -> str:
         f"{_load()}.",
         "",
         "| case | `simulate` (ms) | `forced_response` (ms) | speed-up | max rel. difference "
-        "| `simulate`, all BLAS threads (ms) | wall-clock medians (ms) |",
+        "| `simulate`, all BLAS threads, wall clock (ms) | wall-clock medians (ms) |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for r in rows:
@@ -217,9 +217,12 @@ def table(rows: list[dict], repeat: int) -> str:
         "one-step matrices of the last few systems, as a notebook rerunning an observer does: "
         "the matrix exponential is computed in the first of the timed calls only. "
         "`simulate`'s time also includes what `forced_response` does not "
-        "compute: the measurements, estimates, error and residual. The last column shows "
-        "`simulate` without its one-thread BLAS limit: on 2 cores OpenBLAS's worker threads make "
-        "its small, thin products much slower. Timings on this shared virtual machine vary by "
+        "compute: the measurements, estimates, error and residual. The column before the last "
+        "shows `simulate` without its one-thread BLAS limit, in wall-clock time (best repeat), "
+        "to set beside the wall-clock medians: OpenBLAS's worker threads gain little or nothing "
+        "on these small, thin products on a quiet machine, and on a busy one they wait for "
+        "cores that other jobs hold, so `simulate` keeps BLAS to one thread. Timings on this "
+        "shared virtual machine vary by "
         "about 20 % from run to run (other jobs, and page faults when large arrays are "
         "allocated).",
         "",
