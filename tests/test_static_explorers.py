@@ -209,6 +209,14 @@ def _check_aspect(m: dict, where: str) -> None:
     assert shown == pytest.approx(drawn, abs=1 / m["img"]["width"]), (where, shown, drawn)
 
 
+_FRAME_SHOWN_JS = """
+(k) => {
+  const img = document.querySelectorAll(".uio-static-explorer")[k].querySelector("img.uio-frame");
+  return img.complete && img.naturalWidth > 0;
+}
+"""
+
+
 def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
     """Drive the k-th explorer as a reader would, by mouse and keyboard: slider to either end,
     the other disturbance type. Returns the states seen."""
@@ -216,12 +224,14 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
     root.scroll_into_view_if_needed()
     slider = root.locator("input[type=range]")
     top = int(slider.get_attribute("max"))
+    # the frame is a picture file the browser fetches when it comes into view (lazily)
+    page.wait_for_function(_FRAME_SHOWN_JS, arg=k)
     seen = [page.evaluate(_LAYOUT_JS, k)]
     _check_phone_layout(seen[0], where)
     box = slider.bounding_box()
     for x, want in ((2, 0), (box["width"] - 2, top)):
         slider.click(position={"x": x, "y": box["height"] / 2})
-        page.wait_for_function("() => [...document.images].every((i) => i.complete)")
+        page.wait_for_function(_FRAME_SHOWN_JS, arg=k)
         m = page.evaluate(_LAYOUT_JS, k)
         assert m["state"]["value"] == str(want), (where, m["state"]["value"], want)
         seen.append(m)
