@@ -237,10 +237,12 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
         seen.append(m)
     slider.focus()
     page.keyboard.press("ArrowLeft")
+    page.wait_for_function(_FRAME_SHOWN_JS, arg=k)
     seen.append(page.evaluate(_LAYOUT_JS, k))
     assert seen[-1]["state"]["value"] == str(top - 1), where
     if kinds > 1:
         root.locator("select").select_option(index=1 - int(root.locator("select").input_value()))
+        page.wait_for_function(_FRAME_SHOWN_JS, arg=k)
         seen.append(page.evaluate(_LAYOUT_JS, k))
     for m in seen:
         _check_phone_layout(m, where)
