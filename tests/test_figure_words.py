@@ -234,13 +234,17 @@ def test_line_look_reads_the_drawn_curve():
 
 @pytest.fixture(scope="module")
 def bank_figure():
-    pa9 = ut.examples.pa9()
-    plant = ut.Plant(pa9.A, np.eye(3), B=pa9.B, E=pa9.E)
-    detector = ut.design_uio(plant, poles=[-1, -2, -3])
-    t = np.linspace(0, 6, 601)
-    banks = [ut.design_uio_bank(plant, kind, poles=[-2, -3, -4]) for kind in ("actuator", "sensor")]
-    healthy = [ut.simulate_fault(plant, detector, t, noise=0.01, seed=k) for k in range(30)]
-    ths = [bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5) for bank in banks]
+    from fault_bank import bank_setting
+
+    s = bank_setting()
+    plant, detector, t, banks, healthy, ths = (
+        s.plant,
+        s.detector,
+        s.t,
+        s.banks,
+        s.healthy,
+        s.thresholds,
+    )
     runs = {
         f"{kind} {i + 1}": ut.simulate_fault(
             plant,

@@ -120,13 +120,17 @@ def test_the_course_figures_follow_the_same_conventions():
 
 def test_bank_figure_draws_every_member_over_its_threshold_with_legible_text():
     """One panel per run, one legend, each curve J / threshold, no text under 9 px on the page."""
-    pa9 = ut.examples.pa9()
-    plant = ut.Plant(pa9.A, np.eye(3), B=pa9.B, E=pa9.E)
-    detector = ut.design_uio(plant, poles=[-1, -2, -3])
-    t = np.linspace(0, 6, 601)
-    banks = [ut.design_uio_bank(plant, kind, poles=[-2, -3, -4]) for kind in ("actuator", "sensor")]
-    healthy = [ut.simulate_fault(plant, detector, t, noise=0.01, seed=k) for k in range(30)]
-    ths = [bank.thresholds(healthy, false_alarm_rate=0.05, window=0.5) for bank in banks]
+    from fault_bank import bank_setting
+
+    s = bank_setting()
+    plant, detector, t, banks, healthy, ths = (
+        s.plant,
+        s.detector,
+        s.t,
+        s.banks,
+        s.healthy,
+        s.thresholds,
+    )
     fault = ut.sensor_fault(plant, 0, ut.signals.step(0.3, 3.0))
     runs = {"sensor 1": ut.simulate_fault(plant, detector, t, fault, noise=0.01, seed=99)}
     runs["no fault"] = healthy[0]
