@@ -15,7 +15,14 @@ True
 
 import importlib
 
-from . import examples, linalg, signals
+from . import data_driven, examples, linalg, signals
+from .data_driven import (
+    DataConditionError,
+    DataConditioningWarning,
+    DataReport,
+    check_data,
+    design_uio_from_data,
+)
 from .detection import (
     Detection,
     Fault,
@@ -100,6 +107,12 @@ __all__ = [
     "design_pmo",
     "design_ginverse",
     "design_luenberger",
+    "data_driven",
+    "design_uio_from_data",
+    "check_data",
+    "DataReport",
+    "DataConditionError",
+    "DataConditioningWarning",
     "Observer",
     "ObserverRealization",
     "UIO",
