@@ -64,7 +64,7 @@ def failed_names(report):
     return sorted(c.name for c in report.failed if c.name in DECIDING)
 
 
-def equivalence_cases(count=48, seed=2027):
+def equivalence_cases(count=32, seed=2027):
     rng = np.random.default_rng(seed)
     for _ in range(count):
         plant = random_plant(rng)
@@ -111,56 +111,50 @@ def test_refused_from_the_data_for_the_model_based_reason():
     assert refused >= 10
 
 
-def test_placed_poles_are_exactly_the_requested_plus_the_zeros():
-    rng = np.random.default_rng(7)
+def check_designs(cases, rng):
+    """On each plant where a UIO exists: placed poles, the model-based matrices for the same
+    gain, and the defining property (the error does not depend on d)."""
     designed = 0
-    for plant, rec in CASES:
+    for plant, rec in cases:
         model = ut.check_existence(plant)
         if not model.ok:
             continue
         poles = rng.uniform(-0.6, 0.6, model.movable)
         obs = design_uio_from_data(rec.u, rec.y, rec.x, dt=1, poles=poles)
-        expected = np.concatenate([poles, model.fixed_modes])
-        gain = richness(plant, rec) * max(1.0, float(np.linalg.norm(obs.K1, 2)))
+        gain = richness(plant, rec) * max(1.0, float(np.linalg.norm(obs.K, 2)))
         tol = roundoff(1, terms=rec.x.size, gain=gain) ** 0.5
-        assert same_values(obs.poles(), expected, tol), (obs.poles(), expected)
-        designed += 1
-    assert designed >= 5
-
-
-def test_same_gain_gives_the_model_based_observer_matrix_by_matrix():
-    for plant, rec in CASES:
-        if not ut.check_existence(plant).ok:
-            continue
-        model = ut.design_uio(plant, poles=np.linspace(-0.5, 0.5, ut.check_existence(plant).movable))
-        data = design_uio_from_data(rec.u, rec.y, rec.x, dt=1, K1=model.K1)
-        size = max(float(np.abs(getattr(model, k)).max()) for k in ("F", "H", "T", "K"))
-        tol = roundoff(max(size, 1.0), terms=rec.x.size, gain=richness(plant, rec))
+        # the movable poles exactly those asked for, plus the fixed invariant zeros
+        assert same_values(obs.poles(), np.concatenate([poles, model.fixed_modes]), tol)
+        # for the same gain K1, the model-based observer, matrix by matrix
+        same = ut.design_uio(plant, K1=obs.K1)
+        size = max(float(np.abs(getattr(same, k)).max()) for k in ("F", "H", "T", "K"))
+        atol = roundoff(max(size, 1.0), terms=rec.x.size, gain=gain)
         for name in ("H", "T", "F", "K"):
-            assert np.allclose(getattr(data, name), getattr(model, name), rtol=0, atol=tol), name
-        real_d, real_m = data.realization(), model.realization()
-        assert np.allclose(real_d.B_u, real_m.B_u, rtol=0, atol=tol)
-
-
-def test_the_error_does_not_depend_on_the_unknown_input():
-    rng = np.random.default_rng(3)
-    checked = 0
-    for plant, rec in CASES:
-        model = ut.check_existence(plant)
-        if not model.ok:
-            continue
-        obs = design_uio_from_data(rec.u, rec.y, rec.x, dt=1, poles=np.linspace(-0.3, 0.3, model.movable))
+            assert np.allclose(getattr(obs, name), getattr(same, name), rtol=0, atol=atol), name
+        assert np.allclose(obs.realization().B_u, same.realization().B_u, rtol=0, atol=atol)
+        # the defining property, on the true plant
         t = np.arange(25)
         x0 = rng.standard_normal(plant.n)
         u = rng.standard_normal((plant.m, t.size)) if plant.m else None
+        d = 5 * rng.standard_normal((plant.q, t.size))
         quiet = ut.simulate(plant, obs, t, u=u, initial_state=x0)
-        loud = ut.simulate(plant, obs, t, u=u, initial_state=x0, d=5 * rng.standard_normal((plant.q, t.size)))
+        loud = ut.simulate(plant, obs, t, u=u, initial_state=x0, d=d)
         size = float(np.abs(loud.states).max())
-        gain = richness(plant, rec) * max(1.0, float(np.linalg.norm(obs.K, 2)))
-        assert np.allclose(quiet.error, loud.error, rtol=0, atol=roundoff(size, terms=rec.x.size, steps=t.size, gain=gain))
+        bound = roundoff(size, terms=rec.x.size, steps=t.size, gain=gain)
+        assert np.allclose(quiet.error, loud.error, rtol=0, atol=bound)
         assert np.abs(quiet.states - loud.states).max() > 0.1  # the unknown input did act
-        checked += 1
-    assert checked >= 5
+        designed += 1
+    return designed
+
+
+def test_designs_from_data_are_the_model_based_ones():
+    assert check_designs(CASES[:16], np.random.default_rng(7)) >= 4
+
+
+@pytest.mark.slow
+def test_designs_from_data_are_the_model_based_ones_on_many_plants():
+    cases = list(equivalence_cases(count=120, seed=31))
+    assert check_designs(cases, np.random.default_rng(8)) >= 30
 
 
 def test_minimum_norm_design_is_the_papers_estimator():
@@ -183,8 +177,8 @@ def test_minimum_norm_design_is_the_papers_estimator():
     m, p, n = 1, 2, 3
     W2 = W[:, m + p : m + p + n]
     tol = roundoff(float(np.abs(Xf).max()), terms=x.size, gain=np.linalg.cond(Phi[: m + p + n]))
-    assert np.allclose(obs.F, Xf @ W2, rtol=0, atol=tol ** 0.5)
-    assert np.allclose(obs.K1, Xf @ W[:, m : m + p], rtol=0, atol=tol ** 0.5)
+    assert np.allclose(obs.F, Xf @ W2, rtol=0, atol=tol**0.5)
+    assert np.allclose(obs.K1, Xf @ W[:, m : m + p], rtol=0, atol=tol**0.5)
     # and it estimates the state whatever d is (the error obeys e+ = F e)
     assert obs.is_stable
 
@@ -237,7 +231,9 @@ def test_not_exciting_says_which_signal():
     quiet = ut.Plant(np.diag([0.5, 0.4, 0.3]), np.eye(3), E=[[1.0], [0.0], [0.0]], dt=1)
     rec = record_experiment(quiet, 30, seed=1, initial_state=[0, 0, 0])
     report = check_data(rec.u, rec.y, rec.x, dt=1)
-    assert "the state stayed in a subspace of dimension 1" in report["input and state exciting"].reason
+    assert (
+        "the state stayed in a subspace of dimension 1" in report["input and state exciting"].reason
+    )
 
 
 def test_a_hidden_direction_is_refused_and_would_not_be_decoupled():
@@ -303,7 +299,9 @@ def test_noise_moves_the_design_in_proportion():
     gaps = []
     for noise in (1e-7, 1e-5, 1e-3):
         rec = record_experiment(plant, 200, seed=9, noise=noise)
-        obs = design_uio_from_data(rec.u, rec.y, rec.x, dt=1, poles=[0.1, 0.2, 0.3], unknown_inputs=1, rtol=noise)
+        obs = design_uio_from_data(
+            rec.u, rec.y, rec.x, dt=1, poles=[0.1, 0.2, 0.3], unknown_inputs=1, rtol=noise
+        )
         gaps.append(float(np.abs(obs.F - model.F).max()))
     # graceful: the observer moves by an amount of the order of the noise, not more
     assert gaps[0] < gaps[1] < gaps[2]
@@ -314,7 +312,9 @@ def test_ill_conditioned_data_warn():
     plant = simple_plant()
     rec = record_experiment(plant, 40, seed=9, noise=0.01)
     with pytest.warns(DataConditioningWarning, match="ill-conditioned"):
-        design_uio_from_data(rec.u, rec.y, rec.x, dt=1, poles=[0.1, 0.2, 0.3], unknown_inputs=1, rtol=0.01)
+        design_uio_from_data(
+            rec.u, rec.y, rec.x, dt=1, poles=[0.1, 0.2, 0.3], unknown_inputs=1, rtol=0.01
+        )
     rec = record_experiment(plant, 40, seed=9)
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataConditioningWarning)
