@@ -494,7 +494,8 @@ def check_data(
                 f"{N} samples give {L} transitions, but the known input, the state and the "
                 f"next state span {r_all} dimensions: no transition is left to show what the "
                 f"unknown input leaves alone; record at least {max(need, r_all + 2)} samples "
-                f"(m + n + q + 2 with m = {m}, n = {n} and q the number of unknown inputs)",
+                f"(m + n + q + 2 with m = {m}, n = {n}"
+                + (f", q = {q})" if q is not None else " and q the number of unknown inputs)"),
             )
         )
     else:
@@ -553,7 +554,17 @@ def check_data(
     else:
         conds.append(Condition("outputs a function of the state", True, "y = C x with C = Y X^+"))
     # the unknown input's directions
-    if q is not None:
+    if short:
+        directions = min(seen, q) if q is not None else seen
+        conds.append(
+            Condition(
+                "unknown input shows every direction",
+                None,
+                "not evaluated: too few samples to tell the unknown input's directions",
+                required=q is not None,
+            )
+        )
+    elif q is not None:
         if seen < q:
             conds.append(
                 Condition(

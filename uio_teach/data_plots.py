@@ -68,6 +68,8 @@ def plot_noise_study(study: NoiseStudy, *, title: str = "") -> Figure:
         )
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_xticks(study.lengths, labels=[str(int(n)) for n in study.lengths])
+    ax.minorticks_off()
     ax.set_xlabel("recorded samples N")
     if title:
         ax.set_title(title)
