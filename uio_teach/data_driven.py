@@ -931,8 +931,8 @@ def noise_study(
     plant: Plant,
     poles: Any,
     *,
+    noises: Any,
     lengths: Any = (20, 40, 80, 160),
-    noises: Any = (1e-4, 1e-3, 1e-2),
     repeats: int = 2,
     steps: int = 200,
     seed: int = 0,
@@ -953,10 +953,10 @@ def noise_study(
         A discrete-time plant (``y = C x``).
     poles : array_like
         The movable error poles.
+    noises : sequence of float
+        The relative noise levels of the recorded ``x`` and ``y``.
     lengths : sequence of int
         The numbers of recorded samples.
-    noises : sequence of float
-        The relative noise levels.
     repeats : int
         Experiments per length and level.
     steps : int
