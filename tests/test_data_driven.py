@@ -356,3 +356,35 @@ def test_the_report_reads_as_a_table():
     assert "<table>" in report._repr_html_()
     with pytest.raises(KeyError, match="no condition named"):
         report["nonsense"]
+
+
+def test_several_experiments_count_together():
+    # A = 0.5 I, no known input: one experiment keeps the state in span{x(0), E}
+    case = ut.examples.dt_case_study()
+    plant = ut.Plant(case.A, case.C, E=case.E, dt=1)
+    one = record_experiment(plant, 30, seed=1)
+    assert check_data(one.u, one.y, one.x, dt=1).failed[0].name == "input and state exciting"
+    runs = [record_experiment(plant, 10, seed=k) for k in range(3)]
+    report = check_data(None, [r.y for r in runs], [r.x for r in runs], dt=1, unknown_inputs=1)
+    assert report.ok and report.samples == 30
+    # no transition across two experiments: the blocks are the experiments' side by side
+    mats = data_matrices(None, [r.y for r in runs], [r.x for r in runs])
+    assert mats.transitions == 27
+    assert np.array_equal(mats.X_f[:, 9], runs[1].x[:, 1])
+    obs = design_uio_from_data(
+        None, [r.y for r in runs], [r.x for r in runs], dt=1, poles=[0.1, 0.2], unknown_inputs=1
+    )
+    model = ut.check_existence(plant)
+    assert same_values(obs.poles(), np.concatenate([[0.1, 0.2], model.fixed_modes]), 1e-8)
+    with pytest.raises(ValueError, match="lists of 3 2-D arrays"):
+        check_data(None, runs[0].y, [r.x for r in runs], dt=1)
+
+
+def test_minimum_norm_with_noise_stays_near_the_exact_one():
+    plant = simple_plant()
+    exact = record_experiment(plant, 200, seed=4)
+    noisy = record_experiment(plant, 200, seed=4, noise=1e-6)
+    ref = design_uio_from_data(exact.u, exact.y, exact.x, dt=1)
+    obs = design_uio_from_data(noisy.u, noisy.y, noisy.x, dt=1, unknown_inputs=1, rtol=1e-6)
+    assert np.abs(obs.F - ref.F).max() < 1e-3
+    assert np.abs(obs.H - ref.H).max() < 1e-3
