@@ -74,7 +74,7 @@ NOISE_EDGE = 10.0
 values up to ``rtol (sqrt(L) + sqrt(r))`` (the Marchenko-Pastur edge), with tenfold room."""
 
 ROUND_OFF_RTOL = 1e3
-"""The default ``rtol`` of noise-free (simulated) data is ``ROUND_OFF_RTOL * eps``: the rounding
+"""The default ``rtol`` of noise-free (simulated) data is ``ROUND_OFF_RTOL * eps``, the rounding
 of a state recorded after a thousand steps of a recursion, with room."""
 
 
@@ -173,7 +173,7 @@ class DataReport:
 
     @property
     def ok(self) -> bool:
-        """True when every required condition holds: a UIO can be designed from the data."""
+        """True when every required condition holds, so that a UIO can be designed from the data."""
         return all(c.holds for c in self.conditions if c.required)
 
     @property
