@@ -26,7 +26,7 @@ from ..existence import check_existence
 from ..experiments import experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
-from ..worked import WORKED, RegistryError, resolve
+from ..worked import WORKED, RegistryError
 from .model import (
     FAMILIES,
     Channel,
@@ -410,5 +410,5 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
         input_symbol=opts.input_symbol,
         plant_controls=sliders,
         rebuild=functools.partial(experiment_scenario, name),
-        note=resolve(opts.note)(**physical) if opts.note else "",
+        note=opts.note(**physical) if opts.note else "",
     )

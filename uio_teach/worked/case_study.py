@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from .. import signals
+from .. import examples, signals
 from .. import tolerances as tols
 from .._display import format_poles
 from ..existence import check_existence, decoupling
@@ -478,8 +478,8 @@ EXAMPLES = (
     WorkedExample(
         name="case_study",
         title="The discrete-time case study",
-        plant="uio_teach.examples:dt_case_study",
-        experiment=f"{__name__}:CASE_STUDY",
+        plant=examples.dt_case_study,
+        experiment=CASE_STUDY,
         family="pmo",
         order=20,
         # two fixed poles at 0.5 (the invariant zeros); v at half the amplitude and twice the
@@ -513,12 +513,12 @@ EXAMPLES = (
             FigureEntry(
                 "case_response",
                 "Case study: states, estimates, error and residual with u2 and v both active",
-                f"{__name__}:_case_response",
+                _case_response,
             ),
             FigureEntry(
                 "case_error",
                 "Case study: error norm on a log scale, with and without the unknown signals",
-                f"{__name__}:_case_error",
+                _case_error,
             ),
         ),
     ),
