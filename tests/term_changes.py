@@ -16,7 +16,7 @@ from typing import Any
 from uio_teach.instructor.config import ConfigError, FigureConfig, config_schema
 from uio_teach.instructor.lab_registry import LABS
 
-FACTORS = (0.8, 1.25, 0.5, 1.5, 0.9)
+FACTORS = (1.25, 0.8, 1.5, 0.5, 0.9)
 
 
 def nested(changes: dict) -> dict:
@@ -41,12 +41,14 @@ def leaves(value, path=()):
 def _candidates(opt) -> list[Any]:
     default = opt.default
     kind = opt.kind
-    if kind == "style":
-        return ["ggplot", "grayscale"]
+    if kind in ("style", "str"):
+        return ["ggplot", "grayscale"]  # matplotlib's own styles
     if default is None:
         if kind in ("float", "int"):
             low = opt.minimum if opt.minimum is not None else 0.0
             return [low + 1, low + 0.5] if kind == "float" else [int(low) + 1]
+        if kind == "poles":  # inside the unit circle, and stable in continuous time
+            return [[-0.3], [0.1], [-2.0, -3.0]]
         return []
     if kind == "int":
         return [default + 1, default - 1, default * 2]

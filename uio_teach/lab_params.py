@@ -297,6 +297,17 @@ class LabParams(ABC):
         return cls(**kwargs)
 
     @classmethod
+    def config_keys(cls) -> frozenset[str]:
+        """The keys of the term config this lab reads (its fields' config keys).
+
+        ``uio-teach labs`` names every key a config sets that no lab reads
+        (:func:`uio_teach.instructor.labs.unused_config_keys`); a lab whose
+        :meth:`from_config` reads another key says so here.
+        """
+        keys = (spec.config_key(cls.lab, name) for name, spec in cls.declared())
+        return frozenset(k for k in keys if k is not None)
+
+    @classmethod
     def from_config(cls, config: Mapping[str, Any] | None) -> LabParams:
         """The parameters of a term config (:func:`uio_teach.instructor.config.load_config`).
 

@@ -181,7 +181,8 @@ def unused_config_keys(config: Mapping[str, Any]) -> list[str]:
     """The keys ``config`` sets that no lab uses, one sentence each, by name.
 
     A key set in the term config reaches the labs' ``PARAMS`` when a lab's
-    parameter class declares it (its experiment's field with ``lab=True``);
+    parameter class reads it (``config_keys()``: its experiment's fields with
+    ``lab=True``, and what its ``from_config`` reads besides);
     the others set only the figures and the explorers (a worked example
     without a lab, or a field its lab does not ask about). ``uio-teach labs``
     prints these sentences, so that no configured value is dropped unseen.
@@ -204,11 +205,7 @@ def unused_config_keys(config: Mapping[str, Any]) -> list[str]:
     >>> print(unused_config_keys(cfg)[0])  # doctest: +ELLIPSIS
     quadruple_tank.gamma1 of the term config is used by no lab (quadruple_tank has none): it ...
     """
-    used = {
-        spec.config_key(lab.id, name)
-        for lab in LABS.values()
-        for name, spec in lab.params.declared()
-    }
+    used = {key for lab in LABS.values() for key in lab.params.config_keys()}
     given = getattr(config, "given", None)
     keys = sorted(given) if given is not None else sorted(config)
     notes = []

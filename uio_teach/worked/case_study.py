@@ -316,6 +316,10 @@ the run's error, ...); the lab asks for the same computations on these
 numbers, so no page of the book gives its answers away."""
 
 
+_POLES_KEY = "case_study.poles"
+"""The config key of the observer's poles, which sets the lab's one ``pole``."""
+
+
 @lab_params_of(CASE_STUDY_LAB)
 class CaseStudyParams(LabParams):
     """The numbers of the case-study lab (the fields of :data:`CASE_STUDY`).
@@ -351,11 +355,16 @@ class CaseStudyParams(LabParams):
     """
 
     @classmethod
+    def config_keys(cls) -> frozenset[str]:
+        """As ``LabParams.config_keys``, and ``case_study.poles`` (it sets ``pole``)."""
+        return super().config_keys() | {_POLES_KEY}
+
+    @classmethod
     def from_config(cls, config: Mapping[str, Any] | None) -> CaseStudyParams:
         """As ``LabParams.from_config``; ``case_study.poles``, if given, sets ``pole``."""
         params = super().from_config(config)
         given = getattr(config, "given", None)
-        key = "case_study.poles"
+        key = _POLES_KEY
         unset = config is None or (given is not None and key not in given)
         poles = None if unset else config.get(key)
         if poles:
