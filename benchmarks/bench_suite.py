@@ -5,12 +5,13 @@ Run from the repository root with the project's environment::
     .venv/bin/python benchmarks/bench_suite.py                   # make check, and the API page
     .venv/bin/python benchmarks/bench_suite.py --target test     # make test too (long)
     .venv/bin/python benchmarks/bench_suite.py --junit run.xml   # read a run's JUnit report
+    .venv/bin/python benchmarks/bench_suite.py --checkout ../old --label before  # another checkout
 
 For each target: the wall-clock time of the whole command, the CPU time of every process it
 started (user + system, summed over the workers, the kernels and the book build), the machine's
 load average before and after (the cores are shared: wall-clock grows with the load, CPU time
 much less), and from pytest's JUnit report the tests run and the time summed per test module,
-the ten largest listed. The API page's size is that of ``_build/html/api.html`` when a build is
+the ten largest listed. The API page's size is that of ``_build/html/book/api.html`` when a build is
 there (``make book`` first), with the size of the whole HTML page and of its text. The last line
 is the result as JSON, read by ``benchmarks/report.py``.
 """
@@ -56,7 +57,7 @@ def module_sums(junit: Path) -> tuple[int, dict[str, float]]:
     return count, dict(sums)
 
 
-def run_target(target: str) -> dict:
+def run_target(target: str, root: Path = ROOT) -> dict:
     """Run ``make <target>`` with a JUnit report; its wall-clock and CPU time and module sums."""
     with tempfile.TemporaryDirectory() as tmp:
         junit = Path(tmp) / "junit.xml"
@@ -64,7 +65,7 @@ def run_target(target: str) -> dict:
         before_load = _load()
         usage = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        proc = subprocess.run(["make", target], cwd=ROOT, env=env, check=False)
+        proc = subprocess.run(["make", target], cwd=root, env=env, check=False)
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (after.ru_utime - usage.ru_utime) + (after.ru_stime - usage.ru_stime)
@@ -81,8 +82,8 @@ def run_target(target: str) -> dict:
     }
 
 
-def api_page() -> dict | None:
-    page = ROOT / "_build" / "html" / "api.html"
+def api_page(root: Path = ROOT) -> dict | None:
+    page = root / "_build" / "html" / "book" / "api.html"
     if not page.exists():
         return None
     return {"api_bytes": page.stat().st_size}
@@ -92,8 +93,12 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--target", action="append", choices=sorted(GOALS), default=None)
     parser.add_argument("--junit", type=Path, help="only read this JUnit report (no run)")
+    parser.add_argument(
+        "--checkout", type=Path, default=ROOT, help="run the commands in this checkout (before)"
+    )
+    parser.add_argument("--label", default="after", help="what the run measures (before, after)")
     args = parser.parse_args(argv)
-    result: dict = {"cores": os.cpu_count(), "runs": []}
+    result: dict = {"cores": os.cpu_count(), "runs": [], "label": args.label}
     if args.junit:
         count, sums = module_sums(args.junit)
         total = sum(sums.values())
@@ -102,17 +107,17 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {name}: {seconds:.0f} s")
         return 0
     for target in args.target or ["check"]:
-        run = run_target(target)
+        run = run_target(target, args.checkout)
         result["runs"].append(run)
         print(
-            f"make {target}: {run['wall']:.0f} s wall-clock, {run['cpu']:.0f} s CPU, "
+            f"{args.label}: make {target}: {run['wall']:.0f} s wall-clock, {run['cpu']:.0f} s CPU, "
             f"{run['tests']} tests, status {run['status']}, load {run['load'][0]:.1f} -> "
             f"{run['load'][1]:.1f} on {result['cores']} cores",
             flush=True,
         )
         for name, seconds in run["modules"].items():
             print(f"  {name}: {seconds:.0f} s summed")
-    page = api_page()
+    page = api_page(args.checkout)
     if page:
         result.update(page)
         print(f"API page: {page['api_bytes'] / 1000:.0f} kB of HTML")
