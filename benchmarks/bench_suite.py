@@ -2,8 +2,8 @@
 
 Run from the repository root with the project's environment::
 
-    .venv/bin/python benchmarks/bench_suite.py                   # make check, and the API page
-    .venv/bin/python benchmarks/bench_suite.py --target test     # make test too (long)
+    .venv/bin/python benchmarks/bench_suite.py                   # the API page only
+    .venv/bin/python benchmarks/bench_suite.py --target check --target test  # and the commands
     .venv/bin/python benchmarks/bench_suite.py --junit run.xml   # read a run's JUnit report
     .venv/bin/python benchmarks/bench_suite.py --checkout ../old --label before  # another checkout
 
@@ -91,7 +91,9 @@ def api_page(root: Path = ROOT) -> dict | None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--target", action="append", choices=sorted(GOALS), default=None)
+    parser.add_argument(
+        "--target", action="append", choices=sorted(GOALS), default=None, help="make targets run"
+    )
     parser.add_argument("--junit", type=Path, help="only read this JUnit report (no run)")
     parser.add_argument(
         "--checkout", type=Path, default=ROOT, help="run the commands in this checkout (before)"
@@ -106,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         for name, seconds in sorted(sums.items(), key=lambda kv: -kv[1])[:15]:
             print(f"  {name}: {seconds:.0f} s")
         return 0
-    for target in args.target or ["check"]:
+    for target in args.target or []:
         run = run_target(target, args.checkout)
         result["runs"].append(run)
         print(

@@ -250,7 +250,7 @@ BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
     "decisions": (["bench_decisions.py"], read_decisions),
-    "suite": (["bench_suite.py"], read_suite),
+    "suite": (["bench_suite.py", "--target", "check", "--target", "test"], read_suite),
 }
 
 
