@@ -10,6 +10,7 @@ Jupyter would show raw.
 from __future__ import annotations
 
 import ast
+import functools
 import json
 import re
 import textwrap
@@ -547,31 +548,83 @@ def test_the_written_notebooks_hold_the_terms_numbers(term_labs, lab_id):
         assert params_of(nbformat.read(path, as_version=4)) == expected
 
 
-@pytest.mark.parametrize("key", list(TERM_CHANGES))
-def test_every_config_key_reaches_a_lab_that_reads_it_or_is_said(term_labs, key, capsys):
-    config = FigureConfig.from_dict(nested({key: TERM_CHANGES[key]}))
+@functools.cache
+def solution_code(lab_id: str) -> str:
+    """The code cells of the lab's solution notebook (quotes made double, for :func:`reads`)."""
+    solution = labs.make_notebook(BOOK / labs.LABS[lab_id].source, "solution")
+    code = "\n".join(c.source for c in solution.cells if c.cell_type == "code")
+    return code.replace("'", '"')
+
+
+def wiring_problems(key: str, value) -> list[str]:
+    """Why ``key`` = ``value`` of a term config would not reach what the students run (empty: it
+    does): a key no lab reads must be named by ``labs``; one that reaches a lab's PARAMS must be
+    read by its code, or named in UNREAD_CONFIG_KEYS."""
+    config = FigureConfig.from_dict(nested({key: value}))
     reaches = reached(config)
     if not reaches:  # a key no lab declares: `labs` says so, by name
-        (note,) = labs.unused_config_keys(config)
-        assert note.startswith(f"{key} of the term config is used by no lab"), note
-        return
-    assert labs.unused_config_keys(config) == []
+        notes = labs.unused_config_keys(config)
+        said = [n for n in notes if n.startswith(f"{key} of the term config is used by no lab")]
+        return [] if said else [f"{key} reaches no lab and `uio-teach labs` does not say so"]
+    out = []
     for lab_id, changed in reaches.items():
-        solution = nbformat.read(term_labs["results"][lab_id].solution, as_version=4)
-        code = "\n".join(c.source for c in solution.cells if c.cell_type == "code")
-        code = code.replace("'", '"')
-        is_read = any(reads(code, p) for p in changed)
-        assert is_read != unread(lab_id, key), f"{key} reaches the PARAMS of the {lab_id} lab " + (
-            "and its notebook reads it, but UNREAD_CONFIG_KEYS says it does not"
-            if is_read
-            else f"but no code cell of {labs.LABS[lab_id].source} reads "
-            f"{' or '.join('PARAMS' + ''.join(f'[{p!r}]' for p in path) for path in changed)}:"
-            " wire it into the chapter's code (or name it in UNREAD_CONFIG_KEYS with why)"
-        )
+        is_read = any(reads(solution_code(lab_id), p) for p in changed)
+        if is_read == unread(lab_id, key):
+            out.append(
+                f"{key} reaches the PARAMS of the {lab_id} lab "
+                + (
+                    "and its notebook reads it, but UNREAD_CONFIG_KEYS says it does not"
+                    if is_read
+                    else f"but no code cell of {labs.LABS[lab_id].source} reads "
+                    + " or ".join("PARAMS" + "".join(f"[{p!r}]" for p in path) for path in changed)
+                    + ": wire it into the chapter's code (or name it in UNREAD_CONFIG_KEYS "
+                    "with the reason)"
+                )
+            )
+    return out
+
+
+@pytest.mark.parametrize("key", list(TERM_CHANGES))
+def test_every_config_key_reaches_a_lab_that_reads_it_or_is_said(key, capsys):
+    assert wiring_problems(key, TERM_CHANGES[key]) == []
     assert cli.main(["labs", "--help"]) == 0
     help_text = " ".join(capsys.readouterr().out.split())
     for entry in labs.UNREAD_CONFIG_KEYS:
         assert " ".join(entry.text().split()) in help_text
+
+
+def test_a_lab_field_added_without_wiring_fails_by_name():
+    """One more line in PA9's experiment, ``lab=True``, that the lab chapter never reads."""
+    import dataclasses
+
+    from uio_teach.experiments import param
+    from uio_teach.lab_params import lab_params_of
+    from uio_teach.worked import discover, pa9
+
+    @dataclasses.dataclass(frozen=True)
+    class WithBias(pa9.PA9Experiment):
+        bias: float = param(0.25, "float", "a constant added to d", key="sine.bias")
+
+    @lab_params_of(WithBias(name="pa9", timepts=pa9.PA9_LAB.timepts))
+    class BiasParams(pa9.PA9Params):
+        pass
+
+    own = pa9.EXAMPLES
+    entry = own[0]
+    lab = dataclasses.replace(entry.lab, params=BiasParams)
+    experiment = WithBias(name="pa9", timepts=pa9.PA9.timepts)
+    pa9.EXAMPLES = (dataclasses.replace(entry, experiment=experiment, lab=lab),)
+    discover()
+    try:
+        problems = wiring_problems("pa9.sine.bias", 0.5)
+    finally:
+        pa9.EXAMPLES = own
+        discover()
+    assert problems == [
+        "pa9.sine.bias reaches the PARAMS of the pa9 lab but no code cell of lab_pa9.md reads "
+        "PARAMS['sine']['bias']: wire it into the chapter's code (or name it in "
+        "UNREAD_CONFIG_KEYS with the reason)"
+    ]
 
 
 @pytest.mark.book
