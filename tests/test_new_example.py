@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from uio_teach.explorers.scenarios import scenario_of
 from uio_teach.instructor import cli, figures
 from uio_teach.instructor.config import FigureConfig, config_schema
 from uio_teach.worked import WORKED, RegistryError, discover
@@ -157,7 +158,7 @@ def test_its_figures_are_listed_and_drawn(motor_package, capsys, tmp_path):
 
 
 def test_its_explorer_has_a_slider_per_declared_range(motor_package):
-    scenario = WORKED["probe_motor"].make_scenario()
+    scenario = scenario_of("probe_motor")
     assert scenario.amplitude_limits == (0.0, 1.0) and scenario.defaults.amplitude == 0.2
     assert [c.name for c in scenario.plant_controls] == ["inertia"]
     heavier = scenario.rebuild(inertia=0.04)

@@ -72,7 +72,8 @@ def scenario_of(name: str, **plant_values: float) -> Scenario:
     >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
     False
     """
-    return _entry(name).make_scenario(**plant_values)
+    _entry(name)
+    return experiment_scenario(name, **plant_values)
 
 
 def _entry(name: str):

@@ -17,7 +17,7 @@ set. From these entries come
 * the figures of ``uio-teach figures`` (``uio_teach.instructor.figures``), each
   drawn from the experiment with the config's values in place
   (:func:`run_from_config`);
-* the explorer of each example (``WorkedExample.make_scenario``, from its
+* the explorer of each example (``uio_teach.explorers.scenario_of``, from its
   :class:`ExplorerOptions`), with a slider for every declared field that has a
   ``range``;
 * the labs of ``uio-teach labs`` (``uio_teach.instructor.labs.LABS``): the
@@ -417,13 +417,6 @@ class WorkedExample:
     def run(self) -> Any:
         """The experiment."""
         return self.experiment
-
-    def make_scenario(self, **values: Any) -> Any:
-        """The explorer's scenario; ``values`` set fields of the experiment (its sliders)."""
-        # deferred: the explorers read this registry (a cycle at import time)
-        from ..explorers.scenarios import experiment_scenario
-
-        return experiment_scenario(self.name, **values)
 
     def poles_key(self) -> str | None:
         """The config key that sets the observer's poles (``None``: not in the config)."""
