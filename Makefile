@@ -20,7 +20,7 @@ unexport PYTHONDONTWRITEBYTECODE
 JOBS ?= auto
 
 .DEFAULT_GOAL := help
-.PHONY: help venv book book-instructor pdf pdf-instructor test lint clean
+.PHONY: help venv book book-instructor pdf pdf-instructor test test-slow lint clean
 
 # What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
 # build the book or the wheel, start any other process, or take long (the markers each test
@@ -34,7 +34,8 @@ help:
 	@echo "make pdf    the book, with every page and the whole book printed as tagged PDFs"
 	@echo "            into _build/pdf (and linked from the pages); make pdf-instructor:"
 	@echo "            the instructor edition's, into _build/instructor/_build/pdf"
-	@echo "make test   lint, then run every test (package, chapters, book build, browser)"
+	@echo "make test   lint, then every test but the slow set (package, chapters, book, browser)"
+	@echo "make test-slow  the slow set (CI runs it after make test; make test-all: both)"
 	@echo "make check  lint, then the quick tests: no kernel, browser, book, wheel or process"
 	@echo "make venv   create or update $(VENV) from the lock, requirements.txt"
 	@echo "make lint   ruff check and ruff format --check"
@@ -85,10 +86,17 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
+# `make test` leaves the tests marked `slow` to `make test-slow`; CI (.ci/run) runs both.
 test: lint
+	$(BIN)/pytest -m "not slow" -n $(JOBS) --dist loadgroup --no-loadscope-reorder
+
+test-slow: $(STAMP)
+	$(BIN)/pytest -m slow -n $(JOBS) --dist loadgroup --no-loadscope-reorder
+
+test-all: lint
 	$(BIN)/pytest -n $(JOBS) --dist loadgroup --no-loadscope-reorder
 
-.PHONY: check lock bench
+.PHONY: check lock bench test-all
 
 check: lint
 	$(BIN)/pytest -q -m "$(QUICK)" -n $(JOBS) --dist loadgroup --no-loadscope-reorder

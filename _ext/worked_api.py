@@ -24,7 +24,7 @@ def worked_modules() -> dict[str, str]:
 
     modules: dict[str, str] = {}
     for entry in WORKED.values():
-        modules.setdefault(entry.experiment.partition(":")[0], entry.title)
+        modules.setdefault(entry.module, entry.title)
     return modules
 
 

@@ -202,6 +202,45 @@ def read_pdf(text: str) -> list[list[str]]:
     ]
 
 
+def read_suite(text: str) -> list[list[str]]:
+    results = [json.loads(line) for line in text.splitlines() if line.startswith("{")]
+    if not results:
+        raise ReportError("no JSON result line in the output")
+    rows = []
+    for r in results:
+        rows += _suite_rows(r)
+    return rows
+
+
+def _suite_rows(r: dict) -> list[list[str]]:
+    label = f" ({r['label']})" if r.get("label") else ""
+    rows = []
+    for run in r["runs"]:
+        what = {
+            "check": "`make check`: ruff, then the quick tests (no kernel, browser, book, process)",
+            "test": "`make test`: ruff, then every test but the slow set",
+        }[run["target"]]
+        load = " -> ".join(f"{x:.1f}" for x in run["load"])
+        rows.append(
+            [
+                f"{what}, {run['tests']} tests{label}",
+                f"{run['wall']:.0f} s (CPU {run['cpu']:.0f} s, load {load} on {r['cores']} cores)",
+                f"goal {run['goal']:.0f} s",
+                "",
+            ]
+        )
+    if "api_bytes" in r:
+        rows.append(
+            [
+                f"the API page (`book/api.html`){label}",
+                f"{r['api_bytes'] / 1000:.0f} kB",
+                "goal 400 kB",
+                "",
+            ]
+        )
+    return rows
+
+
 # name -> (script and arguments, reader); the summary lists them in this order
 BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "simulate": (["bench_simulate.py"], read_simulate),
@@ -211,6 +250,7 @@ BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
     "decisions": (["bench_decisions.py"], read_decisions),
+    "suite": (["bench_suite.py", "--target", "check", "--target", "test"], read_suite),
 }
 
 

@@ -21,7 +21,8 @@ carries its own ``@pytest.mark...``):
     takes long for another reason (exhaustive sweeps, every figure drawn, every lab written).
 
 ``make check`` runs the tests that need none of kernel, browser, book, wheel, subprocess or
-slow; ``make test`` runs everything.
+slow; ``make test`` runs every test not marked ``slow``, ``make test-slow`` the ``slow`` ones
+(CI runs both; ``make test-all`` runs them in one go).
 
 A declaration is checked, not trusted: every process the test process starts is looked at while
 a test (or its fixtures) runs, and a test that starts a kernel, a book build, a browser, a wheel

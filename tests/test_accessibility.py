@@ -26,6 +26,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import colour_vision, figure_text, plotting
+from uio_teach.worked import WORKED
 from uio_teach.worked.pa9 import PA9
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -92,16 +93,16 @@ def test_the_check_needs_a_style_or_a_colour_difference_every_reader_sees():
 
 @pytest.mark.slow  # every explorer drawn
 @pytest.mark.parametrize("narrow", [False, True])
-def test_no_two_curves_of_an_explorer_differ_by_hue_alone(narrow):
+@pytest.mark.parametrize("name", list(WORKED))
+def test_no_two_curves_of_an_explorer_differ_by_hue_alone(name, narrow):
     from uio_teach.explorers import compute_frame
     from uio_teach.explorers._figure import ExplorerFigure
     from uio_teach.explorers.scenarios import scenario_of
 
-    for name in ("pa9", "case_study", "missile", "quadruple_tank"):
-        sc = scenario_of(name)
-        fig = ExplorerFigure(sc, dpi=60, sticky=False, narrow=narrow, lmi=False)
-        fig.update(compute_frame(sc))
-        assert colour_vision.curves_apart_by_hue_alone(fig.fig) == [], name
+    sc = scenario_of(name)
+    fig = ExplorerFigure(sc, dpi=60, sticky=False, narrow=narrow, lmi=False)
+    fig.update(compute_frame(sc))
+    assert colour_vision.curves_apart_by_hue_alone(fig.fig) == [], name
 
 
 # --- figures in words --------------------------------------------------------------------------

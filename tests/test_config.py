@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import tomllib
 
@@ -21,7 +22,7 @@ from uio_teach.instructor.config import (
 )
 from uio_teach.instructor.labs import LABS
 from uio_teach.lab_params import lab_params_of
-from uio_teach.worked import pa9
+from uio_teach.worked import discover, pa9
 from uio_teach.worked.case_study import CASE_STUDY
 from uio_teach.worked.pa9 import PA9, PA9Experiment, PA9Params
 
@@ -35,11 +36,23 @@ class PA9WithBias(PA9Experiment):
     )
 
 
+@contextlib.contextmanager
+def registered(experiment):
+    """PA9's registry entry with ``experiment`` in place of its own, while the block runs."""
+    own = pa9.EXAMPLES
+    pa9.EXAMPLES = (dataclasses.replace(own[0], experiment=experiment),)
+    discover()
+    try:
+        yield experiment
+    finally:
+        pa9.EXAMPLES = own
+        discover()
+
+
 @pytest.fixture
-def with_bias(monkeypatch):
-    experiment = PA9WithBias(name="pa9", timepts=PA9.timepts)
-    monkeypatch.setattr(pa9, "PA9", experiment)
-    return experiment
+def with_bias():
+    with registered(PA9WithBias(name="pa9", timepts=PA9.timepts)) as experiment:
+        yield experiment
 
 
 def test_a_new_field_is_a_key_of_the_config_with_its_type_bounds_and_help(with_bias):
@@ -139,15 +152,14 @@ class PA9WithPhase(PA9Experiment):
 
 
 @pytest.fixture
-def with_phase(monkeypatch):
-    experiment = PA9WithPhase(name="pa9", timepts=PA9.timepts)
-    monkeypatch.setattr(pa9, "PA9", experiment)
+def with_phase():
+    with registered(PA9WithPhase(name="pa9", timepts=PA9.timepts)) as experiment:
 
-    @lab_params_of(experiment)
-    class PhaseParams(PA9Params):
-        pass
+        @lab_params_of(experiment)
+        class PhaseParams(PA9Params):
+            pass
 
-    return PhaseParams
+        yield PhaseParams
 
 
 def test_a_configured_field_the_draw_does_not_vary_reaches_every_group(with_phase, tmp_path):

@@ -28,6 +28,7 @@ import pytest
 
 import uio_teach as ut
 from uio_teach import plotting
+from uio_teach.worked import WORKED
 from uio_teach.worked.case_study import CASE_STUDY
 from uio_teach.worked.missile import MISSILE
 from uio_teach.worked.pa9 import PA9
@@ -292,21 +293,14 @@ def test_the_bank_figures_words_are_its_curves(bank_figure):
     assert checked == 5 * len(runs)
 
 
-def _frames():
-    from uio_teach.explorers import compute_frame, scenario_of
-
-    for name in ("pa9", "case_study", "missile", "quadruple_tank"):
-        sc = scenario_of(name)
-        yield name, sc, compute_frame(sc)
-
-
-@pytest.mark.parametrize("name", ["pa9", "case_study", "missile", "quadruple_tank"])
+@pytest.mark.parametrize("name", list(WORKED))
 def test_an_explorer_frames_words_are_its_picture(name):
     """The static frame's words name the value, disturbance, poles, zeros and guides drawn."""
-    from uio_teach.explorers import render
+    from uio_teach.explorers import compute_frame, render, scenario_of
     from uio_teach.explorers.static import frame_alt, main_control_label
 
-    _, sc, frame = next(f for f in _frames() if f[0] == name)
+    sc = scenario_of(name)
+    frame = compute_frame(sc)
     words = frame_alt(frame, main_control_label(sc, frame.settings), "VALUE")
     fig = render(sc, frame.settings)
     assert "= VALUE" in words.split(". ")[0], words  # the value next to the control's name

@@ -24,6 +24,8 @@ from uio_teach.instructor.config import MAX_SAMPLES, ConfigError, FigureConfig, 
 
 FAST = ["case_error", "missile_table2"]  # two quick outputs: a figure and a table
 
+SLOW = pytest.mark.slow  # each a process killed and two full runs: CI runs them all
+
 
 def snapshot(folder: Path) -> dict[str, bytes]:
     """Every file under ``folder`` (relative name -> bytes), hidden ones included."""
@@ -278,7 +280,8 @@ def lab_sets(tmp_path_factory) -> dict:
 
 # steps of `labs --source lab_pa9.md --groups 2`: 4 notebooks (1-4), the key (5), the manifest
 # (6), the swap: before it (7), after it, before the old set is removed (8)
-@pytest.mark.parametrize("kill_at", [1, 3, 5, 6, 7, 8])
+# the step inside the swap (7) in `make test`, every other step in the slow set (`make test-slow`)
+@pytest.mark.parametrize("kill_at", [7, *(pytest.param(k, marks=SLOW) for k in (1, 3, 5, 6, 8))])
 @pytest.mark.subprocess
 def test_labs_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, lab_sets, kill_at):
     out = tmp_path / "labs"
@@ -404,7 +407,8 @@ def test_folders_get_the_users_usual_permissions(tmp_path, mask):
 
 # steps of figures_argv: case_error.png and its words case_error.txt (1, 2), missile_table2.csv
 # and .md (3, 4), the manifest (5), before the swap (6), after it (7)
-@pytest.mark.parametrize("kill_at", [1, 2, 4, 5, 6, 7])
+# the step inside the swap (6) in `make test`, every other step in the slow set (`make test-slow`)
+@pytest.mark.parametrize("kill_at", [6, *(pytest.param(k, marks=SLOW) for k in (1, 2, 4, 5, 7))])
 @pytest.mark.subprocess
 def test_figures_killed_at_any_step_leave_the_old_set_or_the_new_set(tmp_path, kill_at):
     sets = {}

@@ -46,7 +46,7 @@ def test_the_chapter_numbers_are_the_defaults_of_the_parameter_class(lab):
     assert params_of(myst) == lab.params().to_params()
 
 
-@pytest.mark.parametrize("cls", [PA9Params, CaseStudyParams, MissileParams])
+@pytest.mark.parametrize("cls", [lab.params for lab in labs.LABS.values()], ids=list(labs.LABS))
 def test_params_round_trip_through_json(cls):
     params = cls().to_params()
     again = json.loads(json.dumps(params))
@@ -323,3 +323,90 @@ def test_groups_need_a_lab_of_the_course_and_sane_numbers(tmp_path, capsys):
     assert cli.main(["labs", "--out", str(tmp_path / "o"), "--groups", "2", "--seed", "-1"]) == 2
     assert cli.main(["labs", "--out", str(tmp_path / "o"), "--seed", "3"]) == 2
     assert not (tmp_path / "o").exists()
+
+
+# a group's numbers depend on the seed, its lab and the group only ------------------------------
+
+EXTRA_LAB = """
+from uio_teach.worked import ExplorerOptions, LabEntry, WorkedExample
+from uio_teach.worked.pa9 import PA9, PA9Params
+from uio_teach.examples import pa9
+
+EXAMPLES = (
+    WorkedExample(
+        name="aaa_probe_lab",
+        title="A lab registered before every other",
+        plant=pa9,
+        experiment=PA9,
+        family="uio",
+        order=-1,
+        explorer=ExplorerOptions(
+            period=2.5, pole_limits=(-10, 1), frequency_limits=(0, 10),
+            period_limits=(0.25, 5), static_values=(-1.0,),
+        ),
+        lab=LabEntry("lab_aaa_probe.md", PA9Params, ()),
+    ),
+)
+"""
+
+
+def every_groups_numbers(seed: int) -> dict:
+    return {
+        lab_id: [v.to_params() for v in labs.draw_variants(lab, 3, seed=seed)]
+        for lab_id, lab in labs.LABS.items()
+        if lab_id != "aaa_probe_lab"
+    }
+
+
+def test_registering_a_lab_before_the_others_changes_no_groups_numbers(tmp_path, monkeypatch):
+    """The draw is keyed by the lab's id, not its place: an answer key stays right."""
+    import importlib
+    import sys
+
+    from uio_teach.worked import discover
+
+    before = every_groups_numbers(seed=2027)
+    package = tmp_path / "probe_labs"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "probe.py").write_text(EXTRA_LAB)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    importlib.invalidate_caches()
+    discover("probe_labs")
+    try:
+        assert list(labs.LABS)[0] == "aaa_probe_lab"  # first: every other lab moved one place
+        assert every_groups_numbers(seed=2027) == before
+    finally:
+        discover("probe_labs", remove=True)
+        for name in [m for m in sys.modules if m.split(".")[0] == "probe_labs"]:
+            del sys.modules[name]
+    assert "aaa_probe_lab" not in labs.LABS
+
+
+def test_a_lab_draws_from_a_stream_of_its_own():
+    """Two labs with the same parameter class draw different groups under one seed."""
+    from uio_teach.instructor.lab_registry import Lab
+
+    pa9 = labs.LABS["pa9"]
+    twin = Lab("pa9_twin", pa9.source, pa9.params, pa9.check_ids)
+    assert [v.to_params() for v in labs.draw_variants(twin, 2, seed=1)] != [
+        v.to_params() for v in labs.draw_variants(pa9, 2, seed=1)
+    ]
+
+
+def test_a_draw_that_cannot_vary_says_what_collided():
+    """Not "poles or plant" whatever it was: the message names what every draw shared."""
+    from uio_teach.instructor.lab_registry import Lab
+
+    class Still(PA9Params):
+        @classmethod
+        def vary(cls, rng, base):
+            return {"noise": 0.1}  # the poles and the plant stay the course's
+
+    still = Lab("still", "lab_pa9.md", Still, ())
+    with pytest.raises(labs.LabUsageError, match=r"cannot draw 1 distinct variants") as err:
+        labs.draw_variants(still, 1, seed=1)
+    message = str(err.value)
+    assert "draws shared their poles with the book" in message, message
+    assert "draws shared their plant with the book" in message, message
+    assert "params" not in message.split("(", 1)[1], message  # the noise differed

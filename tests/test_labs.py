@@ -10,6 +10,7 @@ Jupyter would show raw.
 from __future__ import annotations
 
 import ast
+import functools
 import json
 import re
 import textwrap
@@ -20,6 +21,7 @@ import nbclient
 import nbformat
 import pytest
 from lab_outputs import assert_checks_say_what_is_missing, assert_every_check_passes, tags
+from term_changes import changed_values, leaves, nested, reached
 
 from uio_teach.instructor import cli, labs
 from uio_teach.instructor.config import FigureConfig, load_config
@@ -419,7 +421,11 @@ def test_no_line_of_solution_code_is_in_the_student_notebook(lab):
     """Not in its code, and not in its markdown either (a summary that repeats the solution)."""
     text = "\n".join(c.source for c in lab["student"].cells)
     lines = solution_only_lines(lab["solution"])
-    assert len(lines) >= 10
+    assert len(lines) >= 10, (
+        f"the solution cells (tagged `solution`) of {lab['source']} hold {len(lines)} lines of "
+        "code of their own, fewer than 10: a lab chapter's exercises are solved in code cells "
+        "tagged `solution` between `solution-start` and `solution-end` (see CONTRIBUTING.md)"
+    )
     leaked = [line for line in lines if line in text]
     assert not leaked, leaked
 
@@ -484,39 +490,14 @@ def test_cross_references_are_short_plain_text(lab, version):
 
 # every key of the term config reaches the labs (or the help says why not) ----------------------
 
-# a value for each key that differs from the default, valid on its own
-TERM_CHANGES = {
-    "seed": 5,
-    "style": "ggplot",
-    "pa9.noise": 0.05,
-    "pa9.duration": 12.0,
-    "pa9.samples": 1201,
-    "pa9.sine.amplitude": 0.5,
-    "missile.duration": 0.4,
-    "missile.samples": 8001,
-    "missile.noise.seed": 11,
-    "missile.noise.sigma": 0.02,
-    "case_study.steps": 50,
-}
+# a value for each key that differs from the default, valid on its own, derived from the schema
+TERM_CHANGES = {key: value for key, (value, _) in changed_values().items() if value is not None}
 
 
-def nested(changes: dict) -> dict:
-    out: dict = {}
-    for key, value in changes.items():
-        *tables, name = key.split(".")
-        where = out
-        for table in tables:
-            where = where.setdefault(table, {})
-        where[name] = value
-    return out
-
-
-def leaves(value, path=()):
-    if isinstance(value, dict):
-        for k, v in value.items():
-            yield from leaves(v, (*path, k))
-    else:
-        yield path, value
+def test_every_config_key_has_a_change_the_config_and_the_labs_accept():
+    """Each key of the schema is tried (no list of keys here): none is left out unseen."""
+    stuck = {key: why for key, (value, why) in changed_values().items() if value is None}
+    assert not stuck, f"no changed value could be made for these config keys: {stuck}"
 
 
 def params_of(nb) -> dict:
@@ -541,7 +522,10 @@ def unread(lab_id: str, key: str) -> bool:
 def term_labs(tmp_path_factory) -> dict:
     """The labs written with a term config that changes every key of TERM_CHANGES."""
     folder = tmp_path_factory.mktemp("term")
-    config = load_config(write_toml(folder / "term.toml", nested(TERM_CHANGES)))
+    changes = {
+        k: v for k, v in TERM_CHANGES.items() if reached(FigureConfig.from_dict(nested({k: v})))
+    }
+    config = load_config(write_toml(folder / "term.toml", nested(changes)))
     results = labs.write_labs(folder / "labs", book_dir=BOOK, config=config)
     return {"config": config, "results": {labs.lab_of(r.source).id: r for r in results}}
 
@@ -564,32 +548,83 @@ def test_the_written_notebooks_hold_the_terms_numbers(term_labs, lab_id):
         assert params_of(nbformat.read(path, as_version=4)) == expected
 
 
+@functools.cache
+def solution_code(lab_id: str) -> str:
+    """The code cells of the lab's solution notebook (quotes made double, for :func:`reads`)."""
+    solution = labs.make_notebook(BOOK / labs.LABS[lab_id].source, "solution")
+    code = "\n".join(c.source for c in solution.cells if c.cell_type == "code")
+    return code.replace("'", '"')
+
+
+def wiring_problems(key: str, value) -> list[str]:
+    """Why ``key`` = ``value`` of a term config would not reach what the students run (empty: it
+    does): a key no lab reads must be named by ``labs``; one that reaches a lab's PARAMS must be
+    read by its code, or named in UNREAD_CONFIG_KEYS."""
+    config = FigureConfig.from_dict(nested({key: value}))
+    reaches = reached(config)
+    if not reaches:  # a key no lab declares: `labs` says so, by name
+        notes = labs.unused_config_keys(config)
+        said = [n for n in notes if n.startswith(f"{key} of the term config is used by no lab")]
+        return [] if said else [f"{key} reaches no lab and `uio-teach labs` does not say so"]
+    out = []
+    for lab_id, changed in reaches.items():
+        is_read = any(reads(solution_code(lab_id), p) for p in changed)
+        if is_read == unread(lab_id, key):
+            out.append(
+                f"{key} reaches the PARAMS of the {lab_id} lab "
+                + (
+                    "and its notebook reads it, but UNREAD_CONFIG_KEYS says it does not"
+                    if is_read
+                    else f"but no code cell of {labs.LABS[lab_id].source} reads "
+                    + " or ".join("PARAMS" + "".join(f"[{p!r}]" for p in path) for path in changed)
+                    + ": wire it into the chapter's code (or name it in UNREAD_CONFIG_KEYS "
+                    "with the reason)"
+                )
+            )
+    return out
+
+
 @pytest.mark.parametrize("key", list(TERM_CHANGES))
-def test_every_config_key_reaches_a_lab_that_reads_it_or_the_help_says_why_not(
-    term_labs, key, capsys
-):
-    config = FigureConfig.from_dict(nested({key: TERM_CHANGES[key]}))
-    reached = []
-    for lab_id, lab in labs.LABS.items():
-        before = dict(leaves(lab.params.from_config(FigureConfig()).to_params()))
-        after = dict(leaves(lab.params.from_config(config).to_params()))
-        changed = [p for p in after if after[p] != before.get(p)]
-        if not changed:
-            continue
-        reached.append(lab_id)
-        solution = nbformat.read(term_labs["results"][lab_id].solution, as_version=4)
-        code = "\n".join(c.source for c in solution.cells if c.cell_type == "code")
-        code = code.replace("'", '"')
-        is_read = any(reads(code, p) for p in changed)
-        assert is_read != unread(lab_id, key), (
-            f"{key} in the {lab_id} lab: {'read' if is_read else 'not read'} by the notebook, "
-            f"but UNREAD_CONFIG_KEYS says {'not read' if unread(lab_id, key) else 'read'}"
-        )
-    assert reached, f"{key} changes no lab's PARAMS"
+def test_every_config_key_reaches_a_lab_that_reads_it_or_is_said(key, capsys):
+    assert wiring_problems(key, TERM_CHANGES[key]) == []
     assert cli.main(["labs", "--help"]) == 0
     help_text = " ".join(capsys.readouterr().out.split())
     for entry in labs.UNREAD_CONFIG_KEYS:
         assert " ".join(entry.text().split()) in help_text
+
+
+def test_a_lab_field_added_without_wiring_fails_by_name():
+    """One more line in PA9's experiment, ``lab=True``, that the lab chapter never reads."""
+    import dataclasses
+
+    from uio_teach.experiments import param
+    from uio_teach.lab_params import lab_params_of
+    from uio_teach.worked import discover, pa9
+
+    @dataclasses.dataclass(frozen=True)
+    class WithBias(pa9.PA9Experiment):
+        bias: float = param(0.25, "float", "a constant added to d", key="sine.bias")
+
+    @lab_params_of(WithBias(name="pa9", timepts=pa9.PA9_LAB.timepts))
+    class BiasParams(pa9.PA9Params):
+        pass
+
+    own = pa9.EXAMPLES
+    entry = own[0]
+    lab = dataclasses.replace(entry.lab, params=BiasParams)
+    experiment = WithBias(name="pa9", timepts=pa9.PA9.timepts)
+    pa9.EXAMPLES = (dataclasses.replace(entry, experiment=experiment, lab=lab),)
+    discover()
+    try:
+        problems = wiring_problems("pa9.sine.bias", 0.5)
+    finally:
+        pa9.EXAMPLES = own
+        discover()
+    assert problems == [
+        "pa9.sine.bias reaches the PARAMS of the pa9 lab but no code cell of lab_pa9.md reads "
+        "PARAMS['sine']['bias']: wire it into the chapter's code (or name it in "
+        "UNREAD_CONFIG_KEYS with the reason)"
+    ]
 
 
 @pytest.mark.book

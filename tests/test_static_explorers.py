@@ -47,6 +47,22 @@ SCENARIOS = {
 }
 
 
+# the tests of one explorer on one worker, which renders its frames once (explorer_page)
+NAMES = [
+    pytest.param(name, marks=pytest.mark.xdist_group(f"static explorer {name}"), id=name)
+    for name in sorted(SCENARIOS)
+]
+
+
+@functools.cache
+def explorer_page(name: str):
+    """The static explorer of ``name``, rendered once per worker for every test that reads it.
+
+    Rendering every frame of an explorer is most of the cost of these tests; the page is the
+    same for each (nothing here changes it), so it is made once."""
+    return static_explorer(SCENARIOS[name]())
+
+
 _STATE_JS = """() => {
   const img = document.querySelector('img.uio-frame');
   return {src: img.src, alt: img.alt, width: img.naturalWidth,
@@ -62,9 +78,9 @@ _SET_JS = """([i, j]) => {
 }"""
 
 
-@pytest.mark.parametrize("name", sorted(SCENARIOS))
+@pytest.mark.parametrize("name", NAMES)
 def test_every_position_changes_picture_caption_and_alt(name, tmp_path):
-    page_data = static_explorer(SCENARIOS[name]())
+    page_data = explorer_page(name)
     html = f"<!doctype html><html lang='en'><body>{page_data.html}</body></html>"
     path = tmp_path / f"{name}.html"
     path.write_text(html, encoding="utf-8")
@@ -263,7 +279,7 @@ def _phone_walk(page, k: int, where: str, kinds: int) -> list[dict]:
 
 
 def _standalone(name: str, tmp_path: Path) -> tuple[Path, int]:
-    data = static_explorer(SCENARIOS[name]())
+    data = explorer_page(name)
     html = (
         f"<!doctype html><html lang='en'><head>{VIEWPORT_META}</head>"
         f"<body><p>Before the explorer.</p>{data.html}</body></html>"
@@ -273,7 +289,7 @@ def _standalone(name: str, tmp_path: Path) -> tuple[Path, int]:
     return path, 1 + max(f.index[1] for f in data.frames)
 
 
-@pytest.mark.parametrize("name", sorted(SCENARIOS))
+@pytest.mark.parametrize("name", NAMES)
 def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
     path, kinds = _standalone(name, tmp_path)
     measured = {}
@@ -297,7 +313,7 @@ def test_phone_layout_reflows_and_stays_operable(name, tmp_path):
     )
 
 
-@pytest.mark.parametrize("name", sorted(SCENARIOS))
+@pytest.mark.parametrize("name", NAMES)
 def test_wide_layout_is_kept(name, tmp_path):
     """At 1280 px the controls share one row above a 780 px picture, drawn wide, with text of at
     least 9 CSS pixels."""
@@ -375,7 +391,7 @@ _CONTROLS_JS = """
 """
 
 
-@pytest.mark.parametrize("name", sorted(SCENARIOS))
+@pytest.mark.parametrize("name", NAMES)
 def test_controls_work_from_the_keyboard_with_focus_labels_and_announcements(name, tmp_path):
     """Tab reaches the slider and the disturbance menu; each shows a focus ring and has a name;
     the arrow keys move the slider, whose value is read out as shown (not as its index), and the

@@ -114,21 +114,33 @@ def cross_keys(lab, drawn):
     return own, failed, total
 
 
-CHECKS_PER_LAB = {"pa9": 1, "case_study": 3, "missile": 2}
+def checks_per_lab(lab):
+    """How many value-graded checks ``verdicts`` runs for ``lab`` (on the course's numbers)."""
+    params = LABS[lab].params().to_params()
+    return len(verdicts(lab, SOLVE[lab](params), params))
 
 
 @pytest.mark.parametrize("lab", list(LABS))
+def test_every_lab_has_a_solution_of_the_tests_own(lab):
+    assert lab in SOLVE, (
+        f"the {lab} lab has no solution in tests/test_variant_keys.py: write {lab}_solution "
+        "(what a right answer computes from a group's PARAMS), add it to SOLVE and its "
+        "value-graded checks to verdicts (CONTRIBUTING.md, step 8)"
+    )
+
+
+@pytest.mark.parametrize("lab", [lab for lab in LABS if lab in SOLVE])
 def test_each_group_solution_passes_its_own_key_and_fails_every_other(variants, lab):
     own, failed, total = cross_keys(lab, variants[lab])
     assert own == GROUPS
-    assert failed == total == GROUPS * (GROUPS - 1) * CHECKS_PER_LAB[lab]
+    assert failed == total == GROUPS * (GROUPS - 1) * checks_per_lab(lab)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("lab", list(LABS))
+@pytest.mark.parametrize("lab", [lab for lab in LABS if lab in SOLVE])
 def test_a_class_of_twelve_groups_has_twelve_keys(lab):
     own, failed, total = cross_keys(lab, draw_variants(LABS[lab], 12, seed=1))
-    assert own == 12 and failed == total == 12 * 11 * CHECKS_PER_LAB[lab]
+    assert own == 12 and failed == total == 12 * 11 * checks_per_lab(lab)
 
 
 @pytest.mark.parametrize("lab", list(LABS))

@@ -14,7 +14,7 @@ from tolerance import assert_rounding_close
 
 from uio_teach.experiments import EXPERIMENTS, LAB_PLANTS, experiment_params, param, pole_text
 from uio_teach.explorers import compute_frame
-from uio_teach.explorers.scenarios import plant_controls
+from uio_teach.explorers.scenarios import plant_controls, scenario_of
 from uio_teach.instructor import figures
 from uio_teach.instructor.config import OBSERVER_KEYS, FigureConfig, config_schema
 from uio_teach.instructor.lab_registry import LABS
@@ -96,7 +96,7 @@ def test_the_registry_is_the_source_of_experiments_labs_observers_and_figures():
 @pytest.mark.parametrize("name", list(WORKED))
 def test_every_declared_field_reaches_the_config_the_lab_and_the_explorer(name):
     entry, experiment = WORKED[name], WORKED[name].run()
-    scenario = entry.make_scenario()
+    scenario = scenario_of(entry.name)
     lab_fields = {f.name for f in dataclasses.fields(LABS[name].params)} if entry.lab else set()
     limits = {
         "amplitude": (scenario.amplitude_limits, scenario.defaults.amplitude),
@@ -124,7 +124,7 @@ def test_every_declared_field_reaches_the_config_the_lab_and_the_explorer(name):
 
 def test_a_slider_of_its_own_remakes_the_run_and_a_plant_slider_the_plant():
     for name, entry in WORKED.items():
-        scenario = entry.make_scenario()
+        scenario = scenario_of(entry.name)
         plant_fields = type(entry.run()).plant_fields
         for control in scenario.plant_controls:
             lo, hi = control.limits
@@ -155,9 +155,9 @@ def test_a_declared_range_gives_a_slider_whatever_the_field():
 
 def test_a_slider_value_for_a_field_without_one_is_refused():
     with pytest.raises(RegistryError, match=r"no slider 'gamma3'; its sliders: gamma1, gamma2"):
-        WORKED["quadruple_tank"].make_scenario(gamma3=0.5)
+        scenario_of("quadruple_tank", gamma3=0.5)
     with pytest.raises(RegistryError, match=r"the pa9 explorer has no slider 'poles'"):
-        WORKED["pa9"].make_scenario(poles=(-1.0, -2.0, -3.0))
+        scenario_of("pa9", poles=(-1.0, -2.0, -3.0))
 
 
 @pytest.mark.slow
@@ -229,13 +229,13 @@ def test_an_option_that_a_declared_field_sets_is_refused(monkeypatch):
     )
     monkeypatch.setitem(WORKED._load(), "pa9", entry)
     with pytest.raises(RegistryError, match=r"the field 'noise' sets the noise control"):
-        entry.make_scenario()
+        scenario_of(entry.name)
 
 
 def test_every_worked_example_has_typed_explorer_options():
     for name, entry in WORKED.items():
         assert isinstance(entry.explorer, ExplorerOptions), name
-        assert entry.make_scenario().title == (entry.explorer.title or entry.title)
+        assert scenario_of(entry.name).title == (entry.explorer.title or entry.title)
 
 
 def test_a_time_grid_given_twice_is_refused():
@@ -259,4 +259,4 @@ def test_an_explorer_option_that_would_be_ignored_is_refused(monkeypatch, change
     )
     monkeypatch.setitem(WORKED._load(), "pa9", entry)
     with pytest.raises(RegistryError, match=message):
-        entry.make_scenario()
+        scenario_of(entry.name)

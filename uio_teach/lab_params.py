@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
@@ -220,15 +221,18 @@ def _paths(params: Mapping[str, Any], prefix: str = "") -> list[str]:
     return out
 
 
-class LabParams:
+class LabParams(ABC):
     """What every lab's parameter class shares (see the module's docstring).
 
     The fields come from the lab's experiment (:func:`lab_params_of`);
     ``to_params``, ``from_params``, ``from_config``, :meth:`draw` and
     :meth:`plant` read the declarations, so they need no change when a field
-    is added. A lab's class says what a group's variant changes
-    (:meth:`vary`), when a variant is a fair exercise (``problems``) and the
-    answer key (``answers``).
+    is added. Four methods only the lab can write are abstract, so a lab's
+    class that forgets one cannot be made at all (Python names the missing
+    ones) rather than deal groups the same numbers or an empty key:
+    :meth:`vary` (what a group's variant changes), :meth:`distinct` (what
+    no two groups may share), :meth:`problems` (when a variant is a fair
+    exercise) and :meth:`answers` (the answer key).
 
     Examples
     --------
@@ -293,6 +297,17 @@ class LabParams:
         return cls(**kwargs)
 
     @classmethod
+    def config_keys(cls) -> frozenset[str]:
+        """The keys of the term config this lab reads (its fields' config keys).
+
+        ``uio-teach labs`` names every key a config sets that no lab reads
+        (:func:`uio_teach.instructor.labs.unused_config_keys`); a lab whose
+        :meth:`from_config` reads another key says so here.
+        """
+        keys = (spec.config_key(cls.lab, name) for name, spec in cls.declared())
+        return frozenset(k for k in keys if k is not None)
+
+    @classmethod
     def from_config(cls, config: Mapping[str, Any] | None) -> LabParams:
         """The parameters of a term config (:func:`uio_teach.instructor.config.load_config`).
 
@@ -316,13 +331,16 @@ class LabParams:
         return cls(**kwargs)
 
     @classmethod
+    @abstractmethod
     def vary(cls, rng: np.random.Generator, base: LabParams) -> dict[str, Any]:
         """What one group's variant changes: field names and their drawn values.
 
         Each lab's class says what it draws (the plant, poles, signals, ...);
-        every field it does not name keeps the value of ``base``.
+        every field it does not name keeps the value of ``base``. Abstract:
+        only the lab knows which numbers make another exercise with other
+        answers; a lab that varies nothing would give every group the
+        same answers, so it says so by returning ``{}`` on purpose.
         """
-        return {}
 
     @classmethod
     def draw(cls, rng: np.random.Generator, base: LabParams | None = None) -> LabParams:
@@ -366,9 +384,34 @@ class LabParams:
         values["matrices"] = dict(getattr(self, "matrices", ()) or ())
         return self.experiment.with_values(duration=getattr(self, "duration", None), **values)
 
+    @abstractmethod
     def distinct(self) -> dict[str, Any]:
-        """What no two groups may share (hashable values by name); see :meth:`draw`."""
-        return {}
+        """What no two groups may share (hashable values by name), e.g. ``{"poles": ...}``.
+
+        Abstract: two variants that differ only in numbers that do not
+        decide the answers (a seed, a time grid) would share an answer key;
+        the lab names what decides them. The names appear in the message of
+        :func:`uio_teach.instructor.variants.draw_variants` when too many
+        draws collide.
+        """
+
+    @abstractmethod
+    def problems(self) -> list[str]:
+        """Why this variant would not be a fair exercise, one sentence each (empty: it is).
+
+        Abstract: only the lab knows what its exercises need (a UIO that
+        exists, poles fast enough for the simulated time, a disturbance large
+        enough to see); a drawn variant with a problem is drawn again.
+        """
+
+    @abstractmethod
+    def answers(self) -> dict[str, Any]:
+        """The answer key of this variant: JSON-compatible numbers by name.
+
+        Abstract: the key is what the lab asks for, computed from the
+        variant's own plant and numbers (:func:`answer_value`);
+        ``uio-teach labs --groups`` writes it to ``answer_key.csv``.
+        """
 
 
 def lab_params_of(experiment: Experiment, lab: str | None = None) -> Callable[[type], type]:

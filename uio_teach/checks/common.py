@@ -200,7 +200,6 @@ class CheckResult:
 _F = TypeVar("_F", bound=Callable[..., CheckResult])
 
 _COLLECTED: list[CheckResult] = []
-_LAB_PREFIXES = ("case_study", "missile", "pa9")
 
 
 def collected() -> list[CheckResult]:
@@ -239,8 +238,15 @@ def clear_collected() -> None:
 
 
 def _default_check_id(name: str) -> str:
-    """``pa9_design`` -> ``pa9.design``: the lab's id, a dot, the rest of the function's name."""
-    for prefix in _LAB_PREFIXES:
+    """``pa9_design`` -> ``pa9.design``: the lab's id, a dot, the rest of the function's name.
+
+    The ids are the worked examples' names, read from the registry (the
+    longest first, so that ``case_study_lmi`` is the case study's).
+    """
+    # deferred: the registry is read once the first check is declared
+    from ..worked import WORKED
+
+    for prefix in sorted(WORKED, key=len, reverse=True):
         if name.startswith(prefix + "_"):
             return f"{prefix}.{name[len(prefix) + 1 :]}"
     return name

@@ -26,7 +26,7 @@ from ..existence import check_existence
 from ..experiments import experiment_params
 from ..linalg import is_stable, rank
 from ..plant import Plant
-from ..worked import WORKED, RegistryError, resolve
+from ..worked import WORKED, RegistryError
 from .model import (
     FAMILIES,
     Channel,
@@ -72,7 +72,8 @@ def scenario_of(name: str, **plant_values: float) -> Scenario:
     >>> scenario_of("quadruple_tank", gamma1=0.43, gamma2=0.34).existence.ok
     False
     """
-    return _entry(name).make_scenario(**plant_values)
+    _entry(name)
+    return experiment_scenario(name, **plant_values)
 
 
 def _entry(name: str):
@@ -410,5 +411,5 @@ def experiment_scenario(name: str, **values: Any) -> Scenario:
         input_symbol=opts.input_symbol,
         plant_controls=sliders,
         rebuild=functools.partial(experiment_scenario, name),
-        note=resolve(opts.note)(**physical) if opts.note else "",
+        note=opts.note(**physical) if opts.note else "",
     )

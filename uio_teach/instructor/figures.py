@@ -44,7 +44,7 @@ from typing import Any
 
 import matplotlib.style
 
-from ..worked import WORKED, RegistryView, resolve, run_from_config
+from ..worked import WORKED, RegistryView, run_from_config
 from .config import (
     ConfigError,
     FigureConfig,
@@ -147,7 +147,7 @@ def _figures(worked: Mapping[str, Any]) -> dict[str, FigureSpec]:
     out = {}
     for entry in worked.values():
         for fig in entry.figures:
-            out[fig.name] = FigureSpec(fig.name, fig.description, resolve(fig.draw), fig.table)
+            out[fig.name] = FigureSpec(fig.name, fig.description, fig.draw, fig.table)
     return out
 
 

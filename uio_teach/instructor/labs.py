@@ -65,6 +65,7 @@ __all__ = [
     "LabResult",
     "ConfigNotKeptWarning",
     "config_notes",
+    "unused_config_keys",
     "draw_variants",
     "lab_of",
     "params_source",
@@ -173,6 +174,56 @@ def config_notes(lab: Lab, config: Mapping[str, Any], groups: bool) -> list[str]
                     f"{' and '.join(given)} of the term config {verb} the {lab.id} lab's "
                     f"PARAMS, but its notebooks do not read {them}: {entry.why}"
                 )
+    return notes
+
+
+def unused_config_keys(config: Mapping[str, Any]) -> list[str]:
+    """The keys ``config`` sets that no lab uses, one sentence each, by name.
+
+    A key set in the term config reaches the labs' ``PARAMS`` when a lab's
+    parameter class reads it (``config_keys()``: its experiment's fields with
+    ``lab=True``, and what its ``from_config`` reads besides);
+    the others set only the figures and the explorers (a worked example
+    without a lab, or a field its lab does not ask about). ``uio-teach labs``
+    prints these sentences, so that no configured value is dropped unseen.
+
+    Parameters
+    ----------
+    config : mapping
+        The term config (a ``FigureConfig`` says which keys it was given;
+        a plain mapping sets every key it has).
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.config import FigureConfig
+    >>> from uio_teach.instructor.labs import unused_config_keys
+    >>> cfg = FigureConfig.from_dict({"quadruple_tank": {"gamma1": 0.8}, "pa9": {"noise": 0.1}})
+    >>> print(unused_config_keys(cfg)[0])  # doctest: +ELLIPSIS
+    quadruple_tank.gamma1 of the term config is used by no lab (quadruple_tank has none): it ...
+    """
+    used = {key for lab in LABS.values() for key in lab.params.config_keys()}
+    given = getattr(config, "given", None)
+    keys = sorted(given) if given is not None else sorted(config)
+    notes = []
+    for key in keys:
+        if key in used:
+            continue
+        table = key.split(".", 1)[0]
+        whose = (
+            f"the {table} lab does not ask for it"
+            if table in LABS
+            else f"{table} has none"
+            if "." in key
+            else "no lab declares it"
+        )
+        notes.append(
+            f"{key} of the term config is used by no lab ({whose}): it sets the figures and "
+            "explorers only"
+        )
     return notes
 
 
@@ -339,6 +390,9 @@ def write_labs(
         raise LabUsageError(f"seed must be a non-negative integer, got {seed}")
     index = BookIndex.from_book(book)
 
+    if config is not None:
+        for note in unused_config_keys(config):
+            warnings.warn(ConfigNotKeptWarning(note), stacklevel=2)
     # every job before anything is written: (path, lab, group, params)
     jobs: list[tuple[Path, Lab | None, str, Any]] = []
     for path in paths:

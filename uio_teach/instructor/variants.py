@@ -16,6 +16,7 @@ True
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 from collections.abc import Sequence
 from pathlib import Path
@@ -23,12 +24,39 @@ from typing import Any
 
 import numpy as np
 
-from .lab_registry import LABS, LabUsageError
+from .lab_registry import LabUsageError
 
-__all__ = ["ANSWER_KEY", "draw_variants", "write_answer_key"]
+__all__ = ["ANSWER_KEY", "draw_variants", "lab_stream", "write_answer_key"]
 
 ANSWER_KEY = "answer_key.csv"
 """The file name of the answer key in the output folder."""
+
+
+def lab_stream(lab_id: str) -> int:
+    """The lab's own stream of random numbers under a seed: a stable hash of its id.
+
+    The variants of a lab depend on the seed, this number and the group
+    only, never on where the lab stands among the others: registering,
+    removing or reordering another lab changes no group's numbers. The hash
+    is SHA-256 of the id (not Python's ``hash``, which changes between runs).
+
+    Parameters
+    ----------
+    lab_id : str
+        The lab's id (``"pa9"``, ...).
+
+    Returns
+    -------
+    int
+        A non-negative 64-bit integer.
+
+    Examples
+    --------
+    >>> from uio_teach.instructor.variants import lab_stream
+    >>> lab_stream("pa9") == lab_stream("pa9") != lab_stream("missile")
+    True
+    """
+    return int.from_bytes(hashlib.sha256(lab_id.encode("utf-8")).digest()[:8], "big")
 
 
 def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[Any]:
@@ -39,6 +67,9 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
     the package's existence check and designs succeed) and shares nothing of
     its ``distinct()`` (poles, plant matrices that decide the answers) with
     a variant already kept, so that no two groups have the same answers.
+    The draw depends on ``seed``, the lab's id (:func:`lab_stream`) and the
+    number of groups drawn before, nothing else: the other labs of the
+    course, their number and their order do not change a group's numbers.
 
     Parameters
     ----------
@@ -64,27 +95,41 @@ def draw_variants(lab: Any, groups: int, seed: int, base: Any = None) -> list[An
     >>> a != b and not a.problems() and not b.problems()
     True
     """
-    index = list(LABS).index(lab.id) if lab.id in LABS else 0
-    rng = np.random.default_rng([int(seed), index])
+    rng = np.random.default_rng([int(seed), lab_stream(lab.id)])
     out: list[Any] = []
     # the course's own numbers (the book's solutions) are no group's
     seen: dict[str, set[Any]] = {k: {v} for k, v in lab.params().distinct().items()}
+    # why draws were thrown away, by what collided (for the message when too few are left)
+    refused: dict[str, int] = {}
     for _ in range(1000 * max(1, groups)):
         if len(out) == groups:
             break
         variant = lab.params.draw(rng, base)
         keys = {"params": repr(variant.to_params()), **variant.distinct()}
-        if any(value in seen.get(name, ()) for name, value in keys.items()):
+        clash = [name for name, value in keys.items() if value in seen.get(name, ())]
+        if clash:
+            for name in clash:
+                refused[name] = refused.get(name, 0) + 1
             continue
-        if variant.problems():
+        problems = variant.problems()
+        if problems:
+            for problem in problems:
+                refused[problem] = refused.get(problem, 0) + 1
             continue
         for name, value in keys.items():
             seen.setdefault(name, set()).add(value)
         out.append(variant)
     if len(out) < groups:
+        common = sorted(refused.items(), key=lambda item: -item[1])[:3]
+        why = "; ".join(
+            f"{count} draws shared their {name} with the book's or an earlier group's"
+            if name in seen
+            else f"{count} draws were no fair exercise ({name})"
+            for name, count in common
+        )
         raise LabUsageError(
-            f"cannot draw {groups} distinct variants of the {lab.id} lab "
-            "(no two groups share poles or plant); give fewer groups"
+            f"cannot draw {groups} distinct variants of the {lab.id} lab, only {len(out)} "
+            f"({why or 'nothing was drawn'}); give fewer groups"
         )
     return out
 

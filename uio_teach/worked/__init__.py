@@ -17,7 +17,7 @@ set. From these entries come
 * the figures of ``uio-teach figures`` (``uio_teach.instructor.figures``), each
   drawn from the experiment with the config's values in place
   (:func:`run_from_config`);
-* the explorer of each example (``WorkedExample.make_scenario``, from its
+* the explorer of each example (``uio_teach.explorers.scenario_of``, from its
   :class:`ExplorerOptions`), with a slider for every declared field that has a
   ``range``;
 * the labs of ``uio-teach labs`` (``uio_teach.instructor.labs.LABS``): the
@@ -58,11 +58,8 @@ __all__ = [
     "RegistryView",
     "WORKED",
     "discover",
-    "resolve",
     "run_from_config",
 ]
-
-_SCENARIO_BUILDER = "uio_teach.explorers.scenarios:experiment_scenario"
 
 FAMILIES = ("uio", "pmo")
 """The observer families whose poles a worked example's config key sets."""
@@ -72,28 +69,17 @@ class RegistryError(UIOTeachError, ValueError):
     """A worked example's declaration that cannot be used (the message names what and why)."""
 
 
-def resolve(target: str) -> Any:
-    """The object a ``"package.module:name"`` string names (imported on first use).
-
-    Parameters
-    ----------
-    target : str
-
-    Returns
-    -------
-    object
-
-    Examples
-    --------
-    >>> from uio_teach.worked import resolve
-    >>> resolve("uio_teach.examples:pa9")().name
-    'PA9'
-    """
-    module, _, name = target.partition(":")
-    obj: Any = importlib.import_module(module)
-    for part in name.split("."):
-        obj = getattr(obj, part)
-    return obj
+def _callable(owner: str, what: str, value: Any, optional: bool = False) -> None:
+    """Refuse a declaration that is not the object itself (a string naming it, say)."""
+    if optional and value is None:
+        return
+    if isinstance(value, str):
+        raise RegistryError(
+            f"{owner}: {what} must be the object itself (import it), not the string {value!r}: "
+            "an import is a reference every tool follows and every rename updates"
+        )
+    if not callable(value):
+        raise RegistryError(f"{owner}: {what} must be callable, got {type(value).__name__}")
 
 
 @dataclass(frozen=True)
@@ -106,10 +92,10 @@ class FigureEntry:
         The file stem (and the name ``--only`` takes).
     description : str
         One line, shown by ``--list``.
-    draw : str
-        ``"module:function"`` of ``draw(runs) -> Figure`` (a table:
-        ``draw(runs, folder) -> paths``), imported only when drawn, so that the
-        registry does not load matplotlib.
+    draw : callable
+        ``draw(runs) -> Figure`` (a table: ``draw(runs, folder) -> paths``),
+        the function itself; it imports matplotlib only when it draws, so the
+        registry does not load it.
     table : bool
         A table (``.csv`` and ``.md``) rather than a picture.
 
@@ -122,8 +108,11 @@ class FigureEntry:
 
     name: str
     description: str
-    draw: str
+    draw: Callable[..., Any]
     table: bool = False
+
+    def __post_init__(self) -> None:
+        _callable(f"figure {self.name!r}", "draw", self.draw)
 
 
 _REQUIRED: Any = object()  # marks an explorer option without a default
@@ -205,10 +194,9 @@ class ExplorerOptions:
     static_control : str
         The static book's main control: ``"pole"``, ``"amplitude"`` or
         ``"plant:<field>"`` (a field's own slider).
-    note : str or None
-        ``"module:function"`` called with the plant's physical parameters
-        (the experiment's ``plant_fields``): a sentence on this plant
-        (``None``: none).
+    note : callable or None
+        Called with the plant's physical parameters (the experiment's
+        ``plant_fields``): a sentence on this plant (``None``: none).
     input_symbol : str
         The unknown input's symbol in the figure.
 
@@ -252,7 +240,7 @@ class ExplorerOptions:
     d_channels: tuple[tuple[Any, ...], ...] = ()
     v_channels: tuple[tuple[Any, ...], ...] = ()
     static_control: str = "pole"
-    note: str | None = None
+    note: Callable[..., str] | None = None
     input_symbol: str = "d"
 
     def __init__(self, **options: Any) -> None:
@@ -311,6 +299,7 @@ class ExplorerOptions:
             set_(self, name, channels)
         if self.poles is not None:
             set_(self, "poles", tuple(self.poles))
+        _callable("explorer option 'note'", "it", self.note, optional=True)
         if not (
             self.static_control in ("pole", "amplitude") or self.static_control.startswith("plant:")
         ):
@@ -356,11 +345,12 @@ class WorkedExample:
         Its identifier: the table of the term config, the lab's id.
     title : str
         How the book names it.
-    plant : str
-        ``"module:function"`` of the plant factory; the experiment's fields
-        listed in ``Experiment.plant_fields`` are passed to it as keywords.
-    experiment : str
-        ``"module:NAME"`` of the experiment (an ``uio_teach.experiments.Experiment``).
+    plant : callable
+        The plant factory (a function of :mod:`uio_teach.examples`, imported);
+        the experiment's fields listed in ``Experiment.plant_fields`` are
+        passed to it as keywords.
+    experiment : Experiment
+        The experiment (an ``uio_teach.experiments.Experiment``).
     family : str
         The observer that the experiment's ``poles`` set: ``"uio"`` or
         ``"pmo"`` (``None`` poles of a PMO: the LMI gain).
@@ -372,6 +362,9 @@ class WorkedExample:
         Its lab (``None``: no lab).
     order : int
         Its place among the worked examples (the book's order).
+    module : str
+        The module that declares it (set by the registry; the API page
+        documents it).
 
     Examples
     --------
@@ -385,15 +378,22 @@ class WorkedExample:
 
     name: str
     title: str
-    plant: str
-    experiment: str
+    plant: Callable[..., Any]
+    experiment: Any
     family: str
     explorer: ExplorerOptions
     figures: tuple[FigureEntry, ...] = ()
     lab: LabEntry | None = None
     order: int = 100
+    module: str = dataclasses.field(default="", compare=False)
 
     def __post_init__(self) -> None:
+        _callable(f"worked example {self.name!r}", "plant", self.plant)
+        if isinstance(self.experiment, str):
+            raise RegistryError(
+                f"worked example {self.name!r}: experiment must be the Experiment itself, "
+                f"not the string {self.experiment!r}"
+            )
         if self.family not in FAMILIES:
             raise RegistryError(
                 f"worked example {self.name!r}: family must be one of {FAMILIES}, "
@@ -411,16 +411,12 @@ class WorkedExample:
             )
 
     def plant_factory(self) -> Callable[..., Any]:
-        """The plant factory (imported on first use)."""
-        return resolve(self.plant)
+        """The plant factory."""
+        return self.plant
 
     def run(self) -> Any:
-        """The experiment (imported on first use, looked up on every call)."""
-        return resolve(self.experiment)
-
-    def make_scenario(self, **values: Any) -> Any:
-        """The explorer's scenario; ``values`` set fields of the experiment (its sliders)."""
-        return resolve(_SCENARIO_BUILDER)(self.name, **values)
+        """The experiment."""
+        return self.experiment
 
     def poles_key(self) -> str | None:
         """The config key that sets the observer's poles (``None``: not in the config)."""
@@ -502,6 +498,8 @@ class _Registry(RegistryView):
                             raise RegistryError(
                                 f"{module.__name__}.EXAMPLES holds {entry!r}, not a WorkedExample"
                             )
+                        if not entry.module:
+                            entry = dataclasses.replace(entry, module=module.__name__)
                         found.append(entry)
             found.sort(key=lambda e: (e.order, e.name))
             names = [e.name for e in found]

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from .. import signals
+from .. import examples, signals
 from .. import tolerances as tols
 from .._display import format_poles
 from ..existence import check_existence, decoupling
@@ -316,6 +316,10 @@ the run's error, ...); the lab asks for the same computations on these
 numbers, so no page of the book gives its answers away."""
 
 
+_POLES_KEY = "case_study.poles"
+"""The config key of the observer's poles, which sets the lab's one ``pole``."""
+
+
 @lab_params_of(CASE_STUDY_LAB)
 class CaseStudyParams(LabParams):
     """The numbers of the case-study lab (the fields of :data:`CASE_STUDY`).
@@ -351,11 +355,16 @@ class CaseStudyParams(LabParams):
     """
 
     @classmethod
+    def config_keys(cls) -> frozenset[str]:
+        """As ``LabParams.config_keys``, and ``case_study.poles`` (it sets ``pole``)."""
+        return super().config_keys() | {_POLES_KEY}
+
+    @classmethod
     def from_config(cls, config: Mapping[str, Any] | None) -> CaseStudyParams:
         """As ``LabParams.from_config``; ``case_study.poles``, if given, sets ``pole``."""
         params = super().from_config(config)
         given = getattr(config, "given", None)
-        key = "case_study.poles"
+        key = _POLES_KEY
         unset = config is None or (given is not None and key not in given)
         poles = None if unset else config.get(key)
         if poles:
@@ -478,8 +487,8 @@ EXAMPLES = (
     WorkedExample(
         name="case_study",
         title="The discrete-time case study",
-        plant="uio_teach.examples:dt_case_study",
-        experiment=f"{__name__}:CASE_STUDY",
+        plant=examples.dt_case_study,
+        experiment=CASE_STUDY,
         family="pmo",
         order=20,
         # two fixed poles at 0.5 (the invariant zeros); v at half the amplitude and twice the
@@ -513,12 +522,12 @@ EXAMPLES = (
             FigureEntry(
                 "case_response",
                 "Case study: states, estimates, error and residual with u2 and v both active",
-                f"{__name__}:_case_response",
+                _case_response,
             ),
             FigureEntry(
                 "case_error",
                 "Case study: error norm on a log scale, with and without the unknown signals",
-                f"{__name__}:_case_error",
+                _case_error,
             ),
         ),
     ),

@@ -580,8 +580,8 @@ EXAMPLES = (
     WorkedExample(
         name="missile",
         title="The missile autopilot",
-        plant="uio_teach.examples:missile_autopilot",
-        experiment=f"{__name__}:MISSILE",
+        plant=examples.missile_autopilot,
+        experiment=MISSILE,
         family="pmo",
         order=30,
         # the paper's damped sinusoids, 0.5 s on 1001 samples; the inputs reconstructed with a
@@ -621,28 +621,28 @@ EXAMPLES = (
             FigureEntry(
                 "missile_pmo",
                 "Missile: x1..x4 with/without v and the PMO estimates (paper Fig. 4.1-4.4)",
-                f"{__name__}:_missile_pmo",
+                _missile_pmo,
             ),
             FigureEntry(
                 "missile_ginverse",
                 "Missile: x1..x4 with/without v and the g-inverse estimates (Fig. 4.7-4.10)",
-                f"{__name__}:_missile_ginverse",
+                _missile_ginverse,
             ),
             FigureEntry(
                 "missile_error",
                 "Missile: estimation error of the PMO and the g-inverse observer, per state",
-                f"{__name__}:_missile_error",
+                _missile_error,
             ),
             FigureEntry(
                 "missile_inputs",
                 "Missile: v1, v2 and their reconstructions by both observers (Fig. 4.5-4.6, "
                 "4.11-4.12)",
-                f"{__name__}:_missile_inputs",
+                _missile_inputs,
             ),
             FigureEntry(
                 "missile_table2",
                 "Missile: Table II, catch times (tol 2 %) next to the paper's, as .csv and .md",
-                f"{__name__}:_table2",
+                _table2,
                 table=True,
             ),
         ),

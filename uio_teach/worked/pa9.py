@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from .. import signals
+from .. import examples, signals
 from .._display import format_poles
 from ..existence import check_existence
 from ..experiments import (
@@ -501,8 +501,8 @@ EXAMPLES = (
     WorkedExample(
         name="pa9",
         title="Practical Assignment 9",
-        plant="uio_teach.examples:pa9",
-        experiment=f"{__name__}:PA9",
+        plant=examples.pa9,
+        experiment=PA9,
         family="uio",
         order=10,
         # the 10 s window on 1001 samples (half the run's resolution, for a quick redraw)
@@ -524,22 +524,22 @@ EXAMPLES = (
             FigureEntry(
                 "pa9_sine",
                 "PA9 lab: sinusoidal disturbance d(t), error e and residual r of the UIO",
-                f"{__name__}:_pa9_sine",
+                _pa9_sine,
             ),
             FigureEntry(
                 "pa9_piecewise",
                 "PA9 lab: piecewise-constant disturbance d(t), error e and residual r of the UIO",
-                f"{__name__}:_pa9_piecewise",
+                _pa9_piecewise,
             ),
             FigureEntry(
                 "pa9_states",
                 "PA9: each state with its UIO estimate, error and residual (sinusoidal d)",
-                f"{__name__}:_pa9_states",
+                _pa9_states,
             ),
             FigureEntry(
                 "pa9_luenberger",
                 "PA9: UIO vs Luenberger observer, same poles, errors and residuals for both d",
-                f"{__name__}:_pa9_luenberger",
+                _pa9_luenberger,
             ),
         ),
     ),

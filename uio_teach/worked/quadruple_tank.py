@@ -504,8 +504,8 @@ EXAMPLES = (
     WorkedExample(
         name="quadruple_tank",
         title="The quadruple-tank process",
-        plant="uio_teach.examples:quadruple_tank",
-        experiment=f"{__name__}:QUADRUPLE_TANK",
+        plant=quadruple_tank,
+        experiment=QUADRUPLE_TANK,
         family="uio",
         order=40,
         explorer=ExplorerOptions(
@@ -521,18 +521,18 @@ EXAMPLES = (
             # rank condition fails)
             static_control="plant:gamma2",
             static_values=(0.0, 0.1, 0.2, 0.29, 0.31, 0.4, 0.6, 0.8),
-            note=f"{__name__}:valve_verdict",
+            note=valve_verdict,
         ),
         figures=(
             FigureEntry(
                 "tank_error",
                 "Quadruple tank: pump deviations, error of the UIO and of a Luenberger observer",
-                f"{__name__}:_figure_error",
+                _figure_error,
             ),
             FigureEntry(
                 "tank_zeros",
                 "Quadruple tank: the invariant zeros against gamma1 + gamma2, the run's valves",
-                f"{__name__}:_figure_zeros",
+                _figure_zeros,
             ),
         ),
     ),
