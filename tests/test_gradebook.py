@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from uio_teach import folders
 from uio_teach.grading import grade
 from uio_teach.grading.gradebook import Gradebook, GradebookBusy, Submission
 from uio_teach.grading.lab_checks import lab_checks
-from uio_teach.instructor import output
 
 IDS = ("pa9.design", "pa9.plot")
 
@@ -44,7 +44,7 @@ def test_each_row_is_on_disk_as_soon_as_it_is_added(tmp_path):
     table = rows(out)
     assert [r["file"] for r in table] == ["a.ipynb", "b.ipynb"]  # the order given
     assert [r["pa9.design"] for r in table] == [grade.FAIL, grade.PASS]
-    manifest = output.read_manifest(tmp_path / "grades_feedback")
+    manifest = folders.read_manifest(tmp_path / "grades_feedback")
     assert manifest["command"] == "uio-teach grade"
     assert sorted(f["name"] for f in manifest["files"]) == ["a.html", "a.txt", "b.html", "b.txt"]
     # without a roster no group can be matched to a student: no Canvas import at all
@@ -125,11 +125,11 @@ def test_a_folder_that_is_not_earlier_feedback_is_left_alone(tmp_path, content):
     folder.mkdir()
     if content == "figures":
         (folder / "a.png").write_bytes(b"png")
-        output.write_manifest(folder, command="uio-teach figures", config={})
+        folders.write_manifest(folder, command="uio-teach figures", config={})
     else:
         (folder / "notes.txt").write_text("mine")
     before = sorted(p.name for p in folder.iterdir())
-    with pytest.raises(output.OutputError, match="left alone"):
+    with pytest.raises(folders.OutputError, match="left alone"):
         grade.grade([tmp_path / "x.ipynb"], out, sandbox=False)
     assert not out.exists() and sorted(p.name for p in folder.iterdir()) == before
 
@@ -137,7 +137,7 @@ def test_a_folder_that_is_not_earlier_feedback_is_left_alone(tmp_path, content):
 def test_a_csv_that_is_not_a_gradebook_is_not_resumed_over(tmp_path):
     out = tmp_path / "grades.csv"
     out.write_text("name,mark\nann,5\n")
-    with pytest.raises(output.OutputError, match="not a gradebook"):
+    with pytest.raises(folders.OutputError, match="not a gradebook"):
         Gradebook(out, ["a.ipynb"], IDS, resume=True).__enter__()
     assert out.read_text() == "name,mark\nann,5\n"
 

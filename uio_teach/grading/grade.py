@@ -72,7 +72,7 @@ from typing import Any
 import nbformat
 
 from ..errors import UIOTeachWarning
-from ..instructor.output import sha256_file
+from ..folders import sha256_file
 from .checking import check_in_child
 from .copies import fingerprint
 from .gradebook import (
@@ -613,7 +613,7 @@ def write_gradebook(
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` is a folder, or its feedback folder is not one of an earlier grading.
 
     Examples
@@ -766,7 +766,7 @@ def grade(
     SandboxRefused
         The sandbox is unavailable (or cannot run a one-cell notebook) and
         ``sandbox`` is True.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` is a folder, its feedback folder is not ours, or another run
         is writing it (checked before any notebook runs).
     KeyboardInterrupt

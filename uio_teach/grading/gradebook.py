@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..instructor.output import (
+from ..folders import (
     MANIFEST,
     FolderBusy,
     FolderLock,
@@ -332,7 +332,7 @@ def feedback_folder(out: str | os.PathLike[str]) -> Path:
 
 
 def check_gradebook_target(out: str | os.PathLike[str]) -> None:
-    """Raise :class:`~uio_teach.instructor.output.OutputError` unless ``out`` may be written.
+    """Raise :class:`~uio_teach.folders.OutputError` unless ``out`` may be written.
 
     The gradebook must not be a folder; its feedback folder must be absent,
     empty, or the feedback folder of an earlier grading (its manifest says so).
@@ -343,13 +343,13 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
 
     Examples
     --------
     >>> import tempfile, pathlib
     >>> from uio_teach.grading.gradebook import check_gradebook_target
-    >>> from uio_teach.instructor.output import OutputError
+    >>> from uio_teach.folders import OutputError
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     mine = pathlib.Path(tmp) / "grades_feedback"
     ...     mine.mkdir()
@@ -581,7 +581,7 @@ def read_gradebook(out: str | os.PathLike[str]) -> tuple[list[str], list[list[st
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         It cannot be read, or it is not a gradebook of uio-teach.
     """
     try:
@@ -640,7 +640,7 @@ class Gradebook:
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         The CSV is a folder, or its feedback folder is not ours.
     GradebookBusy
         Another run holds the lock.
@@ -697,7 +697,7 @@ class Gradebook:
 
         Raises
         ------
-        uio_teach.instructor.output.OutputError
+        uio_teach.folders.OutputError
             The CSV is a folder, or its feedback folder is not ours.
         GradebookBusy
             Another run holds the lock.

@@ -49,6 +49,7 @@ from typing import Any
 
 from ..checks.common import CheckResult
 from ..errors import UIOTeachError
+from ..folders import default_book_dir
 
 __all__ = [
     "CHECK_TAG",
@@ -297,7 +298,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
     Examples
     --------
     >>> from uio_teach.grading.lab_checks import read_lab_checks
-    >>> from uio_teach.instructor.book import default_book_dir
+    >>> from uio_teach.folders import default_book_dir
     >>> checks = read_lab_checks(default_book_dir() / "lab_missile.md", "missile")
     >>> checks.check_ids[:2], checks.checks[2].names
     (('missile.pmo', 'missile.ginverse'), ('vhat', 'run_pmo', 'pmo'))
@@ -379,7 +380,7 @@ def course_labs(book: str | os.PathLike[str] | None = None) -> dict[str, Path]:
     Parameters
     ----------
     book : path, optional
-        The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
+        The book's folder (:func:`~uio_teach.folders.default_book_dir` by default).
 
     Returns
     -------
@@ -391,8 +392,6 @@ def course_labs(book: str | os.PathLike[str] | None = None) -> dict[str, Path]:
     >>> sorted(course_labs())
     ['case_study', 'missile', 'pa9']
     """
-    from ..instructor.book import default_book_dir  # deferred: only where the chapters are
-
     folder = Path(book) if book is not None else default_book_dir()
     return {path.stem[4:]: path for path in sorted(folder.glob("lab_*.md"))}
 
@@ -405,7 +404,7 @@ def lab_checks(lab: str, book: str | os.PathLike[str] | None = None) -> LabCheck
     lab : str
         A lab of the course (:func:`course_labs`).
     book : path, optional
-        The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
+        The book's folder (:func:`~uio_teach.folders.default_book_dir` by default).
 
     Returns
     -------

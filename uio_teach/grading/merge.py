@@ -35,7 +35,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..instructor.output import MANIFEST, read_manifest, sha256_file, write_manifest
+from ..folders import MANIFEST, read_manifest, sha256_file, write_manifest
 from .gradebook import (
     COMMAND,
     check_gradebook_target,
@@ -222,7 +222,7 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
         No gradebook, gradebooks of different classes or gradings, a shard
         twice or missing, a row in two gradebooks, a shard not finished, or
         ``out`` is one of the gradebooks.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         A gradebook cannot be read, or ``out``'s feedback folder is not ours.
 
     Examples

@@ -34,8 +34,9 @@ from typing import Any, NoReturn, TextIO
 import matplotlib
 
 from .. import __version__
+from ..folders import MANIFEST, OutputError, check_output_folder
 from .config import DPI_RANGE, ConfigError, FigureConfig, check_dpi, load_config
-from .output import FORMATS, MANIFEST, OutputError, check_output_folder
+from .output import FORMATS
 
 # Each command imports the module that does its work only when it runs (figures draws with
 # matplotlib, grade starts kernels): deferred on purpose, so `uio-teach --help` and a usage
