@@ -24,10 +24,12 @@ from uio_teach.grading.gradebook import (
 from uio_teach.grading.rosters import (
     GradeError,
     group_from_name,
+    group_id,
     read_answer_key,
     read_roster,
 )
 from uio_teach.grading.runner import clean_notebook
+from uio_teach.grading.survey import added_since, survey
 
 # names --------------------------------------------------------------------------------------
 
@@ -48,11 +50,130 @@ from uio_teach.grading.runner import clean_notebook
         ("lab_pa9.ipynb", ("", "")),
         ("notebook (3).ipynb", ("", "")),
         ("pa9.ipynb", ("", "")),
+        ("pa9_Group-30.ipynb", ("pa9", "g30")),  # the group's own spelling, not a re-submission
+        ("pa9_group_30.ipynb", ("pa9", "g30")),
+        ("pa9_G30.ipynb", ("pa9", "g30")),
+        ("pa9_Group 30.ipynb", ("pa9", "g30")),
+        ("pa9_Group-30-1.ipynb", ("pa9", "g30")),  # and its re-submission
+        ("pa9_G30 (2).ipynb", ("pa9", "g30")),
     ],
 )
 def test_the_group_is_read_from_names_as_students_and_lmss_write_them(name, expected):
     assert group_from_name(name) == expected
     assert group_from_name(f"some/folder/{name}") == expected
+
+
+@pytest.mark.parametrize("spelling", ["Group-30", "group_30", "G30", "g030", "GROUP 30", "g30"])
+def test_every_spelling_of_a_group_is_one_group(spelling):
+    assert group_id(spelling) == "g30"
+
+
+def test_a_name_from_a_macos_zip_meets_its_roster_line(tmp_path):
+    """A macOS zip writes é as e and a combining accent (NFD); the roster, saved on Windows, as
+    one character (NFC): the same hand-in, and the student's name is one name too."""
+    roster = tmp_path / "groups.csv"
+    roster.write_text(
+        "file,lab,group,student,name\nJos\u00e9 notebook.ipynb,pa9,g07,s1,Jos\u00e9 Pe\u00f1a\n",
+        encoding="utf-8-sig",
+    )
+    files, students = read_roster(roster)
+    decomposed = tmp_path / "Jose\u0301 notebook.ipynb"
+    nb = nbformat.v4.new_notebook()
+    nbformat.write(nb, decomposed)
+    handin = grade.read_handin(decomposed, files)
+    assert (handin.lab, handin.group) == ("pa9", "g07")
+    assert students == {"g07": [("s1", "Jos\u00e9 Pe\u00f1a")]}
+
+
+def test_canvas_s_own_gradebook_export_is_a_roster_by_sis_id(tmp_path):
+    """Saved as Canvas exports it: "Student" is the display name, "SIS User ID" the id; its
+    second line is "Points Possible" and its test student is no student."""
+    roster = tmp_path / "canvas_export.csv"
+    roster.write_text(
+        "Student,ID,SIS User ID,SIS Login ID,Section,Lab 9 (123)\n"
+        "    Points Possible,,,,,5\n"
+        '"Pe\u00f1a, Jos\u00e9",101,s2026001,jpena,Group 3,\n'
+        '"Example, Ann",102,s2026002,aexample,group_3,\n'
+        '"Student, Test",103,,test,Group 3,\n',
+        encoding="utf-8-sig",
+    )
+    files, students = read_roster(roster)
+    assert files == {}
+    assert students == {"g03": [("s2026001", "Pe\u00f1a, Jos\u00e9"), ("s2026002", "Example, Ann")]}
+
+
+def test_a_group_column_added_to_canvas_s_export_wins_over_its_section(tmp_path):
+    roster = tmp_path / "canvas_export.csv"
+    roster.write_text(
+        "Student,ID,SIS User ID,SIS Login ID,Section,Group\nAnn,1,s1,a,Monday lab,G12\n",
+        encoding="utf-8",
+    )
+    assert read_roster(roster)[1] == {"g12": [("s1", "Ann")]}
+
+
+# what a hand-in folder holds ------------------------------------------------------------------
+
+
+def test_every_entry_of_a_hand_in_folder_at_any_depth_is_a_hand_in_or_a_reason(tmp_path):
+    """Canvas's flat download, Moodle's download in folders, and what students upload besides."""
+    root = tmp_path / "handed_in"
+    moodle = root / "Ann Example_123_assignsubmission_file_"
+    (moodle / "deeper").mkdir(parents=True)
+    nb = nbformat.writes(nbformat.v4.new_notebook())
+    files = {
+        root / "pa9_g01.ipynb": nb,
+        root / "PA9_G02.IPYNB": nb,
+        moodle / "pa9_g03.ipynb": nb,
+        moodle / "deeper" / "pa9_g04.Ipynb": nb,
+        root / "pa9_g05.zip": "PK",
+        root / "pa9_g06.py": "x = 1",
+        root / "report.pdf": "%PDF",
+        root / ".DS_Store": "",
+        root / "README": "",
+    }
+    for path, text in files.items():
+        path.write_text(text)
+    (root / ".ipynb_checkpoints").mkdir()
+    (root / ".ipynb_checkpoints" / "pa9_g01-checkpoint.ipynb").write_text(nb)
+    (root / "__MACOSX").mkdir()
+    (root / "__MACOSX" / "._pa9_g01.ipynb").write_text("")
+    (root / "elsewhere").symlink_to(tmp_path)
+    out = root / "grades.csv"
+    out.write_text("file\n")
+    (root / "grades_feedback").mkdir()
+    found = survey(root, own=[out, root / "grades_feedback"])
+    assert found.handins == sorted(found.handins)  # in a fixed order: the same rows each run
+    assert {Path(f).name for f in found.handins} == {
+        "pa9_g01.ipynb",
+        "PA9_G02.IPYNB",
+        "pa9_g03.ipynb",
+        "pa9_g04.Ipynb",
+    }
+    why = {Path(p).name: w for p, w in found.others}
+    every = {p.name for p in root.rglob("*")} - {Path(f).name for f in found.handins}
+    every -= {"pa9_g01-checkpoint.ipynb", "._pa9_g01.ipynb"}  # inside folders not entered
+    assert set(why) == every  # each entry once: a row or a line
+    assert why["pa9_g05.zip"].startswith("an archive, not opened")
+    assert why["pa9_g06.py"].startswith("a Python script, not a notebook")
+    assert why["report.pdf"] == "a .pdf file, not a notebook: only .ipynb notebooks are graded"
+    assert why[".ipynb_checkpoints"].startswith("Jupyter's checkpoints")
+    assert why["__MACOSX"].startswith("what macOS adds to a zip")
+    assert why["elsewhere"].startswith("a link: not followed")
+    assert (
+        why["grades.csv"]
+        == why["grades_feedback"]
+        == ("written by this grading run (its gradebook)")
+    )
+    assert why[moodle.name] == "a folder: its entries are listed on their own"
+    assert found.counts() == "16 entries: 4 hand-ins, 2 folders, 10 other entries not graded"
+    assert grade.handin_files(root) == found.handins
+    (moodle / "pa9_g07.ipynb").write_text(nb)
+    (root / "late.zip").write_text("PK")
+    added = added_since(found, survey(root, own=[out, root / "grades_feedback"]))
+    assert [(Path(p).name, w.split(":")[0]) for p, w in added] == [
+        ("pa9_g07.ipynb", "added during the grading run"),
+        ("late.zip", "added during the grading run"),
+    ]
 
 
 def test_names_of_any_legal_length_and_encoding_get_their_own_feedback_file(tmp_path):

@@ -111,6 +111,7 @@ def test_resume_widens_the_columns_for_a_new_lab(tmp_path):
         "missile.pmo",
         "total",
         "out_of",
+        "late",
     ]
     assert [(r["pa9.design"], r["missile.pmo"]) for r in table] == [
         (grade.PASS, ""),
@@ -256,3 +257,28 @@ def test_numbers_stay_numbers_and_the_lms_exports_follow_the_rows(tmp_path):
         # g02 has no student in the roster: no row Canvas could not match
         ("Cy", "s3", "g03", "0"),
     ]
+
+
+def test_the_late_flag_is_a_column_of_its_own(tmp_path):
+    out = tmp_path / "grades.csv"
+    late = Submission("ann_LATE_1_2_pa9_g01.ipynb", "pa9", "g01", "ok", late=True)
+    on_time = Submission("pa9_g02.ipynb", "pa9", "g02", "ok")
+    with Gradebook(out, [late.file, on_time.file], IDS) as book:
+        book.add(late)
+        book.add(on_time)
+    assert [(r["file"], r["late"]) for r in rows(out)] == [
+        ("ann_LATE_1_2_pa9_g01.ipynb", "late"),
+        ("pa9_g02.ipynb", ""),
+    ]
+
+
+def test_two_names_that_differ_only_in_their_normal_form_never_share_a_cell(tmp_path):
+    composed, decomposed = "Jos\u00e9_pa9_g01.ipynb", "Jose\u0301_pa9_g01.ipynb"
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, [composed, decomposed], IDS) as book:
+        book.add(sub(composed))
+        book.add(sub(decomposed))
+    cells = [r["file"] for r in rows(out)]
+    assert cells == [composed, "Jose\\u0301_pa9_g01.ipynb"]
+    with Gradebook(out, [composed, decomposed], IDS, resume=True) as book:
+        assert book.prior() == {composed, decomposed}  # each kept as its own row
