@@ -21,6 +21,7 @@ from uio_teach.grading.gradebook import (
     file_cell,
     shown,
 )
+from uio_teach.grading.lab_checks import lab_checks
 from uio_teach.grading.rosters import (
     GradeError,
     group_from_name,
@@ -357,6 +358,136 @@ def test_different_work_is_not_a_copy(changed):
 def test_a_cell_that_is_not_python_is_compared_without_comments_and_spacing():
     assert copies.fingerprint(["x = (1  # a\n"]) == copies.fingerprint(["x=(1"])
     assert copies.fingerprint(["%matplotlib inline\ny = 2"]) == copies.fingerprint(["y = 2"])
+
+
+# A group's own solution (not the chapter's): what a disguised copy of it must still be caught as.
+OWN = [
+    "import numpy as np\nimport control as ct\nimport uio_teach as ut",
+    "M = np.linalg.pinv(C @ E)\nM = E @ M\nproj = np.eye(3) - M @ C\nscale = 1.0\n"
+    "A1 = proj @ A * scale",
+    "gains = ct.place(A1.T, C.T, [-1.0, -2.0, -3.0]).T\nF = A1 - gains @ C\nK2 = F @ M\n"
+    "H, T, K1 = M, proj, gains",
+    "run = ut.simulate(plant, obs, np.linspace(0, 10, 2001), d=0.5)\nerr = run.error\n"
+    "worst = abs(err).max()\nsettled = worst < 1e-3 * scale",
+]
+
+
+def _disguise(kind: str) -> list[str]:
+    cells = list(OWN)
+    swap = {
+        "1.0 as 1": lambda c: [x.replace("scale = 1.0", "scale = 1") for x in c],
+        "0.5 as 1/2": lambda c: [x.replace("d=0.5", "d=1/2") for x in c],
+        "two lines swapped": lambda c: [
+            x.replace(
+                "proj = np.eye(3) - M @ C\nscale = 1.0", "scale = 1.0\nproj = np.eye(3) - M @ C"
+            )
+            for x in c
+        ],
+        "an unused variable": lambda c: [*c[:2], c[2] + "\nunused = 42", *c[3:]],
+        "an if False block": lambda c: [*c, "if False:\n    worst = 0\n    print(worst)"],
+        "one extra print": lambda c: [*c, "print(worst)"],
+        "a cell split": lambda c: [c[0], *c[1].replace("\nscale", "\0scale").split("\0"), *c[2:]],
+        "two cells merged": lambda c: [c[0], c[1] + "\n" + c[2], c[3]],
+        "np.dot for @": lambda c: [x.replace("M = E @ M", "M = np.dot(E, M)") for x in c],
+        "a.dot(b) for @": lambda c: [x.replace("F @ M", "F.dot(M)") for x in c],
+        "scipy's pinv": lambda c: [
+            x.replace("np.linalg.pinv", "sla.pinv").replace(
+                "import numpy as np", "import numpy as np\nimport scipy.linalg as sla"
+            )
+            for x in c
+        ],
+        "names and comments": lambda c: [
+            "# the gain, then the error\n\n"
+            + x.replace("proj", "projector").replace("gains", "L").replace("worst", "biggest")
+            for x in c
+        ],
+        "all at once": lambda c: [
+            "import scipy.linalg as sla\nimport numpy\nimport control as ct\n"
+            "import uio_teach as ut",
+            "M = sla.pinv(C @ E)\nM = numpy.dot(E, M)\nk = 1\nP = numpy.eye(3) - M @ C\n"
+            "A1 = P @ A * k\nprint(A1)",
+            "g = ct.place(A1.T, C.T, [-1, -2, -3]).T",
+            "F = A1 - g @ C\nK2 = F.dot(M)\nH, T, K1 = M, P, g\nif 0:\n    H = None",
+            "r = ut.simulate(plant, obs, numpy.linspace(0, 10, 2001), d=1/2)\ne = r.error\n"
+            "w = abs(e).max()\nok = w < 1e-3 * k\nw",
+        ],
+    }
+    return swap[kind](cells)
+
+
+DISGUISES = [
+    "1.0 as 1",
+    "0.5 as 1/2",
+    "two lines swapped",
+    "an unused variable",
+    "an if False block",
+    "one extra print",
+    "a cell split",
+    "two cells merged",
+    "np.dot for @",
+    "a.dot(b) for @",
+    "scipy's pinv",
+    "names and comments",
+    "all at once",
+]
+
+
+@pytest.fixture(scope="module")
+def pa9_checks():
+    return lab_checks("pa9")
+
+
+@pytest.mark.parametrize("kind", DISGUISES)
+def test_a_disguised_copy_of_a_group_s_own_solution_is_still_alike(kind, pa9_checks):
+    keep = pa9_checks.names
+    given = copies.statements(pa9_checks.given, keep=keep)
+    disguised = _disguise(kind)
+    assert disguised != OWN
+    share, smaller = copies.similarity(
+        copies.statements(OWN, keep=keep), copies.statements(disguised, keep=keep), given
+    )
+    assert share >= copies.SIMILAR and smaller >= copies.MIN_STATEMENTS, (kind, share, smaller)
+
+
+def _handin(name: str, group: str, sources: list[str], keep) -> grade.Handin:
+    h = grade.Handin(name, "pa9", group)
+    h.code = copies.fingerprint(sources, keep=keep)
+    h.units = copies.statements(sources, keep=keep)
+    return h
+
+
+def test_near_copies_are_checked_by_hand_naming_the_other_group_and_the_share(pa9_checks):
+    keep = pa9_checks.names
+    given = {"pa9": copies.statements(pa9_checks.given, keep=keep)}
+    other = [  # another group's own work: other steps, other checks of the result
+        "import numpy as np\nimport uio_teach as ut",
+        "obs = ut.design_uio(plant, poles=[-2, -3, -4])\nH, T, K1 = obs.H, obs.T, obs.K1",
+        "F, K2 = obs.F, obs.K2\nrun = obs.simulate(timepts)\nmisfit = np.linalg.norm(run.error)",
+        "tail = run.error[:, -100:]\nassert np.all(np.abs(tail) < 1e-2)",
+    ]
+    handins = [
+        _handin("pa9_g01.ipynb", "g01", OWN, keep),
+        _handin("pa9_g02.ipynb", "g02", _disguise("all at once"), keep),
+        _handin("pa9_g03.ipynb", "g03", other, keep),
+    ]
+    notes = grade._identity_notes(handins, given)
+    assert notes["pa9_g03.ipynb"] == []
+    (note,) = notes["pa9_g01.ipynb"]
+    assert note.startswith("code much like group g02's (pa9_g02.ipynb): ")
+    assert "% of their own statements alike" in note
+    assert notes["pa9_g02.ipynb"][0].startswith("code much like group g01's (pa9_g01.ipynb)")
+
+
+def test_untouched_templates_are_never_copies_of_each_other(pa9_checks):
+    from uio_teach.folders import default_book_dir
+    from uio_teach.instructor.lab_notebook import make_notebook
+
+    template = make_notebook(default_book_dir() / "lab_pa9.md", "student")
+    keep = pa9_checks.names
+    given = {"pa9": copies.statements(pa9_checks.given, keep=keep)}
+    sources = grade._own_code(template)
+    handins = [_handin(f"pa9_g0{g}.ipynb", f"g0{g}", sources, keep) for g in (1, 2)]
+    assert grade._identity_notes(handins, given) == {h.file: [] for h in handins}
 
 
 # shards and merges ----------------------------------------------------------------------------

@@ -65,6 +65,7 @@ import tempfile
 import threading
 import time
 import warnings
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -76,7 +77,7 @@ import nbformat
 from ..errors import UIOTeachWarning
 from ..folders import sha256_file
 from .checking import check_in_child
-from .copies import fingerprint
+from .copies import MIN_STATEMENTS, SIMILAR, fingerprint, similarity, statements
 from .gradebook import (
     EXPORTS,
     FAIL,
@@ -261,6 +262,9 @@ class Handin:
         The lab and group the notebook's metadata claims.
     code : str
         A fingerprint of its code (for hand-ins copied between groups).
+    units : collections.Counter
+        Its code as normalised statements (for near-copies,
+        :func:`uio_teach.grading.copies.statements`).
     """
 
     file: str
@@ -273,6 +277,7 @@ class Handin:
     meta_lab: str = ""
     meta_group: str = ""
     code: str = ""
+    units: Counter[str] = field(default_factory=Counter)
 
 
 def _kind(mode: int) -> str:
@@ -344,18 +349,15 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _fingerprint(nb: Any, keep: Iterable[str]) -> str:
-    """The code of a notebook, normalised (:mod:`uio_teach.grading.copies`), hashed.
-
-    The cells every group has alike are left out: ``parameters``, ``check``.
-    """
+def _own_code(nb: Any) -> list[str]:
+    """The code cells of a notebook but those every group has alike: ``parameters``, ``check``."""
     sources = []
     for cell in nb.cells:
         tags = cell.get("metadata", {}).get("tags", [])
         if cell.get("cell_type") != "code" or {"parameters", CHECK_TAG} & set(tags):
             continue
         sources.append(cell.source)
-    return fingerprint(sources, keep=keep)
+    return sources
 
 
 def read_handin(
@@ -425,12 +427,21 @@ def read_handin(
     if not handin.lab:
         stem = Path(source).stem if source else Path(file).stem
         handin.lab = handin.meta_lab or next((k for k in course_labs() if f"lab_{k}" == stem), "")
-    handin.code = _fingerprint(handin.notebook, keep)
+    sources = _own_code(handin.notebook)
+    handin.code = fingerprint(sources, keep=keep)
+    handin.units = statements(sources, keep=keep)
     return handin
 
 
-def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
-    """File -> why its identity needs a look: the notebook disagrees, a group twice, a copy."""
+def _identity_notes(
+    handins: Sequence[Handin], given: Mapping[str, Counter[str]] | None = None
+) -> dict[str, list[str]]:
+    """File -> why its identity needs a look: the notebook disagrees, a group twice, a copy.
+
+    ``given`` (lab -> the statements of the course's own code of that lab) is set aside before
+    code is compared: a hand-in with nothing of its own (an untouched template) is no copy.
+    """
+    given = given or {}
     notes: dict[str, list[str]] = {h.file: [] for h in handins}
     for h in handins:
         if h.status:
@@ -453,7 +464,7 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
             continue
         if h.group:
             by_group.setdefault((h.lab, h.group), []).append(h)
-        if h.code:
+        if h.code and h.units - given.get(h.lab, Counter()):  # something of its own
             by_code.setdefault(h.code, []).append(h)
     for (_, group), same in by_group.items():
         for h in same if len(same) > 1 else ():
@@ -470,7 +481,45 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
                 f"the same code as {others}, once comments, blank lines, formatting and the "
                 "names of variables are set aside"
             )
+    exact = {h.file for same in by_code.values() if len({h.group for h in same}) > 1 for h in same}
+    _near_copies(handins, given, notes, exact)
     return notes
+
+
+def _near_copies(
+    handins: Sequence[Handin],
+    given: Mapping[str, Counter[str]],
+    notes: dict[str, list[str]],
+    exact: set[str],
+) -> None:
+    """Note every pair of groups of one lab whose own statements are mostly alike.
+
+    Set aside first: the course's own code of the lab and, in a class of four hand-ins or
+    more, what at least half of them hold (what everyone writes is no sign of a copy).
+    """
+    labs: dict[str, list[Handin]] = {}
+    for h in handins:
+        if not h.status and h.units:
+            labs.setdefault(h.lab, []).append(h)
+    for lab, same in labs.items():
+        common = Counter(given.get(lab, Counter()))
+        if len(same) >= 4:
+            seen = Counter(s for h in same for s in set(h.units))
+            common |= Counter({s: 1 << 30 for s, n in seen.items() if 2 * n >= len(same)})
+        for i, a in enumerate(same):
+            for b in same[i + 1 :]:
+                if a.group == b.group or (a.file in exact and b.file in exact):
+                    continue
+                share, smaller = similarity(a.units, b.units, common)
+                if share < SIMILAR or smaller < MIN_STATEMENTS:
+                    continue
+                for h, o in ((a, b), (b, a)):
+                    notes[h.file].append(
+                        f"code much like group {o.group or '(none)'}'s ({o.file}): {share:.0%} "
+                        "of their own statements alike, once names, numbers as written, "
+                        "statement order, cells, dead code, prints and equivalent calls are "
+                        "set aside"
+                    )
 
 
 def _error_notes(outcome: RunOutcome) -> list[str]:
@@ -946,7 +995,8 @@ def grade(
             handins.append(
                 Handin(file, status="grader error", reason=f"cannot be read ({type(exc).__name__})")
             )
-    identity = _identity_notes(handins)
+    given = {lab: statements(c.given, keep=c.names) for lab, c in checks.items()}
+    identity = _identity_notes(handins, given)
     columns: list[str] = []
     for h in handins:
         ids = checks[h.lab].check_ids if h.lab in checks else ()

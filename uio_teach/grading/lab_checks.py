@@ -177,6 +177,11 @@ class LabChecks:
         The chapter's ``parameters`` cell (the course's own numbers).
     checks : tuple of GradedCheck
         Its check cells, in order.
+    given : tuple of str
+        The code the course itself holds: every code cell of the chapter, its
+        solutions included. Copy detection sets it aside
+        (:mod:`uio_teach.grading.copies`): an untouched template, or a line
+        as the course's own solution writes it, is no sign of a copy.
     """
 
     lab: str
@@ -184,6 +189,7 @@ class LabChecks:
     setup: tuple[str, ...]
     params: str
     checks: tuple[GradedCheck, ...]
+    given: tuple[str, ...] = ()
 
     @property
     def check_ids(self) -> tuple[str, ...]:
@@ -315,6 +321,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
     setup: list[str] = []
     params = ""
     found: list[tuple[str, str]] = []
+    alike: list[str] = []
     title = ""
     started = False
     for cell in nb.cells:
@@ -328,6 +335,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
         if cell.cell_type != "code":
             continue
         tags = cell.metadata.get("tags", [])
+        alike.append(source)
         if "parameters" in tags:
             params = source
         elif CHECK_TAG in tags:
@@ -361,7 +369,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
         if any(c.check_id == check_id for c in checks):
             raise LabChecksError(f"{where} calls checks.{function} a second time")
         checks.append(GradedCheck(check_id, function, heading, names, source))
-    return LabChecks(lab, name, tuple(setup), params, tuple(checks))
+    return LabChecks(lab, name, tuple(setup), params, tuple(checks), tuple(alike))
 
 
 @functools.lru_cache(maxsize=16)
