@@ -21,7 +21,7 @@ from uio_teach.grading.gradebook import (
     file_cell,
     shown,
 )
-from uio_teach.grading.lab_checks import lab_checks
+from uio_teach.grading.lab_checks import course_labs, lab_checks
 from uio_teach.grading.rosters import (
     GradeError,
     group_from_name,
@@ -110,6 +110,22 @@ def test_a_group_column_added_to_canvas_s_export_wins_over_its_section(tmp_path)
         encoding="utf-8",
     )
     assert read_roster(roster)[1] == {"g12": [("s1", "Ann")]}
+
+
+# what the students are told --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("lab", sorted(course_labs()))
+def test_each_lab_page_says_what_to_hand_in_how_to_name_it_and_how_it_is_marked(lab):
+    """Read from the registry of labs and their check cells: a new lab needs the same words."""
+    text = course_labs()[lab].read_text(encoding="utf-8")
+    ids = lab_checks(lab).check_ids
+    assert "**What you hand in.**" in text, f"lab_{lab}.md does not say what to hand in"
+    assert f"`{lab}_g07.ipynb`" in text and "`<lab>_<group>.ipynb`" in text
+    assert "**What is checked, and how it is marked.**" in text
+    missing = [c for c in ids if f"`{c}`" not in text]
+    assert not missing, f"lab_{lab}.md does not name the checks {missing} it is marked by"
+    assert f"out of {len(ids)}." in text
 
 
 # what a hand-in folder holds ------------------------------------------------------------------

@@ -311,9 +311,9 @@ def prepare(
         The group's parameters from the answer key.
     output_mb : int
         The output a run keeps (``Limits.output_mb``): the notebook's streams
-        are cut in the kernel just past half of it (:func:`kept_output`), so
-        the runner, which keeps half and records the cut, never receives much
-        more than it keeps.
+        are cut in the kernel one character past it (:func:`kept_output`), so
+        the runner, which keeps that much and records the cut, never receives
+        much more than it keeps.
 
     Returns
     -------
@@ -360,7 +360,7 @@ def prepare(
 
 
 def kept_output(output_mb: int) -> int:
-    """How many characters of output a run keeps (half of ``output_mb`` MiB); one more is cut.
+    """How many characters of output a run keeps (``output_mb`` MiB); one more is cut.
 
     Parameters
     ----------
@@ -374,9 +374,9 @@ def kept_output(output_mb: int) -> int:
     --------
     >>> from uio_teach.grading.runner import kept_output
     >>> kept_output(2)
-    1048576
+    2097152
     """
-    return output_mb * 1024 * 1024 // 2
+    return output_mb * 1024 * 1024
 
 
 def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes | None:
