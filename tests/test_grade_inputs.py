@@ -583,14 +583,15 @@ def test_merged_shards_are_what_one_whole_run_writes(tmp_path):
 
 
 def test_a_pattern_that_also_matches_the_shards_exports_merges_the_gradebooks(tmp_path):
-    # `uio-teach merge marks/grades_*.csv` also picks grades_1_groups.csv, grades_1_canvas.csv
+    # `uio-teach merge marks/grades_*.csv` also picks grades_1_groups.csv, grades_1_canvas.csv,
+    # grades_1_moodle.csv
     files = CLASS[:8]
     students = {"g01": [("s1", "Ann")]}
     _book(tmp_path / "whole" / "grades.csv", files, None, students=students)
     for k in (1, 2):
         _book(tmp_path / "marks" / f"grades_{k}.csv", files, (k, 2), students=students)
     matched = sorted((tmp_path / "marks").glob("grades_*.csv"))
-    assert len(matched) == 6  # two gradebooks, each with its two exports
+    assert len(matched) == 8  # two gradebooks, each with its three exports
     merge.merge(matched, tmp_path / "merged" / "grades.csv")
     assert _tree(tmp_path / "merged") == _tree(tmp_path / "whole")
 
@@ -675,9 +676,9 @@ def test_the_summary_after_resume_counts_the_whole_gradebook(tmp_path, capsys):
     assert cli.main([*args, "--resume"]) == 0
     err = capsys.readouterr().err
     assert "3 rows need a look (3 unreadable) of the 3 rows in grades.csv" in err
-    assert "no Canvas import written" not in err  # -q: only what needs a look
+    assert "no Canvas or Moodle import written" not in err  # -q: only what needs a look
     assert cli.main([*args[:-1], "--resume"]) == 0
-    assert "no Canvas import written: without --roster" in capsys.readouterr().err
+    assert "no Canvas or Moodle import written: without --roster" in capsys.readouterr().err
 
 
 def test_shard_and_merge_usage_errors_are_one_line(tmp_path, capsys):

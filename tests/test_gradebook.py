@@ -282,3 +282,26 @@ def test_two_names_that_differ_only_in_their_normal_form_never_share_a_cell(tmp_
     assert cells == [composed, "Jose\\u0301_pa9_g01.ipynb"]
     with Gradebook(out, [composed, decomposed], IDS, resume=True) as book:
         assert book.prior() == {composed, decomposed}  # each kept as its own row
+
+
+def test_moodle_s_grade_import_is_written_beside_canvas_s_from_a_moodle_roster(tmp_path):
+    roster = tmp_path / "participants.csv"
+    roster.write_text(
+        "First name,Last name,ID number,Email address,Groups\n"
+        "Ann,Example,u101,ann@example.org,Group 1\n"
+        "Bo,Example,u102,bo@example.org,Group 2\n",
+        encoding="utf-8-sig",
+    )
+    _, students = grade.read_roster(roster)
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["pa9_g01.ipynb", "pa9_g02.ipynb"], IDS, students=students) as book:
+        book.add(sub("pa9_g01.ipynb"))
+        book.add(Submission("pa9_g02.ipynb", "pa9", "g02", "ok", expected=IDS))
+    with open(tmp_path / "grades_moodle.csv", newline="", encoding="utf-8") as fh:
+        table = list(csv.reader(fh))
+    assert table == [
+        ["ID number", "Full name", "Group", "pa9 (uio-teach)"],
+        ["u101", "Ann Example", "g01", "1"],
+        ["u102", "Bo Example", "g02", "0"],
+    ]
+    assert (tmp_path / "grades_canvas.csv").is_file()

@@ -893,7 +893,8 @@ def grade(
         appears during the run in its ``added`` (see :mod:`uio_teach.grading.survey`).
     out : path
         The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it,
-        the LMS exports to ``<stem>_canvas.csv`` and ``<stem>_groups.csv``.
+        the LMS exports to ``<stem>_groups.csv``, ``<stem>_canvas.csv`` and
+        ``<stem>_moodle.csv``.
         Each row is written as soon as its hand-in is graded.
     answer_key : path, optional
         ``answer_key.csv`` of ``uio-teach labs --groups``: each hand-in is

@@ -80,7 +80,7 @@ __all__ = [
 ]
 
 PASS, FAIL = "✓", "✗"
-EXPORTS = ("canvas", "groups")
+EXPORTS = ("canvas", "groups", "moodle")
 """The exports written beside a gradebook (:func:`export_path` of each)."""
 COMMAND = "uio-teach grade"
 """The command recorded in the feedback folder's manifest."""
@@ -530,8 +530,14 @@ def exports(
     header: Sequence[str],
     rows: Sequence[Sequence[str]],
     students: Mapping[str, Sequence[tuple[str, str]]],
-) -> tuple[list[list[str]], list[list[str]] | None]:
-    """The export keyed by group, and Canvas's (None without students: it could match none).
+) -> tuple[list[list[str]], list[list[str]] | None, list[list[str]] | None]:
+    """The export keyed by group, Canvas's and Moodle's (None without students: they could
+    match none).
+
+    Moodle's grade import (*Grades*, *Import*, *CSV file*) maps each row to a user by the
+    column ``ID number`` (the roster's student id: choose "ID number", or the user field the
+    roster's ids are, as the mapping) and takes one column per lab, named as the grade item;
+    it has no "Points Possible" line (the maximum is the grade item's).
 
     Parameters
     ----------
@@ -544,7 +550,7 @@ def exports(
 
     Returns
     -------
-    (list, list or None)
+    (list, list or None, list or None)
     """
     at = {name: i for i, name in enumerate(header)}
     labs: dict[str, str] = {}
@@ -568,15 +574,21 @@ def exports(
         plain.append([group, lab, score, row[at["out_of"]], status, reason, files])
     plain = [[safe_cell(c) for c in r] for r in plain]
     if not students:
-        return plain, None
+        return plain, None, None
     names = [f"{lab} (uio-teach)" for lab in labs]
     canvas: list[list[Any]] = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", *names]]
     canvas.append(["Points Possible", "", "", "", "", *labs.values()])
+    moodle: list[list[Any]] = [["ID number", "Full name", "Group", *names]]
     for group in sorted({g for _, g in groups}):
         marks = [scores.get((lab, group), "") for lab in labs]
         for student, name in students.get(group, []):
             canvas.append([name or student, "", student, "", group, *marks])
-    return plain, [[safe_cell(c) for c in r] for r in canvas]
+            moodle.append([student, name, group, *marks])
+    return (
+        plain,
+        [[safe_cell(c) for c in r] for r in canvas],
+        [[safe_cell(c) for c in r] for r in moodle],
+    )
 
 
 def write_exports(
@@ -596,13 +608,14 @@ def write_exports(
     header, rows, students
         As :func:`exports` takes them.
     """
-    plain, canvas = exports(header, rows, students)
+    plain, canvas, moodle = exports(header, rows, students)
     _write_atomic(export_path(out, "groups"), _csv_text(plain))
-    target = export_path(out, "canvas")
-    if canvas is not None:
-        _write_atomic(target, _csv_text(canvas))
-    else:
-        target.unlink(missing_ok=True)
+    for kind, table in (("canvas", canvas), ("moodle", moodle)):
+        target = export_path(out, kind)
+        if table is not None:
+            _write_atomic(target, _csv_text(table))
+        else:
+            target.unlink(missing_ok=True)
 
 
 def read_gradebook(out: str | os.PathLike[str]) -> tuple[list[str], list[list[str]]]:

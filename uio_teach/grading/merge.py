@@ -38,6 +38,7 @@ from typing import Any
 from ..folders import MANIFEST, read_manifest, sha256_file, write_manifest
 from .gradebook import (
     COMMAND,
+    EXPORTS,
     check_gradebook_target,
     export_path,
     feedback_folder,
@@ -194,7 +195,7 @@ def shard_gradebooks(gradebooks: Sequence[str | os.PathLike[str]]) -> list[Path]
     ['grades_1.csv', 'grades_2.csv']
     """
     paths = [Path(g) for g in gradebooks]
-    exports = {export_path(p, kind).resolve() for p in paths for kind in ("groups", "canvas")}
+    exports = {export_path(p, kind).resolve() for p in paths for kind in EXPORTS}
     return [p for p in paths if p.resolve() not in exports]
 
 

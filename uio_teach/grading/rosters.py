@@ -63,10 +63,20 @@ _LATE = re.compile(r"(?:^|_)LATE_")
 # each column's names, the better first: a table with two of them takes the better one
 # (Canvas's gradebook export has "Student", the display name, and "SIS User ID", the id)
 _COLUMNS = {
-    "group": ("group", "group name", "gruppe", "groupe", "section"),
+    "group": ("group", "group name", "groups", "gruppe", "groupe", "section"),
     "file": ("file", "file name", "filename", "hand-in", "handin"),
-    "student": ("sis user id", "student id", "id number", "username", "student"),
+    "student": (
+        "sis user id",
+        "student id",
+        "id number",
+        "username",
+        "email address",
+        "email",
+        "student",
+    ),
     "name": ("name", "student name", "full name", "student"),
+    "first": ("first name",),
+    "last": ("last name", "surname"),
     "lab": ("lab",),
     "params": ("params",),
 }
@@ -328,10 +338,12 @@ def read_roster(
     gradebook export is a roster as it is saved (its ``SIS User ID`` is the
     student, its ``Student`` the name, its ``Section`` the group unless a
     ``Group`` column is added; its "Points Possible" line and the test student
-    are skipped); a Moodle export names the student by ``ID number`` or
-    ``Username``. Names are read in NFC (:func:`same_form`). A row with a
-    file says that file is the group's hand-in; a row with a student puts the
-    student in the group (for the Canvas export). A student or a file listed
+    are skipped); Moodle's participants export names the student by ``ID
+    number`` (else ``Username`` or ``Email address``), the name by ``First
+    name`` and ``Last name``, and the group by ``Groups``. Names are read in
+    NFC (:func:`same_form`). A row with a file says that file is the group's
+    hand-in; a row with a student puts the student in the group (for the
+    Canvas and Moodle exports). A student or a file listed
     twice is refused, naming it and both lines: one of the two rows is wrong,
     and a student listed twice would get two marks in Canvas.
 
@@ -388,14 +400,15 @@ def read_roster(
                 )
             files[file], file_lines[file] = entry, number
         if student:
-            who = f"{student} ({row['name']})" if row["name"] else student
+            full = row["name"] or " ".join(p for p in (row["first"], row["last"]) if p)
+            who = f"{student} ({full})" if full else student
             if student in student_lines:
                 raise GradeError(
                     f"{name}: line {number}: student {who} is listed twice (also line "
                     f"{student_lines[student]}): each student in one group, once"
                 )
             student_lines[student] = number
-            students.setdefault(group, []).append((student, row["name"]))
+            students.setdefault(group, []).append((student, full))
     return files, students
 
 

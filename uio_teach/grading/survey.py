@@ -31,7 +31,7 @@ Examples
 >>> [pathlib.Path(f).name for f in found.handins]
 ['pa9_g01.IPYNB']
 >>> [why.split(":")[0] for _, why in found.others]
-['a folder', 'an archive']
+['a folder', 'an archive, not opened']
 """
 
 from __future__ import annotations

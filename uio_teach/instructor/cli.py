@@ -205,9 +205,10 @@ and what appears during the run is listed as not graded.
 Writes FILE (one row per hand-in: file, lab, group, status, reason, one
 column per check with ✓ or ✗, total, out_of and late), FILE's stem + _feedback/
 (a text and an HTML page per hand-in), FILE's stem + _groups.csv (one row per
-group) and + _canvas.csv (Canvas's gradebook import, with its "Points
-Possible" row; only with a --roster naming the students, since without one
-no row could be matched to a student). Each row is written as soon as its
+group), + _canvas.csv (Canvas's gradebook import, with its "Points
+Possible" row) and + _moodle.csv (Moodle's grade import, by ID number); the
+last two only with a --roster naming the students, since without one no row
+could be matched to a student. Each row is written as soon as its
 hand-in is graded; --resume grades only the missing ones; Ctrl-C stops at
 once and keeps them.
 
@@ -858,8 +859,9 @@ def _summary(command: str, out: Path, *, roster: bool, quiet: bool) -> None:
             )
     if not roster and not quiet and command == "grade":
         _say(
-            f"no Canvas import written: without --roster no group can be matched to its "
-            f"students (give a roster with a student column to get {out.stem}_canvas.csv)",
+            "no Canvas or Moodle import written: without --roster no group can be matched to "
+            f"its students (give a roster with a student column to get {out.stem}_canvas.csv "
+            f"and {out.stem}_moodle.csv)",
             sys.stderr,
         )
 
