@@ -30,6 +30,7 @@ import re
 from typing import Any
 
 from docutils import nodes
+from sphinx import addnodes
 from sphinx.application import Sphinx
 from sphinx.config import Config
 from sphinx.transforms import SphinxTransform
@@ -198,6 +199,10 @@ class StudentEdition(SphinxTransform):
             ids |= set(target.get("ids", []))
             if target.parent is owner and any(c is target for c in owner.children):
                 owner.remove(target)
+        # the objects it documents (the API page's autodoc entries): links to them go too
+        objects = _dropped_objects(self.env).setdefault(self.env.docname, set())
+        for signature in section.findall(addnodes.desc_signature):
+            objects.update(signature.get("ids", []))
         parent.remove(section)
         dropped = _dropped(self.env)
         for name in names:  # no label of the page leads there any more
@@ -220,14 +225,44 @@ def _dropped(env: Any) -> dict[str, tuple[str, str]]:
     return env.uio_teach_dropped
 
 
+def _dropped_objects(env: Any) -> dict[str, set[str]]:
+    """The anchors of the objects documented in the tutors' sections left out, by page."""
+    if not hasattr(env, "uio_teach_dropped_objects"):
+        env.uio_teach_dropped_objects = {}
+    return env.uio_teach_dropped_objects
+
+
 def _purge(app: Sphinx, env: Any, docname: str) -> None:
     dropped = _dropped(env)
     for name in [n for n, (doc, _) in dropped.items() if doc == docname]:
         del dropped[name]
+    _dropped_objects(env).pop(docname, None)
 
 
 def _merge(app: Sphinx, env: Any, docnames: set[str], other: Any) -> None:
     _dropped(env).update({n: v for n, v in _dropped(other).items() if v[0] in docnames})
+    objects = _dropped_objects(other)
+    _dropped_objects(env).update({d: objects[d] for d in docnames if d in objects})
+
+
+def unlink_dropped(doctree: nodes.Node, anchors: set[str]) -> int:
+    """Turn every link to one of ``anchors`` (objects of a tutors' section left out) into its
+    text: the student edition links no anchor it does not have. Returns how many."""
+    count = 0
+    for ref in list(doctree.findall(nodes.reference)):
+        target = ref.get("refid") or ref.get("refuri", "").partition("#")[2]
+        if target and target in anchors:
+            ref.replace_self(nodes.inline("", "", *ref.children))
+            count += 1
+    return count
+
+
+def _unlink(app: Sphinx, doctree: nodes.Node, docname: str) -> None:
+    if edition_of(app.config) != "student":
+        return
+    anchors = set().union(*_dropped_objects(app.env).values())
+    if anchors:
+        unlink_dropped(doctree, anchors)
 
 
 def _dropped_reference(app: Sphinx, env: Any, node: nodes.Element, contnode: nodes.Node):
@@ -270,5 +305,6 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("env-purge-doc", _purge)
     app.connect("env-merge-info", _merge)
     app.connect("missing-reference", _dropped_reference)
+    app.connect("doctree-resolved", _unlink)
     app.add_transform(StudentEdition)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

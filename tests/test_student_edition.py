@@ -382,6 +382,22 @@ def test_the_link_check_finds_a_missing_file_and_a_missing_anchor(tmp_path: Path
     ]
 
 
+def test_links_to_the_objects_of_a_dropped_section_become_their_text() -> None:
+    from docutils import nodes
+    from editions import unlink_dropped
+
+    para = nodes.paragraph()
+    para += nodes.reference("", "grade()", refuri="api.html#uio_teach.grading.grade.grade")
+    para += nodes.reference("", "simulate()", refuri="api.html#uio_teach.simulate")
+    para += nodes.reference("", "here", refid="uio_teach.grading.merge.merge")
+    assert (
+        unlink_dropped(para, {"uio_teach.grading.grade.grade", "uio_teach.grading.merge.merge"})
+        == 2
+    )
+    assert [r["refuri"] for r in para.findall(nodes.reference)] == ["api.html#uio_teach.simulate"]
+    assert para.astext() == "grade()simulate()here"
+
+
 def test_no_link_of_the_student_edition_is_dead(built_book: Path) -> None:
     """No page of the student edition links a page, a file or an anchor the edition leaves
     out (the API page's tutor-only sections are left out with every link into them)."""
