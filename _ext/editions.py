@@ -18,6 +18,10 @@ what is rendered differs:
   (``# TODO`` cells, as ``uio-teach labs`` writes it). No student page names the other edition.
 * **instructor** (``make book-instructor``, that is ``UIO_TEACH_EDITION=instructor`` in the
   environment of ``jupyter-book build``): everything, as written.
+* **selfstudy** (``make book-selfstudy``): the student edition for those who learn alone. Each
+  solution is still preceded by the starting code, and follows it folded, behind "Show a
+  worked solution (after you tried)" (a ``<details>`` element: closed until the reader opens
+  it); the tutors' notes are left out as in the student edition.
 
 The edition is read from the environment variable :data:`EDITION_VAR` when the build starts and
 is the Sphinx setting ``uio_teach_edition``; changing it rebuilds every page.
@@ -41,7 +45,10 @@ from uio_teach.instructor.lab_notebook import make_notebook
 from uio_teach.instructor.lab_registry import LabUsageError
 
 EDITION_VAR = "UIO_TEACH_EDITION"
-EDITIONS = ("student", "instructor")
+EDITIONS = ("student", "instructor", "selfstudy")
+LIKE_STUDENT = ("student", "selfstudy")  # the editions that leave the tutors' notes out
+FOLD_SUMMARY = "Show a worked solution (after you tried)"
+FOLD_CLASS = "selfstudy-solution"
 HIDDEN_TAGS = ("solution", "instructor")  # code cells with these tags are not in the student pages
 STUB_NOTE = (
     "This page is for those who teach the course: how to prepare a term, regenerate the "
@@ -127,28 +134,40 @@ class StudentEdition(SphinxTransform):
         return node is self.document
 
     def apply(self, **kwargs: Any) -> None:
-        if edition_of(self.config) != "student":
+        edition = edition_of(self.config)
+        if edition not in LIKE_STUDENT:
             return
+        fold = edition == "selfstudy"
         cells = [node for node in self.document.findall(_is_code_cell)]
         first = next((i for i, c in enumerate(cells) if "solution" in _tags(c)), None)
         code = starters(self.env.doc2path(self.env.docname)) if first is not None else {}
         for node in list(self.document.findall(solution_node)):
             start = code.get(node.get("target_label", ""))
             if start is None:
-                node.parent.remove(node)
+                if fold:
+                    fold_away(node)
+                else:
+                    node.parent.remove(node)
                 continue
             box = nodes.container(classes=[STARTER_CLASS])
             box += nodes.paragraph(STARTER_NOTE, STARTER_NOTE)
             box += nodes.literal_block(start, start, language="ipython3")
-            node.replace_self(box)
+            if fold:
+                node.parent.insert(node.parent.index(node), box)
+                fold_away(node)
+            else:
+                node.replace_self(box)
         for node in cells:
             if self._attached(node) and any(tag in HIDDEN_TAGS for tag in _tags(node)):
-                node.parent.remove(node)
+                if fold and "solution" in _tags(node) and not _inside_fold(node):
+                    fold_away(node)
+                elif not _inside_fold(node):
+                    node.parent.remove(node)
         if first is not None:  # a lab page: what follows the first solution ran on the solutions
             for cell in cells[first:]:
                 outputs = _outputs(cell)
-                if not outputs or not self._attached(cell):
-                    continue
+                if not outputs or not self._attached(cell) or _inside_fold(cell):
+                    continue  # a folded solution keeps its outputs
                 for output in outputs:
                     cell.remove(output)
                 note = nodes.paragraph(UNRUN_NOTE, "", nodes.emphasis(UNRUN_NOTE, UNRUN_NOTE))
@@ -213,6 +232,24 @@ class StudentEdition(SphinxTransform):
             self.document.ids.pop(i, None)
 
 
+def fold_away(node: nodes.Element) -> None:
+    """Put ``node`` behind a closed ``<details>`` whose summary is :data:`FOLD_SUMMARY`."""
+    box = nodes.container(classes=[FOLD_CLASS])
+    opening = f'<details class="{FOLD_CLASS}"><summary>{FOLD_SUMMARY}</summary>'
+    box += nodes.raw("", opening, format="html")
+    node.replace_self(box)
+    box += node
+    box += nodes.raw("", "</details>", format="html")
+
+
+def _inside_fold(node: nodes.Node) -> bool:
+    while node is not None:
+        if isinstance(node, nodes.container) and FOLD_CLASS in node.get("classes", []):
+            return True
+        node = node.parent
+    return False
+
+
 def _is_label(node: nodes.Node) -> bool:
     """An internal target (a ``(label)=`` line), not a link to elsewhere."""
     return isinstance(node, nodes.target) and not node.get("refuri")
@@ -258,7 +295,7 @@ def unlink_dropped(doctree: nodes.Node, anchors: set[str]) -> int:
 
 
 def _unlink(app: Sphinx, doctree: nodes.Node, docname: str) -> None:
-    if edition_of(app.config) != "student":
+    if edition_of(app.config) not in LIKE_STUDENT:
         return
     anchors = set().union(*_dropped_objects(app.env).values())
     if anchors:
@@ -288,7 +325,7 @@ def _check_edition(app: Sphinx, config: Config) -> None:
         raise ValueError(
             f"{EDITION_VAR} must be one of {', '.join(EDITIONS)}, got {config.uio_teach_edition!r}"
         )
-    if config.uio_teach_edition == "student":
+    if config.uio_teach_edition in LIKE_STUDENT:
         # the pages' sources hold the solutions: not copied into the site, no "show source" link
         config.html_copy_source = False
         config.html_show_sourcelink = False

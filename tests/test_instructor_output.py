@@ -619,7 +619,10 @@ def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edi
 def test_an_unknown_edition_is_refused(tmp_path):
     proc = build_edition(tmp_path, "teachers")
     assert proc.returncode != 0
-    assert "UIO_TEACH_EDITION must be one of student, instructor, got 'teachers'" in proc.stderr
+    assert (
+        "UIO_TEACH_EDITION must be one of student, instructor, selfstudy, got 'teachers'"
+        in proc.stderr
+    )
 
 
 def test_labs_and_figures_never_replace_each_others_folders(tmp_path, capsys):

@@ -398,6 +398,24 @@ def test_links_to_the_objects_of_a_dropped_section_become_their_text() -> None:
     assert para.astext() == "grade()simulate()here"
 
 
+def test_the_self_study_edition_folds_a_solution_behind_its_summary() -> None:
+    from docutils import nodes
+    from editions import FOLD_SUMMARY, fold_away
+
+    section = nodes.section()
+    section += nodes.paragraph("", "Exercise")
+    solution = nodes.container("", nodes.literal_block("H = E @ pinv(C @ E)", "H = ..."))
+    section += solution
+    fold_away(solution)
+    (box,) = [c for c in section.children if isinstance(c, nodes.container)]
+    opening, inner, closing = box.children
+    assert inner is solution and solution.parent is box
+    assert (
+        opening.astext().startswith("<details") and f"<summary>{FOLD_SUMMARY}" in opening.astext()
+    )
+    assert closing.astext() == "</details>" and " open" not in opening.astext()
+
+
 def test_no_link_of_the_student_edition_is_dead(built_book: Path) -> None:
     """No page of the student edition links a page, a file or an anchor the edition leaves
     out (the API page's tutor-only sections are left out with every link into them)."""
