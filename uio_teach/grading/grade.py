@@ -150,6 +150,13 @@ class Graded(list):
         the hand-ins, and every other entry with why it is not graded.
     added : list of (str, str)
         What appeared in the folder during the run, not graded.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.grade import Graded
+    >>> result = Graded([])
+    >>> len(result), result.survey, result.added
+    (0, None, [])
     """
 
     survey: Survey | None = None
