@@ -20,7 +20,7 @@ unexport PYTHONDONTWRITEBYTECODE
 JOBS ?= auto
 
 .DEFAULT_GOAL := help
-.PHONY: help venv book book-instructor pdf pdf-instructor test test-slow lint clean
+.PHONY: help venv book book-instructor book-selfstudy pdf pdf-instructor test test-slow lint clean
 
 # What `make check` leaves to `make test`: tests that start a Jupyter kernel, drive a browser,
 # build the book or the wheel, start any other process, or take long (the markers each test
@@ -30,6 +30,7 @@ QUICK := not kernel and not browser and not book and not wheel and not subproces
 help:
 	@echo "make book   build the HTML book into _build/html (warnings are errors)"
 	@echo "make book-instructor  the instructor edition (lab solutions, tutors' notes)"
+	@echo "make book-selfstudy   the self-study edition (solutions folded, shown on request)"
 	@echo "            into _build/instructor/_build/html"
 	@echo "make pdf    the book, with every page and the whole book printed as tagged PDFs"
 	@echo "            into _build/pdf (and linked from the pages); make pdf-instructor:"
@@ -65,6 +66,14 @@ book-instructor: $(STAMP)
 	UIO_TEACH_EDITION=instructor $(BIN)/jupyter-book build . -W -n --keep-going \
 		--path-output _build/instructor
 	@echo "The instructor edition is in $(CURDIR)/_build/instructor/_build/html/index.html"
+
+# the student edition with each lab solution folded behind "Show a worked solution (after you
+# tried)", for those who learn alone; the class edition (make book) stays as it is
+book-selfstudy: $(STAMP)
+	$(BIN)/python _ext/run_chapters.py --cache _build/selfstudy/_build/.jupyter_cache
+	UIO_TEACH_EDITION=selfstudy $(BIN)/jupyter-book build . -W -n --keep-going \
+		--path-output _build/selfstudy
+	@echo "The self-study edition is in $(CURDIR)/_build/selfstudy/_build/html/index.html"
 
 # The printed book (_ext/downloads.py, _ext/pdf_print.py): the book built with UIO_TEACH_PDF=1,
 # whose pages then link their PDFs, and once written every page printed as a tagged PDF by

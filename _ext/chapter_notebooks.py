@@ -50,7 +50,7 @@ def write_notebook(source: Path, target: Path, edition: str = "instructor") -> N
 
     In the ``"student"`` edition a lab chapter becomes its student notebook.
     """
-    if edition == "student":
+    if edition in ("student", "selfstudy"):
         try:
             notebook = make_notebook(source, "student")
         except LabUsageError:  # not a lab: no solution to leave out
@@ -77,7 +77,7 @@ def add_notebook(
     if source is None or app.builder.format != "html" or "body" not in context:
         return
     edition = getattr(app.config, "uio_teach_edition", "instructor")
-    if edition == "student" and is_stub(doctree):
+    if edition in ("student", "selfstudy") and is_stub(doctree):
         return
     relative = f"{NOTEBOOK_DIR}/{Path(pagename).name}.ipynb"
     write_notebook(source, Path(app.outdir) / relative, edition)
@@ -103,7 +103,7 @@ def fix_download_menu(
 
     Runs after the theme has made the menu (its handler has priority 501).
     """
-    student = getattr(app.config, "uio_teach_edition", "instructor") == "student"
+    student = getattr(app.config, "uio_teach_edition", "instructor") in ("student", "selfstudy")
     notebook = context.get("uio_teach_notebook")
     for group in context.get("header_buttons", []):
         if group.get("label") != "download-buttons":

@@ -18,6 +18,10 @@ what is rendered differs:
   (``# TODO`` cells, as ``uio-teach labs`` writes it). No student page names the other edition.
 * **instructor** (``make book-instructor``, that is ``UIO_TEACH_EDITION=instructor`` in the
   environment of ``jupyter-book build``): everything, as written.
+* **selfstudy** (``make book-selfstudy``): the student edition for those who learn alone. Each
+  solution is still preceded by the starting code, and follows it folded, behind "Show a
+  worked solution (after you tried)" (a ``<details>`` element: closed until the reader opens
+  it); the tutors' notes are left out as in the student edition.
 
 The edition is read from the environment variable :data:`EDITION_VAR` when the build starts and
 is the Sphinx setting ``uio_teach_edition``; changing it rebuilds every page.
@@ -30,6 +34,7 @@ import re
 from typing import Any
 
 from docutils import nodes
+from sphinx import addnodes
 from sphinx.application import Sphinx
 from sphinx.config import Config
 from sphinx.transforms import SphinxTransform
@@ -40,7 +45,10 @@ from uio_teach.instructor.lab_notebook import make_notebook
 from uio_teach.instructor.lab_registry import LabUsageError
 
 EDITION_VAR = "UIO_TEACH_EDITION"
-EDITIONS = ("student", "instructor")
+EDITIONS = ("student", "instructor", "selfstudy")
+LIKE_STUDENT = ("student", "selfstudy")  # the editions that leave the tutors' notes out
+FOLD_SUMMARY = "Show a worked solution (after you tried)"
+FOLD_CLASS = "selfstudy-solution"
 HIDDEN_TAGS = ("solution", "instructor")  # code cells with these tags are not in the student pages
 STUB_NOTE = (
     "This page is for those who teach the course: how to prepare a term, regenerate the "
@@ -126,28 +134,40 @@ class StudentEdition(SphinxTransform):
         return node is self.document
 
     def apply(self, **kwargs: Any) -> None:
-        if edition_of(self.config) != "student":
+        edition = edition_of(self.config)
+        if edition not in LIKE_STUDENT:
             return
+        fold = edition == "selfstudy"
         cells = [node for node in self.document.findall(_is_code_cell)]
         first = next((i for i, c in enumerate(cells) if "solution" in _tags(c)), None)
         code = starters(self.env.doc2path(self.env.docname)) if first is not None else {}
         for node in list(self.document.findall(solution_node)):
             start = code.get(node.get("target_label", ""))
             if start is None:
-                node.parent.remove(node)
+                if fold:
+                    fold_away(node)
+                else:
+                    node.parent.remove(node)
                 continue
             box = nodes.container(classes=[STARTER_CLASS])
             box += nodes.paragraph(STARTER_NOTE, STARTER_NOTE)
             box += nodes.literal_block(start, start, language="ipython3")
-            node.replace_self(box)
+            if fold:
+                node.parent.insert(node.parent.index(node), box)
+                fold_away(node)
+            else:
+                node.replace_self(box)
         for node in cells:
             if self._attached(node) and any(tag in HIDDEN_TAGS for tag in _tags(node)):
-                node.parent.remove(node)
+                if fold and "solution" in _tags(node) and not _inside_fold(node):
+                    fold_away(node)
+                elif not _inside_fold(node):
+                    node.parent.remove(node)
         if first is not None:  # a lab page: what follows the first solution ran on the solutions
             for cell in cells[first:]:
                 outputs = _outputs(cell)
-                if not outputs or not self._attached(cell):
-                    continue
+                if not outputs or not self._attached(cell) or _inside_fold(cell):
+                    continue  # a folded solution keeps its outputs
                 for output in outputs:
                     cell.remove(output)
                 note = nodes.paragraph(UNRUN_NOTE, "", nodes.emphasis(UNRUN_NOTE, UNRUN_NOTE))
@@ -198,6 +218,10 @@ class StudentEdition(SphinxTransform):
             ids |= set(target.get("ids", []))
             if target.parent is owner and any(c is target for c in owner.children):
                 owner.remove(target)
+        # the objects it documents (the API page's autodoc entries): links to them go too
+        objects = _dropped_objects(self.env).setdefault(self.env.docname, set())
+        for signature in section.findall(addnodes.desc_signature):
+            objects.update(signature.get("ids", []))
         parent.remove(section)
         dropped = _dropped(self.env)
         for name in names:  # no label of the page leads there any more
@@ -206,6 +230,24 @@ class StudentEdition(SphinxTransform):
             dropped[name] = (self.env.docname, text)
         for i in ids:
             self.document.ids.pop(i, None)
+
+
+def fold_away(node: nodes.Element) -> None:
+    """Put ``node`` behind a closed ``<details>`` whose summary is :data:`FOLD_SUMMARY`."""
+    box = nodes.container(classes=[FOLD_CLASS])
+    opening = f'<details class="{FOLD_CLASS}"><summary>{FOLD_SUMMARY}</summary>'
+    box += nodes.raw("", opening, format="html")
+    node.replace_self(box)
+    box += node
+    box += nodes.raw("", "</details>", format="html")
+
+
+def _inside_fold(node: nodes.Node) -> bool:
+    while node is not None:
+        if isinstance(node, nodes.container) and FOLD_CLASS in node.get("classes", []):
+            return True
+        node = node.parent
+    return False
 
 
 def _is_label(node: nodes.Node) -> bool:
@@ -220,14 +262,44 @@ def _dropped(env: Any) -> dict[str, tuple[str, str]]:
     return env.uio_teach_dropped
 
 
+def _dropped_objects(env: Any) -> dict[str, set[str]]:
+    """The anchors of the objects documented in the tutors' sections left out, by page."""
+    if not hasattr(env, "uio_teach_dropped_objects"):
+        env.uio_teach_dropped_objects = {}
+    return env.uio_teach_dropped_objects
+
+
 def _purge(app: Sphinx, env: Any, docname: str) -> None:
     dropped = _dropped(env)
     for name in [n for n, (doc, _) in dropped.items() if doc == docname]:
         del dropped[name]
+    _dropped_objects(env).pop(docname, None)
 
 
 def _merge(app: Sphinx, env: Any, docnames: set[str], other: Any) -> None:
     _dropped(env).update({n: v for n, v in _dropped(other).items() if v[0] in docnames})
+    objects = _dropped_objects(other)
+    _dropped_objects(env).update({d: objects[d] for d in docnames if d in objects})
+
+
+def unlink_dropped(doctree: nodes.Node, anchors: set[str]) -> int:
+    """Turn every link to one of ``anchors`` (objects of a tutors' section left out) into its
+    text: the student edition links no anchor it does not have. Returns how many."""
+    count = 0
+    for ref in list(doctree.findall(nodes.reference)):
+        target = ref.get("refid") or ref.get("refuri", "").partition("#")[2]
+        if target and target in anchors:
+            ref.replace_self(nodes.inline("", "", *ref.children))
+            count += 1
+    return count
+
+
+def _unlink(app: Sphinx, doctree: nodes.Node, docname: str) -> None:
+    if edition_of(app.config) not in LIKE_STUDENT:
+        return
+    anchors = set().union(*_dropped_objects(app.env).values())
+    if anchors:
+        unlink_dropped(doctree, anchors)
 
 
 def _dropped_reference(app: Sphinx, env: Any, node: nodes.Element, contnode: nodes.Node):
@@ -253,7 +325,7 @@ def _check_edition(app: Sphinx, config: Config) -> None:
         raise ValueError(
             f"{EDITION_VAR} must be one of {', '.join(EDITIONS)}, got {config.uio_teach_edition!r}"
         )
-    if config.uio_teach_edition == "student":
+    if config.uio_teach_edition in LIKE_STUDENT:
         # the pages' sources hold the solutions: not copied into the site, no "show source" link
         config.html_copy_source = False
         config.html_show_sourcelink = False
@@ -270,5 +342,6 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("env-purge-doc", _purge)
     app.connect("env-merge-info", _merge)
     app.connect("missing-reference", _dropped_reference)
+    app.connect("doctree-resolved", _unlink)
     app.add_transform(StudentEdition)
     return {"version": "1.0", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -28,6 +28,7 @@ SUBPACKAGE_API = (
     "instructor.config",
     "instructor.figures",
     "instructor.output",
+    "folders",
     "grading.grade",
     "grading.rosters",
     "grading.merge",

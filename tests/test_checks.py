@@ -504,3 +504,26 @@ def test_a_rounded_projection_matrix_is_named_with_its_decimals_on_a_groups_plan
         result = checks.case_study_projection(np.round(exact, k), plant)
         assert f"rounded to {k} decimals" in failures_text(result), str(result)
     assert checks.case_study_projection(exact, plant).passed
+
+
+# hints name the real cause, in the exercise's own terms ------------------------------------------
+
+
+def test_a_gain_placed_by_hand_is_never_asked_about_an_lmi():
+    placed = ut.design_pmo(ut.examples.dt_case_study(), poles=[0.3])
+    result = checks.case_study_pole(placed.L + 0.1, 0.3)
+    (ld,) = [m for m in result.failures if m.startswith("LD is not 0")]
+    assert "LMI" not in ld and "L = l N" in ld
+    lmi = ut.design_pmo(ut.examples.dt_case_study(), method="lmi")
+    P = lmi.lmi_certificate
+    result = checks.case_study_lmi(lmi.L + 0.1, P, Y=P @ (lmi.L + 0.1))
+    (ld,) = [m for m in result.failures if m.startswith("LD is not 0")]
+    assert "is it in your LMI?" in ld
+
+
+def test_l_and_p_of_one_solve_are_not_asked_whether_they_are_of_one_solve():
+    lmi = ut.design_pmo(ut.examples.dt_case_study(), method="lmi")
+    P = lmi.lmi_certificate
+    result = checks.case_study_lmi(lmi.L, P, Y=P @ lmi.L, margin=10.0)
+    (failure,) = result.failures
+    assert "same solve" not in failure and "lacks the margin" in failure

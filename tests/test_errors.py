@@ -10,11 +10,11 @@ import pytest
 
 import uio_teach as ut
 from uio_teach.checks.answers import AnswerError
+from uio_teach.folders import FolderBusy, OutputError
 from uio_teach.grading.grade import GradeError, SandboxRefused, UnsandboxedWarning
 from uio_teach.grading.sandbox import SandboxUnavailable
 from uio_teach.instructor.config import ConfigError
 from uio_teach.instructor.lab_registry import LabError, LabUsageError
-from uio_teach.instructor.output import FolderBusy, OutputError
 
 # each error with the built-in class that says what went wrong
 ERRORS = {

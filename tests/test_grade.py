@@ -696,14 +696,16 @@ def test_the_sandbox_mounts_parents_first_so_nothing_under_tmp_is_hidden(tmp_pat
 
 
 @needs_sandbox
-def test_an_environment_under_tmp_is_still_there_inside(tmp_path, monkeypatch):
+def test_an_environment_under_tmp_is_still_there_inside(tmp_path, monkeypatch, request):
     env = tmp_path / "venv"
     (env / "lib").mkdir(parents=True)
     (env / "lib" / "marker_under_tmp.py").write_text("VALUE = 42\n")
     work = tmp_path / "work"
     work.mkdir()
     monkeypatch.setattr(sys, "prefix", str(env))
-    user = sandbox.sandbox_user(0)
+    held = sandbox.SandboxUser()
+    user = held.acquire()
+    request.addfinalizer(held.release)
     if user is not None:
         os.chown(work, user, user)
         os.chmod(tmp_path, 0o755)

@@ -21,13 +21,16 @@ from uio_teach.grading.gradebook import (
     file_cell,
     shown,
 )
+from uio_teach.grading.lab_checks import course_labs, lab_checks
 from uio_teach.grading.rosters import (
     GradeError,
     group_from_name,
+    group_id,
     read_answer_key,
     read_roster,
 )
 from uio_teach.grading.runner import clean_notebook
+from uio_teach.grading.survey import added_since, survey
 
 # names --------------------------------------------------------------------------------------
 
@@ -48,11 +51,146 @@ from uio_teach.grading.runner import clean_notebook
         ("lab_pa9.ipynb", ("", "")),
         ("notebook (3).ipynb", ("", "")),
         ("pa9.ipynb", ("", "")),
+        ("pa9_Group-30.ipynb", ("pa9", "g30")),  # the group's own spelling, not a re-submission
+        ("pa9_group_30.ipynb", ("pa9", "g30")),
+        ("pa9_G30.ipynb", ("pa9", "g30")),
+        ("pa9_Group 30.ipynb", ("pa9", "g30")),
+        ("pa9_Group-30-1.ipynb", ("pa9", "g30")),  # and its re-submission
+        ("pa9_G30 (2).ipynb", ("pa9", "g30")),
     ],
 )
 def test_the_group_is_read_from_names_as_students_and_lmss_write_them(name, expected):
     assert group_from_name(name) == expected
     assert group_from_name(f"some/folder/{name}") == expected
+
+
+@pytest.mark.parametrize("spelling", ["Group-30", "group_30", "G30", "g030", "GROUP 30", "g30"])
+def test_every_spelling_of_a_group_is_one_group(spelling):
+    assert group_id(spelling) == "g30"
+
+
+def test_a_name_from_a_macos_zip_meets_its_roster_line(tmp_path):
+    """A macOS zip writes é as e and a combining accent (NFD); the roster, saved on Windows, as
+    one character (NFC): the same hand-in, and the student's name is one name too."""
+    roster = tmp_path / "groups.csv"
+    roster.write_text(
+        "file,lab,group,student,name\nJos\u00e9 notebook.ipynb,pa9,g07,s1,Jos\u00e9 Pe\u00f1a\n",
+        encoding="utf-8-sig",
+    )
+    files, students = read_roster(roster)
+    decomposed = tmp_path / "Jose\u0301 notebook.ipynb"
+    nb = nbformat.v4.new_notebook()
+    nbformat.write(nb, decomposed)
+    handin = grade.read_handin(decomposed, files)
+    assert (handin.lab, handin.group) == ("pa9", "g07")
+    assert students == {"g07": [("s1", "Jos\u00e9 Pe\u00f1a")]}
+
+
+def test_canvas_s_own_gradebook_export_is_a_roster_by_sis_id(tmp_path):
+    """Saved as Canvas exports it: "Student" is the display name, "SIS User ID" the id; its
+    second line is "Points Possible" and its test student is no student."""
+    roster = tmp_path / "canvas_export.csv"
+    roster.write_text(
+        "Student,ID,SIS User ID,SIS Login ID,Section,Lab 9 (123)\n"
+        "    Points Possible,,,,,5\n"
+        '"Pe\u00f1a, Jos\u00e9",101,s2026001,jpena,Group 3,\n'
+        '"Example, Ann",102,s2026002,aexample,group_3,\n'
+        '"Student, Test",103,,test,Group 3,\n',
+        encoding="utf-8-sig",
+    )
+    files, students = read_roster(roster)
+    assert files == {}
+    assert students == {"g03": [("s2026001", "Pe\u00f1a, Jos\u00e9"), ("s2026002", "Example, Ann")]}
+
+
+def test_a_group_column_added_to_canvas_s_export_wins_over_its_section(tmp_path):
+    roster = tmp_path / "canvas_export.csv"
+    roster.write_text(
+        "Student,ID,SIS User ID,SIS Login ID,Section,Group\nAnn,1,s1,a,Monday lab,G12\n",
+        encoding="utf-8",
+    )
+    assert read_roster(roster)[1] == {"g12": [("s1", "Ann")]}
+
+
+# what the students are told --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("lab", sorted(course_labs()))
+def test_each_lab_page_says_what_to_hand_in_how_to_name_it_and_how_it_is_marked(lab):
+    """Read from the registry of labs and their check cells: a new lab needs the same words."""
+    text = course_labs()[lab].read_text(encoding="utf-8")
+    ids = lab_checks(lab).check_ids
+    assert "**What you hand in.**" in text, f"lab_{lab}.md does not say what to hand in"
+    assert f"`{lab}_g07.ipynb`" in text and "`<lab>_<group>.ipynb`" in text
+    assert "**What is checked, and how it is marked.**" in text
+    missing = [c for c in ids if f"`{c}`" not in text]
+    assert not missing, f"lab_{lab}.md does not name the checks {missing} it is marked by"
+    assert f"out of {len(ids)}." in text
+
+
+# what a hand-in folder holds ------------------------------------------------------------------
+
+
+def test_every_entry_of_a_hand_in_folder_at_any_depth_is_a_hand_in_or_a_reason(tmp_path):
+    """Canvas's flat download, Moodle's download in folders, and what students upload besides."""
+    root = tmp_path / "handed_in"
+    moodle = root / "Ann Example_123_assignsubmission_file_"
+    (moodle / "deeper").mkdir(parents=True)
+    nb = nbformat.writes(nbformat.v4.new_notebook())
+    files = {
+        root / "pa9_g01.ipynb": nb,
+        root / "PA9_G02.IPYNB": nb,
+        moodle / "pa9_g03.ipynb": nb,
+        moodle / "deeper" / "pa9_g04.Ipynb": nb,
+        root / "pa9_g05.zip": "PK",
+        root / "pa9_g06.py": "x = 1",
+        root / "report.pdf": "%PDF",
+        root / ".DS_Store": "",
+        root / "README": "",
+    }
+    for path, text in files.items():
+        path.write_text(text)
+    (root / ".ipynb_checkpoints").mkdir()
+    (root / ".ipynb_checkpoints" / "pa9_g01-checkpoint.ipynb").write_text(nb)
+    (root / "__MACOSX").mkdir()
+    (root / "__MACOSX" / "._pa9_g01.ipynb").write_text("")
+    (root / "elsewhere").symlink_to(tmp_path)
+    out = root / "grades.csv"
+    out.write_text("file\n")
+    (root / "grades_feedback").mkdir()
+    found = survey(root, own=[out, root / "grades_feedback"])
+    assert found.handins == sorted(found.handins)  # in a fixed order: the same rows each run
+    assert {Path(f).name for f in found.handins} == {
+        "pa9_g01.ipynb",
+        "PA9_G02.IPYNB",
+        "pa9_g03.ipynb",
+        "pa9_g04.Ipynb",
+    }
+    why = {Path(p).name: w for p, w in found.others}
+    every = {p.name for p in root.rglob("*")} - {Path(f).name for f in found.handins}
+    every -= {"pa9_g01-checkpoint.ipynb", "._pa9_g01.ipynb"}  # inside folders not entered
+    assert set(why) == every  # each entry once: a row or a line
+    assert why["pa9_g05.zip"].startswith("an archive, not opened")
+    assert why["pa9_g06.py"].startswith("a Python script, not a notebook")
+    assert why["report.pdf"] == "a .pdf file, not a notebook: only .ipynb notebooks are graded"
+    assert why[".ipynb_checkpoints"].startswith("Jupyter's checkpoints")
+    assert why["__MACOSX"].startswith("what macOS adds to a zip")
+    assert why["elsewhere"].startswith("a link: not followed")
+    assert (
+        why["grades.csv"]
+        == why["grades_feedback"]
+        == ("written by this grading run (its gradebook)")
+    )
+    assert why[moodle.name] == "a folder: its entries are listed on their own"
+    assert found.counts() == "16 entries: 4 hand-ins, 2 folders, 10 other entries not graded"
+    assert grade.handin_files(root) == found.handins
+    (moodle / "pa9_g07.ipynb").write_text(nb)
+    (root / "late.zip").write_text("PK")
+    added = added_since(found, survey(root, own=[out, root / "grades_feedback"]))
+    assert [(Path(p).name, w.split(":")[0]) for p, w in added] == [
+        ("pa9_g07.ipynb", "added during the grading run"),
+        ("late.zip", "added during the grading run"),
+    ]
 
 
 def test_names_of_any_legal_length_and_encoding_get_their_own_feedback_file(tmp_path):
@@ -238,6 +376,136 @@ def test_a_cell_that_is_not_python_is_compared_without_comments_and_spacing():
     assert copies.fingerprint(["%matplotlib inline\ny = 2"]) == copies.fingerprint(["y = 2"])
 
 
+# A group's own solution (not the chapter's): what a disguised copy of it must still be caught as.
+OWN = [
+    "import numpy as np\nimport control as ct\nimport uio_teach as ut",
+    "M = np.linalg.pinv(C @ E)\nM = E @ M\nproj = np.eye(3) - M @ C\nscale = 1.0\n"
+    "A1 = proj @ A * scale",
+    "gains = ct.place(A1.T, C.T, [-1.0, -2.0, -3.0]).T\nF = A1 - gains @ C\nK2 = F @ M\n"
+    "H, T, K1 = M, proj, gains",
+    "run = ut.simulate(plant, obs, np.linspace(0, 10, 2001), d=0.5)\nerr = run.error\n"
+    "worst = abs(err).max()\nsettled = worst < 1e-3 * scale",
+]
+
+
+def _disguise(kind: str) -> list[str]:
+    cells = list(OWN)
+    swap = {
+        "1.0 as 1": lambda c: [x.replace("scale = 1.0", "scale = 1") for x in c],
+        "0.5 as 1/2": lambda c: [x.replace("d=0.5", "d=1/2") for x in c],
+        "two lines swapped": lambda c: [
+            x.replace(
+                "proj = np.eye(3) - M @ C\nscale = 1.0", "scale = 1.0\nproj = np.eye(3) - M @ C"
+            )
+            for x in c
+        ],
+        "an unused variable": lambda c: [*c[:2], c[2] + "\nunused = 42", *c[3:]],
+        "an if False block": lambda c: [*c, "if False:\n    worst = 0\n    print(worst)"],
+        "one extra print": lambda c: [*c, "print(worst)"],
+        "a cell split": lambda c: [c[0], *c[1].replace("\nscale", "\0scale").split("\0"), *c[2:]],
+        "two cells merged": lambda c: [c[0], c[1] + "\n" + c[2], c[3]],
+        "np.dot for @": lambda c: [x.replace("M = E @ M", "M = np.dot(E, M)") for x in c],
+        "a.dot(b) for @": lambda c: [x.replace("F @ M", "F.dot(M)") for x in c],
+        "scipy's pinv": lambda c: [
+            x.replace("np.linalg.pinv", "sla.pinv").replace(
+                "import numpy as np", "import numpy as np\nimport scipy.linalg as sla"
+            )
+            for x in c
+        ],
+        "names and comments": lambda c: [
+            "# the gain, then the error\n\n"
+            + x.replace("proj", "projector").replace("gains", "L").replace("worst", "biggest")
+            for x in c
+        ],
+        "all at once": lambda c: [
+            "import scipy.linalg as sla\nimport numpy\nimport control as ct\n"
+            "import uio_teach as ut",
+            "M = sla.pinv(C @ E)\nM = numpy.dot(E, M)\nk = 1\nP = numpy.eye(3) - M @ C\n"
+            "A1 = P @ A * k\nprint(A1)",
+            "g = ct.place(A1.T, C.T, [-1, -2, -3]).T",
+            "F = A1 - g @ C\nK2 = F.dot(M)\nH, T, K1 = M, P, g\nif 0:\n    H = None",
+            "r = ut.simulate(plant, obs, numpy.linspace(0, 10, 2001), d=1/2)\ne = r.error\n"
+            "w = abs(e).max()\nok = w < 1e-3 * k\nw",
+        ],
+    }
+    return swap[kind](cells)
+
+
+DISGUISES = [
+    "1.0 as 1",
+    "0.5 as 1/2",
+    "two lines swapped",
+    "an unused variable",
+    "an if False block",
+    "one extra print",
+    "a cell split",
+    "two cells merged",
+    "np.dot for @",
+    "a.dot(b) for @",
+    "scipy's pinv",
+    "names and comments",
+    "all at once",
+]
+
+
+@pytest.fixture(scope="module")
+def pa9_checks():
+    return lab_checks("pa9")
+
+
+@pytest.mark.parametrize("kind", DISGUISES)
+def test_a_disguised_copy_of_a_group_s_own_solution_is_still_alike(kind, pa9_checks):
+    keep = pa9_checks.names
+    given = copies.statements(pa9_checks.given, keep=keep)
+    disguised = _disguise(kind)
+    assert disguised != OWN
+    share, smaller = copies.similarity(
+        copies.statements(OWN, keep=keep), copies.statements(disguised, keep=keep), given
+    )
+    assert share >= copies.SIMILAR and smaller >= copies.MIN_STATEMENTS, (kind, share, smaller)
+
+
+def _handin(name: str, group: str, sources: list[str], keep) -> grade.Handin:
+    h = grade.Handin(name, "pa9", group)
+    h.code = copies.fingerprint(sources, keep=keep)
+    h.units = copies.statements(sources, keep=keep)
+    return h
+
+
+def test_near_copies_are_checked_by_hand_naming_the_other_group_and_the_share(pa9_checks):
+    keep = pa9_checks.names
+    given = {"pa9": copies.statements(pa9_checks.given, keep=keep)}
+    other = [  # another group's own work: other steps, other checks of the result
+        "import numpy as np\nimport uio_teach as ut",
+        "obs = ut.design_uio(plant, poles=[-2, -3, -4])\nH, T, K1 = obs.H, obs.T, obs.K1",
+        "F, K2 = obs.F, obs.K2\nrun = obs.simulate(timepts)\nmisfit = np.linalg.norm(run.error)",
+        "tail = run.error[:, -100:]\nassert np.all(np.abs(tail) < 1e-2)",
+    ]
+    handins = [
+        _handin("pa9_g01.ipynb", "g01", OWN, keep),
+        _handin("pa9_g02.ipynb", "g02", _disguise("all at once"), keep),
+        _handin("pa9_g03.ipynb", "g03", other, keep),
+    ]
+    notes = grade._identity_notes(handins, given)
+    assert notes["pa9_g03.ipynb"] == []
+    (note,) = notes["pa9_g01.ipynb"]
+    assert note.startswith("code much like group g02's (pa9_g02.ipynb): ")
+    assert "% of their own statements alike" in note
+    assert notes["pa9_g02.ipynb"][0].startswith("code much like group g01's (pa9_g01.ipynb)")
+
+
+def test_untouched_templates_are_never_copies_of_each_other(pa9_checks):
+    from uio_teach.folders import default_book_dir
+    from uio_teach.instructor.lab_notebook import make_notebook
+
+    template = make_notebook(default_book_dir() / "lab_pa9.md", "student")
+    keep = pa9_checks.names
+    given = {"pa9": copies.statements(pa9_checks.given, keep=keep)}
+    sources = grade._own_code(template)
+    handins = [_handin(f"pa9_g0{g}.ipynb", f"g0{g}", sources, keep) for g in (1, 2)]
+    assert grade._identity_notes(handins, given) == {h.file: [] for h in handins}
+
+
 # shards and merges ----------------------------------------------------------------------------
 
 CLASS = [f"handed_in/pa9_g{i:02d}.ipynb" for i in range(1, 41)]
@@ -315,14 +583,15 @@ def test_merged_shards_are_what_one_whole_run_writes(tmp_path):
 
 
 def test_a_pattern_that_also_matches_the_shards_exports_merges_the_gradebooks(tmp_path):
-    # `uio-teach merge marks/grades_*.csv` also picks grades_1_groups.csv, grades_1_canvas.csv
+    # `uio-teach merge marks/grades_*.csv` also picks grades_1_groups.csv, grades_1_canvas.csv,
+    # grades_1_moodle.csv
     files = CLASS[:8]
     students = {"g01": [("s1", "Ann")]}
     _book(tmp_path / "whole" / "grades.csv", files, None, students=students)
     for k in (1, 2):
         _book(tmp_path / "marks" / f"grades_{k}.csv", files, (k, 2), students=students)
     matched = sorted((tmp_path / "marks").glob("grades_*.csv"))
-    assert len(matched) == 6  # two gradebooks, each with its two exports
+    assert len(matched) == 8  # two gradebooks, each with its three exports
     merge.merge(matched, tmp_path / "merged" / "grades.csv")
     assert _tree(tmp_path / "merged") == _tree(tmp_path / "whole")
 
@@ -407,9 +676,9 @@ def test_the_summary_after_resume_counts_the_whole_gradebook(tmp_path, capsys):
     assert cli.main([*args, "--resume"]) == 0
     err = capsys.readouterr().err
     assert "3 rows need a look (3 unreadable) of the 3 rows in grades.csv" in err
-    assert "no Canvas import written" not in err  # -q: only what needs a look
+    assert "no Canvas or Moodle import written" not in err  # -q: only what needs a look
     assert cli.main([*args[:-1], "--resume"]) == 0
-    assert "no Canvas import written: without --roster" in capsys.readouterr().err
+    assert "no Canvas or Moodle import written: without --roster" in capsys.readouterr().err
 
 
 def test_shard_and_merge_usage_errors_are_one_line(tmp_path, capsys):

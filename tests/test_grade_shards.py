@@ -23,6 +23,7 @@ import copy
 import csv
 import io
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -295,12 +296,16 @@ def test_a_failure_of_the_runner_is_the_graders_not_the_notebooks(tmp_path, monk
 
     monkeypatch.setattr(nbclient, "NotebookClient", Broken)
     monkeypatch.setattr(Limits, "apply", lambda self: None)
+    monkeypatch.setattr(runner, "_private", lambda: None)  # this test process stays dumpable
     src = tmp_path / "submission.ipynb"
     nbformat.write(notebook("x = 1"), src)
-    code = runner._execute(str(src), str(tmp_path / runner.ERRORS), 10.0, "1,1,1,1,1,", "")
+    read_end, write_end = os.pipe()
+    code = runner._execute(str(src), write_end, 10.0, "1,1,1,1,1,", "")
+    with os.fdopen(read_end, encoding="utf-8") as records:  # the runner closed its end
+        entries = [json.loads(line) for line in records]
     assert code == 3
-    failed = json.loads((tmp_path / runner.RUNNER_FAILED).read_text())
-    assert failed["error"] == "MemoryError"
+    assert entries == [{"failed": "MemoryError"}]
+    assert not [p.name for p in tmp_path.iterdir() if p.name != "submission.ipynb"]
 
 
 # the wheel ------------------------------------------------------------------------------------

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from uio_teach import folders
 from uio_teach.grading import grade
 from uio_teach.grading.gradebook import Gradebook, GradebookBusy, Submission
 from uio_teach.grading.lab_checks import lab_checks
-from uio_teach.instructor import output
 
 IDS = ("pa9.design", "pa9.plot")
 
@@ -44,7 +44,7 @@ def test_each_row_is_on_disk_as_soon_as_it_is_added(tmp_path):
     table = rows(out)
     assert [r["file"] for r in table] == ["a.ipynb", "b.ipynb"]  # the order given
     assert [r["pa9.design"] for r in table] == [grade.FAIL, grade.PASS]
-    manifest = output.read_manifest(tmp_path / "grades_feedback")
+    manifest = folders.read_manifest(tmp_path / "grades_feedback")
     assert manifest["command"] == "uio-teach grade"
     assert sorted(f["name"] for f in manifest["files"]) == ["a.html", "a.txt", "b.html", "b.txt"]
     # without a roster no group can be matched to a student: no Canvas import at all
@@ -111,6 +111,7 @@ def test_resume_widens_the_columns_for_a_new_lab(tmp_path):
         "missile.pmo",
         "total",
         "out_of",
+        "late",
     ]
     assert [(r["pa9.design"], r["missile.pmo"]) for r in table] == [
         (grade.PASS, ""),
@@ -125,11 +126,11 @@ def test_a_folder_that_is_not_earlier_feedback_is_left_alone(tmp_path, content):
     folder.mkdir()
     if content == "figures":
         (folder / "a.png").write_bytes(b"png")
-        output.write_manifest(folder, command="uio-teach figures", config={})
+        folders.write_manifest(folder, command="uio-teach figures", config={})
     else:
         (folder / "notes.txt").write_text("mine")
     before = sorted(p.name for p in folder.iterdir())
-    with pytest.raises(output.OutputError, match="left alone"):
+    with pytest.raises(folders.OutputError, match="left alone"):
         grade.grade([tmp_path / "x.ipynb"], out, sandbox=False)
     assert not out.exists() and sorted(p.name for p in folder.iterdir()) == before
 
@@ -137,7 +138,7 @@ def test_a_folder_that_is_not_earlier_feedback_is_left_alone(tmp_path, content):
 def test_a_csv_that_is_not_a_gradebook_is_not_resumed_over(tmp_path):
     out = tmp_path / "grades.csv"
     out.write_text("name,mark\nann,5\n")
-    with pytest.raises(output.OutputError, match="not a gradebook"):
+    with pytest.raises(folders.OutputError, match="not a gradebook"):
         Gradebook(out, ["a.ipynb"], IDS, resume=True).__enter__()
     assert out.read_text() == "name,mark\nann,5\n"
 
@@ -256,3 +257,51 @@ def test_numbers_stay_numbers_and_the_lms_exports_follow_the_rows(tmp_path):
         # g02 has no student in the roster: no row Canvas could not match
         ("Cy", "s3", "g03", "0"),
     ]
+
+
+def test_the_late_flag_is_a_column_of_its_own(tmp_path):
+    out = tmp_path / "grades.csv"
+    late = Submission("ann_LATE_1_2_pa9_g01.ipynb", "pa9", "g01", "ok", late=True)
+    on_time = Submission("pa9_g02.ipynb", "pa9", "g02", "ok")
+    with Gradebook(out, [late.file, on_time.file], IDS) as book:
+        book.add(late)
+        book.add(on_time)
+    assert [(r["file"], r["late"]) for r in rows(out)] == [
+        ("ann_LATE_1_2_pa9_g01.ipynb", "late"),
+        ("pa9_g02.ipynb", ""),
+    ]
+
+
+def test_two_names_that_differ_only_in_their_normal_form_never_share_a_cell(tmp_path):
+    composed, decomposed = "Jos\u00e9_pa9_g01.ipynb", "Jose\u0301_pa9_g01.ipynb"
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, [composed, decomposed], IDS) as book:
+        book.add(sub(composed))
+        book.add(sub(decomposed))
+    cells = [r["file"] for r in rows(out)]
+    assert cells == [composed, "Jose\\u0301_pa9_g01.ipynb"]
+    with Gradebook(out, [composed, decomposed], IDS, resume=True) as book:
+        assert book.prior() == {composed, decomposed}  # each kept as its own row
+
+
+def test_moodle_s_grade_import_is_written_beside_canvas_s_from_a_moodle_roster(tmp_path):
+    roster = tmp_path / "participants.csv"
+    roster.write_text(
+        "First name,Last name,ID number,Email address,Groups\n"
+        "Ann,Example,u101,ann@example.org,Group 1\n"
+        "Bo,Example,u102,bo@example.org,Group 2\n",
+        encoding="utf-8-sig",
+    )
+    _, students = grade.read_roster(roster)
+    out = tmp_path / "grades.csv"
+    with Gradebook(out, ["pa9_g01.ipynb", "pa9_g02.ipynb"], IDS, students=students) as book:
+        book.add(sub("pa9_g01.ipynb"))
+        book.add(Submission("pa9_g02.ipynb", "pa9", "g02", "ok", expected=IDS))
+    with open(tmp_path / "grades_moodle.csv", newline="", encoding="utf-8") as fh:
+        table = list(csv.reader(fh))
+    assert table == [
+        ["ID number", "Full name", "Group", "pa9 (uio-teach)"],
+        ["u101", "Ann Example", "g01", "1"],
+        ["u102", "Bo Example", "g02", "0"],
+    ]
+    assert (tmp_path / "grades_canvas.csv").is_file()

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from uio_teach.instructor import cli, figures, output
+from uio_teach import folders
+from uio_teach.instructor import cli, figures
 from uio_teach.instructor.config import MAX_SAMPLES, ConfigError, FigureConfig, load_config
 
 FAST = ["case_error", "missile_table2"]  # two quick outputs: a figure and a table
@@ -112,7 +113,7 @@ def test_a_style_file_is_read_beside_the_config_file(tmp_path, monkeypatch):
     cfg = load_config(Path("..") / "course" / "term.toml")
     assert Path(cfg["style"]) == (folder / "x.mplstyle").resolve()
     assert make(elsewhere / "out", "--config", str(folder / "term.toml")) == 0
-    manifest = json.loads((elsewhere / "out" / output.MANIFEST).read_text())
+    manifest = json.loads((elsewhere / "out" / folders.MANIFEST).read_text())
     assert manifest["config"]["style"] == os.fspath((folder / "x.mplstyle").resolve())
 
 
@@ -127,17 +128,17 @@ def test_a_good_run_over_last_term_leaves_only_this_terms_files(tmp_path, last_t
         "case_error.txt",
         "missile_table2.csv",
         "missile_table2.md",
-        output.MANIFEST,
+        folders.MANIFEST,
     }
     assert sorted(os.listdir(tmp_path)) == ["figures", "term.toml"]  # no temporary left
-    manifest = json.loads((last_term / output.MANIFEST).read_text())
+    manifest = json.loads((last_term / folders.MANIFEST).read_text())
     assert manifest["config"]["seed"] == 11
     assert manifest["config"]["missile.pmo_poles"] == [-90.0, -140.0]
     assert manifest["options"]["config_file"] == str(config)
     canonical = json.dumps(manifest["config"], sort_keys=True, separators=(",", ":"))
     assert manifest["config_sha256"] == hashlib.sha256(canonical.encode()).hexdigest()
     listed = {f["name"]: f for f in manifest["files"]}
-    assert set(listed) == names - {output.MANIFEST}
+    assert set(listed) == names - {folders.MANIFEST}
     for name, entry in listed.items():
         data = (last_term / name).read_bytes()
         assert entry["sha256"] == hashlib.sha256(data).hexdigest()
@@ -179,14 +180,14 @@ def test_a_folder_that_is_not_an_earlier_output_is_left_alone(tmp_path, capsys):
     code = make(mine)
     err = capsys.readouterr().err
     assert code == 1 and err.count("\n") == 1
-    assert f"the output folder {mine} is not empty and has no {output.MANIFEST}" in err
+    assert f"the output folder {mine} is not empty and has no {folders.MANIFEST}" in err
     assert [p.name for p in mine.iterdir()] == ["chapter1.tex"]
     empty = tmp_path / "empty"
     empty.mkdir()
-    assert make(empty) == 0 and (empty / output.MANIFEST).is_file()
+    assert make(empty) == 0 and (empty / folders.MANIFEST).is_file()
     forged = tmp_path / "forged"
     forged.mkdir()
-    (forged / output.MANIFEST).write_text('{"generator": "someone else"}')
+    (forged / folders.MANIFEST).write_text('{"generator": "someone else"}')
     assert make(forged) == 1
 
 
@@ -194,8 +195,8 @@ def test_a_folder_that_is_not_an_earlier_output_is_left_alone(tmp_path, capsys):
 def test_the_same_run_gives_the_same_manifest(tmp_path):
     for name in ("a", "b"):
         assert make(tmp_path / name) == 0
-    a = (tmp_path / "a" / output.MANIFEST).read_bytes()
-    assert a == (tmp_path / "b" / output.MANIFEST).read_bytes()
+    a = (tmp_path / "a" / folders.MANIFEST).read_bytes()
+    assert a == (tmp_path / "b" / folders.MANIFEST).read_bytes()
     assert str(tmp_path).encode() not in a  # no path of the machine, no time stamp
 
 
@@ -224,14 +225,15 @@ def leftovers(parent: Path) -> list[str]:
 # its staged output (a file written, a point of the swap): the package's steps do nothing.
 _KILLER = """
 import os, signal, sys
-from uio_teach.instructor import cli, output
+from uio_teach import folders
+from uio_teach.instructor import cli
 count = 0
 def step():
     global count
     count += 1
     if count == int(sys.argv[1]):
         os.kill(os.getpid(), signal.SIGKILL)
-output._step = step
+folders._step = step
 sys.exit(cli.main(sys.argv[2:]))
 """
 
@@ -305,9 +307,9 @@ def test_a_labs_rerun_with_fewer_groups_leaves_no_notebook_of_the_earlier_run(tm
     assert cli.main(labs_argv(out, 2)) == 0
     assert snapshot(out) == lab_sets["new"]
     assert not list(out.rglob("*_g03*"))
-    manifest = json.loads((out / output.MANIFEST).read_text())
+    manifest = json.loads((out / folders.MANIFEST).read_text())
     names = {f["name"] for f in manifest["files"]}
-    assert names == set(lab_sets["new"]) - {output.MANIFEST}
+    assert names == set(lab_sets["new"]) - {folders.MANIFEST}
     assert "pa9/student/pa9_g01.ipynb" in names and "answer_key.csv" in names
     for entry in manifest["files"]:
         data = (out / entry["name"]).read_bytes()
@@ -336,7 +338,7 @@ def test_a_second_run_into_the_same_folder_is_refused_while_the_first_holds_it(
     argv = labs_argv(out, 2) if command == "labs" else figures_argv(out, 1)
     assert cli.main(argv) == 0
     before = snapshot(tmp_path)
-    with output.FolderLock(out):  # the first run, still writing
+    with folders.FolderLock(out):  # the first run, still writing
         code = cli.main(argv)
         err = capsys.readouterr().err
         assert (tmp_path / ".out.lock").read_text().strip() == str(os.getpid())
@@ -349,7 +351,7 @@ def test_a_second_run_into_the_same_folder_is_refused_while_the_first_holds_it(
 @pytest.mark.subprocess
 def test_a_second_process_is_refused_while_the_lock_is_held(tmp_path):
     out = tmp_path / "out"
-    with output.FolderLock(out):
+    with folders.FolderLock(out):
         proc = uio_teach(*figures_argv(out, 1))
     assert proc.returncode == 1
     assert proc.stderr.count("\n") == 1 and "is writing" in proc.stderr
@@ -366,7 +368,7 @@ def test_the_lock_of_a_dead_process_is_taken_over(tmp_path):
     )
     (tmp_path / ".out.lock").write_text(dead.stdout)  # a killed run's lock, no one holds it
     assert cli.main(figures_argv(tmp_path / "out", 1)) == 0
-    assert (tmp_path / "out" / output.MANIFEST).is_file()
+    assert (tmp_path / "out" / folders.MANIFEST).is_file()
     assert leftovers(tmp_path) == []
 
 
@@ -386,7 +388,7 @@ def test_an_output_set_aside_by_a_killed_swap_is_put_back(tmp_path):
     assert make(out) == 0
     before = snapshot(out)
     os.replace(out, tmp_path / ".figs.old-abc")  # killed between the two renames of a swap
-    with output.StagedFolder(out) as stage:
+    with folders.StagedFolder(out) as stage:
         assert snapshot(out) == before  # back before anything else happens
         (stage.path / "x.txt").write_text("x")
     assert snapshot(out) == before and leftovers(tmp_path) == []
@@ -621,7 +623,10 @@ def test_the_student_edition_leaves_solutions_and_tutors_notes_out(tmp_path, edi
 def test_an_unknown_edition_is_refused(tmp_path):
     proc = build_edition(tmp_path, "teachers")
     assert proc.returncode != 0
-    assert "UIO_TEACH_EDITION must be one of student, instructor, got 'teachers'" in proc.stderr
+    assert (
+        "UIO_TEACH_EDITION must be one of student, instructor, selfstudy, got 'teachers'"
+        in proc.stderr
+    )
 
 
 def test_labs_and_figures_never_replace_each_others_folders(tmp_path, capsys):

@@ -482,10 +482,14 @@ def test_a_source_that_is_not_a_lab_is_a_usage_error(tmp_path, capsys):
 @pytest.mark.parametrize("version", labs.VERSIONS)
 def test_cross_references_are_short_plain_text(lab, version):
     text = "\n".join(c.source for c in lab[version].cells if c.cell_type == "markdown")
-    assert re.search(r"\beq\. \(\d+\.\d+\)", text)
+    assert re.search(r"\b(?:eq\.|equations?) \(\d+\.\d+\)", text)
     assert re.search(r"\bchapter \d+\b", text)
     assert not re.search(r"\) of chapter \d", text)
     assert not re.search(r"chapter \d+, \*", text)
+    # the word is said once: not "eq. eq. (4.2)", not "equations (4.1), eq. (4.2)"
+    listed = r"(?:\([^()]*\)(?:,\s*|\s+and\s+))*"
+    doubled = re.search(rf"\b(?:[Ee]q\.|[Ee]qs\.|[Ee]quations?)\s+{listed}eq\. \(", text)
+    assert not doubled, doubled and doubled.group(0)
 
 
 # every key of the term config reaches the labs (or the help says why not) ----------------------

@@ -88,21 +88,69 @@ def test_the_layout_check_sees_a_forbidden_import(tmp_path):
     assert "uio_teach.instructor.cli" in _imports(root / "explorers" / "deep.py", root)
 
 
+def room_crossings(root: Path = PACKAGE) -> list[str]:
+    """Imports that tie the grader and the term's tooling together outside the command line.
+
+    ``grading/`` may import nothing of ``instructor/``; of ``instructor/``, only ``cli.py`` may
+    import ``grading/``. What the two share (the folder lock, the manifest, the hashes, where the
+    book is) lives below both, in ``uio_teach.folders``.
+    """
+    top = root.name
+    found = []
+    for room, other, allowed in (
+        ("grading", "instructor", ()),
+        ("instructor", "grading", ("cli",)),
+    ):
+        for path in sorted((root / room).rglob("*.py")):
+            if path.stem in allowed:
+                continue
+            crossing = sorted(
+                m
+                for m in _imports(path, root)
+                if m == f"{top}.{other}" or m.startswith(f"{top}.{other}.")
+            )
+            if crossing:
+                found.append(f"{room}/{path.relative_to(root / room)} imports {crossing}")
+    return found
+
+
 def test_the_grader_is_a_room_of_its_own():
-    """Only the command line ties the term's tooling to the grader; the grader takes from the
-    term's tooling only where the book is and the output folders, never the figures, the labs'
-    parameters or the variants (nor the algorithms they load, before the first hand-in)."""
+    """Only the command line ties the term's tooling to the grader; what both need comes from a
+    module below them (and the grader's engine starts none of the figures, the labs' parameters or
+    the variants before the first hand-in)."""
+    found = room_crossings()
+    assert not found, (
+        "the grader and the term's tooling import each other (move what they share down into "
+        f"uio_teach.folders): {found}"
+    )
     tied = sorted(
         path.name
         for path in (PACKAGE / "instructor").glob("*.py")
         if any(m.startswith("uio_teach.grading") for m in _imports(path))
     )
     assert tied == ["cli.py"]
-    allowed = ("uio_teach.instructor.output", "uio_teach.instructor.book")
-    for path in (PACKAGE / "grading").glob("*.py"):
-        used = {m for m in _imports(path) if m.startswith("uio_teach.instructor")}
-        assert all(m.startswith(allowed) for m in used), f"{path.name} imports {sorted(used)}"
+    shared = {"uio_teach.folders"}
+    for room in ("grading", "instructor"):
+        assert any(shared & _imports(p) for p in (PACKAGE / room).glob("*.py")), room
     assert not (PACKAGE / "checks" / "grading.py").exists()
+
+
+def test_the_room_check_sees_a_crossing_at_any_depth(tmp_path):
+    root = tmp_path / "uio_teach"
+    for room in ("grading", "instructor"):
+        (root / room).mkdir(parents=True)
+    (root / "grading" / "grade.py").write_text(
+        "from ..folders import MANIFEST\n\ndef f():\n    from ..instructor.book import x\n"
+    )
+    (root / "grading" / "merge.py").write_text("import uio_teach.instructor\n")
+    (root / "instructor" / "cli.py").write_text("from ..grading import grade\n")
+    (root / "instructor" / "labs.py").write_text("from uio_teach.grading.rosters import read\n")
+    assert room_crossings(root) == [
+        "grading/grade.py imports ['uio_teach.instructor.book', 'uio_teach.instructor.book.x']",
+        "grading/merge.py imports ['uio_teach.instructor']",
+        "instructor/labs.py imports ['uio_teach.grading.rosters', "
+        "'uio_teach.grading.rosters.read']",
+    ]
 
 
 def test_algorithm_layer_is_found():

@@ -330,6 +330,134 @@ def test_every_local_link_and_download_resolves(page: str, built_book: Path) -> 
     assert not (built_book / "_sources").exists(), "the pages' sources are copied into the site"
 
 
+class _Anchors(HTMLParser):
+    """The ids a page defines (anchors a link may point to) and the links it holds."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.ids: set[str] = set()
+        self.links: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        for name, value in attrs:
+            if name in ("id", "name") and value:
+                self.ids.add(value)
+            if name in ("href", "src") and value:
+                self.links.append(value)
+
+
+def dead_links(site: Path) -> list[str]:
+    """Every local link of every HTML page of ``site`` to a file that is not there, or to an
+    anchor (``#id``) its page does not define: ``page -> link``."""
+    pages: dict[Path, _Anchors] = {}
+    for html in sorted(site.rglob("*.html")):
+        parser = _Anchors()
+        parser.feed(html.read_text(encoding="utf-8", errors="replace"))
+        pages[html.resolve()] = parser
+    dead = []
+    for html, parser in pages.items():
+        for link in sorted(set(parser.links)):
+            parts = urlsplit(link)
+            if parts.scheme or parts.netloc or link.startswith(("data:", "javascript:", "mailto:")):
+                continue
+            target = (html.parent / unquote(parts.path)).resolve() if parts.path else html
+            if not target.exists():
+                dead.append(f"{html.relative_to(site.resolve())} -> {link}")
+                continue
+            fragment = unquote(parts.fragment)
+            if fragment and target in pages and fragment not in pages[target].ids:
+                dead.append(f"{html.relative_to(site.resolve())} -> {link}")
+    return dead
+
+
+def test_the_link_check_finds_a_missing_file_and_a_missing_anchor(tmp_path: Path) -> None:
+    (tmp_path / "api.html").write_text('<h2 id="kept">x</h2><a href="#kept">ok</a>')
+    (tmp_path / "lab.html").write_text(
+        '<a href="api.html#kept">ok</a> <a href="api.html#uio_teach.grading.grade.grade">gone</a>'
+        ' <a href="gone.html">gone</a> <a href="https://example.org/#x">out</a>'
+    )
+    assert dead_links(tmp_path) == [
+        "lab.html -> api.html#uio_teach.grading.grade.grade",
+        "lab.html -> gone.html",
+    ]
+
+
+def test_links_to_the_objects_of_a_dropped_section_become_their_text() -> None:
+    from docutils import nodes
+    from editions import unlink_dropped
+
+    para = nodes.paragraph()
+    para += nodes.reference("", "grade()", refuri="api.html#uio_teach.grading.grade.grade")
+    para += nodes.reference("", "simulate()", refuri="api.html#uio_teach.simulate")
+    para += nodes.reference("", "here", refid="uio_teach.grading.merge.merge")
+    assert (
+        unlink_dropped(para, {"uio_teach.grading.grade.grade", "uio_teach.grading.merge.merge"})
+        == 2
+    )
+    assert [r["refuri"] for r in para.findall(nodes.reference)] == ["api.html#uio_teach.simulate"]
+    assert para.astext() == "grade()simulate()here"
+
+
+def test_the_self_study_edition_folds_a_solution_behind_its_summary() -> None:
+    from docutils import nodes
+    from editions import FOLD_SUMMARY, fold_away
+
+    section = nodes.section()
+    section += nodes.paragraph("", "Exercise")
+    solution = nodes.container("", nodes.literal_block("H = E @ pinv(C @ E)", "H = ..."))
+    section += solution
+    fold_away(solution)
+    (box,) = [c for c in section.children if isinstance(c, nodes.container)]
+    opening, inner, closing = box.children
+    assert inner is solution and solution.parent is box
+    assert (
+        opening.astext().startswith("<details") and f"<summary>{FOLD_SUMMARY}" in opening.astext()
+    )
+    assert closing.astext() == "</details>" and " open" not in opening.astext()
+
+
+def test_no_link_of_the_student_edition_is_dead(built_book: Path) -> None:
+    """No page of the student edition links a page, a file or an anchor the edition leaves
+    out (the API page's tutor-only sections are left out with every link into them)."""
+    dead = dead_links(built_book)
+    assert not dead, f"{len(dead)} dead links in the student edition: {dead[:20]}"
+
+
+def test_the_student_api_page_holds_no_tutor_only_text(built_book: Path) -> None:
+    text = _main_text(built_book / "api.html")
+    for words in ("answer key", "sandbox", "copies between groups", "uio_teach.grading"):
+        assert words not in text, f"the student edition's API page speaks of {words!r}"
+
+
+@pytest.mark.slow  # a second build of the book (the instructor edition)
+@pytest.mark.subprocess
+def test_no_link_of_the_instructor_edition_is_dead(built_book: Path) -> None:
+    import os
+    import shutil
+    import subprocess
+
+    from conftest import jupyter_book
+
+    out = ROOT / "_build" / "instructor"
+    html = out / "_build" / "html"
+    if not (html / "api.html").is_file():  # the accessibility test may have built it already
+        cache = out / "_build" / ".jupyter_cache"
+        shutil.rmtree(cache, ignore_errors=True)
+        shutil.copytree(ROOT / "_build" / ".jupyter_cache", cache)
+        command = [jupyter_book(), "build", ".", "--all", "-W", "-n", "--keep-going"]
+        proc = subprocess.run(
+            [*command, "--path-output", str(out)],
+            cwd=ROOT,
+            env={**os.environ, "UIO_TEACH_EDITION": "instructor"},
+            capture_output=True,
+            text=True,
+            timeout=3600,
+        )
+        assert proc.returncode == 0, (proc.stdout + proc.stderr)[-4000:]
+    dead = dead_links(html)
+    assert not dead, f"{len(dead)} dead links in the instructor edition: {dead[:20]}"
+
+
 def test_fonts_of_the_chapters_figures() -> None:
     """The figures' smallest text: the book's Matplotlib settings and every font size a chapter
     or the plotting module sets are at least FIGURE_FONT_PT."""

@@ -157,7 +157,10 @@ def _error_matrix(plant, L: np.ndarray) -> np.ndarray:
     return decoupling(plant).A1 - L @ plant.C
 
 
-def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
+def _LD(result: CheckResult, L: np.ndarray, plant, tol: float, *, lmi: bool) -> bool:
+    """✓/✗ ``LD = 0``, the hint naming the cause in the exercise's own terms: the LMI's linear
+    constraint where ``L`` comes from an LMI (``lmi``), the form ``L = l N`` where it is placed
+    by hand."""
     LD = L @ plant.D
     ok, big = _small(LD, float(np.max(np.abs(L))), tol)
     if ok:
@@ -168,7 +171,12 @@ def _LD(result: CheckResult, L: np.ndarray, plant, tol: float) -> bool:
         " Your L is the printed one, rounded to 4 decimals; rounding moves it off LD = 0. Use "
         "the gain of your solver."
         if close(L, pub, tols.CHECK_EXACT_RTOL)
-        else " With Y = PL, LD = 0 is the linear constraint YD = 0: is it in your LMI?"
+        else (
+            " With Y = PL, LD = 0 is the linear constraint YD = 0: is it in your LMI?"
+            if lmi
+            else " A gain with LD = 0 has the form L = l N, with N D = 0 (N the combination of "
+            "outputs that v does not reach): build your L from N."
+        )
     )
     result.add(
         False,
@@ -250,7 +258,7 @@ def case_study_lmi(
         return result
     certified = Pm is not None and (Y is None or Ym is not None) and _P_definite(result, Pm, tol)
     from_solve = _L_from_solve(result, L, Pm, Ym, tol) if certified else False
-    _LD(result, L, plant, tol)
+    _LD(result, L, plant, tol, lmi=True)
     F = _error_matrix(plant, L)
     eig = np.linalg.eigvals(F)
     worst = float(np.max(np.abs(eig)))
@@ -272,11 +280,20 @@ def case_study_lmi(
         top = float(np.max(np.linalg.eigvalsh((block + block.T) / 2)))
         if top <= -float(margin) + tol * max(1.0, float(np.max(np.abs(Pm)))):
             result.add(True, "P certifies the LMI: [[-P, F'P], [PF, -P]] <= 0 for your L.")
+        elif from_solve:  # L = P^-1 Y holds: one solve, of an LMI without the exercise's margin
+            result.add(
+                False,
+                f"P does not certify this L with the exercise's margin: the LMI block has the "
+                f"eigenvalue {top:.3g}, above {-float(margin):g}. L and P are from one solve, "
+                f"so the LMI you solved lacks the margin: ask for the block <= -{float(margin):g} "
+                "I, not <= 0.",
+            )
         else:
             result.add(
                 False,
                 f"P does not certify this L: the LMI block has the eigenvalue {top:.3g}, above "
-                f"{-float(margin):g}. Are L and P from the same solve?",
+                f"{-float(margin):g}. Without Y, L cannot be traced to the solve: are L and P "
+                "from the same solve?",
             )
     return result
 
@@ -358,7 +375,7 @@ def case_study_pole(
     if L is None:
         return result
     pole = float(pole)
-    decoupled = _LD(result, L, plant, tol)
+    decoupled = _LD(result, L, plant, tol, lmi=False)
     eig = np.sort_complex(np.linalg.eigvals(_error_matrix(plant, L)))
     fixed = np.asarray(check_existence(plant).fixed_modes, complex)
     if same_poles(eig, np.concatenate([[pole], fixed]), tol):

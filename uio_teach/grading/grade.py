@@ -53,7 +53,9 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import hashlib
 import json
 import os
 import shutil
@@ -63,6 +65,7 @@ import tempfile
 import threading
 import time
 import warnings
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -72,16 +75,18 @@ from typing import Any
 import nbformat
 
 from ..errors import UIOTeachWarning
-from ..instructor.output import sha256_file
+from ..folders import sha256_file
 from .checking import check_in_child
-from .copies import fingerprint
+from .copies import MIN_STATEMENTS, SIMILAR, fingerprint, similarity, statements
 from .gradebook import (
+    EXPORTS,
     FAIL,
     PASS,
     Gradebook,
     GradebookBusy,
     Submission,
     check_gradebook_target,
+    export_path,
     feedback_folder,
 )
 from .lab_checks import CHECK_TAG, LabChecks, LabChecksError, course_checks, course_labs
@@ -93,17 +98,19 @@ from .rosters import (
     is_late,
     read_answer_key,
     read_roster,
+    same_form,
 )
 from .runner import RunOutcome, clean_notebook, prepare, run_notebook
 from .sandbox import (
     OWNER,
     TEMP_PREFIX,
     Limits,
+    SandboxUser,
     own_folder,
     sandbox_problem,
-    sandbox_user,
     start_time,
 )
+from .survey import Survey, added_since, survey
 
 __all__ = [
     "GradeError",
@@ -127,7 +134,33 @@ __all__ = [
     "PASS",
     "FAIL",
     "TEMP_PREFIX",
+    "Graded",
+    "SELF_TEST_FOLDER",
+    "self_test_key",
 ]
+
+
+class Graded(list):
+    """The submissions a run graded (a list), and what else its hand-in folder held.
+
+    Attributes
+    ----------
+    survey : Survey or None
+        The hand-in folder as the run found it (None when files were given):
+        the hand-ins, and every other entry with why it is not graded.
+    added : list of (str, str)
+        What appeared in the folder during the run, not graded.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.grade import Graded
+    >>> result = Graded([])
+    >>> len(result), result.survey, result.added
+    (0, None, [])
+    """
+
+    survey: Survey | None = None
+    added: list[tuple[str, str]] = []
 
 
 class SandboxRefused(GradeError):
@@ -236,6 +269,9 @@ class Handin:
         The lab and group the notebook's metadata claims.
     code : str
         A fingerprint of its code (for hand-ins copied between groups).
+    units : collections.Counter
+        Its code as normalised statements (for near-copies,
+        :func:`uio_teach.grading.copies.statements`).
     """
 
     file: str
@@ -248,6 +284,7 @@ class Handin:
     meta_lab: str = ""
     meta_group: str = ""
     code: str = ""
+    units: Counter[str] = field(default_factory=Counter)
 
 
 def _kind(mode: int) -> str:
@@ -319,18 +356,15 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _fingerprint(nb: Any, keep: Iterable[str]) -> str:
-    """The code of a notebook, normalised (:mod:`uio_teach.grading.copies`), hashed.
-
-    The cells every group has alike are left out: ``parameters``, ``check``.
-    """
+def _own_code(nb: Any) -> list[str]:
+    """The code cells of a notebook but those every group has alike: ``parameters``, ``check``."""
     sources = []
     for cell in nb.cells:
         tags = cell.get("metadata", {}).get("tags", [])
         if cell.get("cell_type") != "code" or {"parameters", CHECK_TAG} & set(tags):
             continue
         sources.append(cell.source)
-    return fingerprint(sources, keep=keep)
+    return sources
 
 
 def read_handin(
@@ -373,7 +407,7 @@ def read_handin(
     """
     file = os.fspath(path)
     name_lab, name_group = group_from_name(file)
-    lab, group = (roster or {}).get(Path(file).name, (name_lab, name_group))
+    lab, group = (roster or {}).get(same_form(Path(file).name), (name_lab, name_group))
     lab = lab or name_lab
     handin = Handin(file, lab, group)
     if is_late(file):
@@ -400,12 +434,21 @@ def read_handin(
     if not handin.lab:
         stem = Path(source).stem if source else Path(file).stem
         handin.lab = handin.meta_lab or next((k for k in course_labs() if f"lab_{k}" == stem), "")
-    handin.code = _fingerprint(handin.notebook, keep)
+    sources = _own_code(handin.notebook)
+    handin.code = fingerprint(sources, keep=keep)
+    handin.units = statements(sources, keep=keep)
     return handin
 
 
-def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
-    """File -> why its identity needs a look: the notebook disagrees, a group twice, a copy."""
+def _identity_notes(
+    handins: Sequence[Handin], given: Mapping[str, Counter[str]] | None = None
+) -> dict[str, list[str]]:
+    """File -> why its identity needs a look: the notebook disagrees, a group twice, a copy.
+
+    ``given`` (lab -> the statements of the course's own code of that lab) is set aside before
+    code is compared: a hand-in with nothing of its own (an untouched template) is no copy.
+    """
+    given = given or {}
     notes: dict[str, list[str]] = {h.file: [] for h in handins}
     for h in handins:
         if h.status:
@@ -428,7 +471,7 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
             continue
         if h.group:
             by_group.setdefault((h.lab, h.group), []).append(h)
-        if h.code:
+        if h.code and h.units - given.get(h.lab, Counter()):  # something of its own
             by_code.setdefault(h.code, []).append(h)
     for (_, group), same in by_group.items():
         for h in same if len(same) > 1 else ():
@@ -445,7 +488,45 @@ def _identity_notes(handins: Sequence[Handin]) -> dict[str, list[str]]:
                 f"the same code as {others}, once comments, blank lines, formatting and the "
                 "names of variables are set aside"
             )
+    exact = {h.file for same in by_code.values() if len({h.group for h in same}) > 1 for h in same}
+    _near_copies(handins, given, notes, exact)
     return notes
+
+
+def _near_copies(
+    handins: Sequence[Handin],
+    given: Mapping[str, Counter[str]],
+    notes: dict[str, list[str]],
+    exact: set[str],
+) -> None:
+    """Note every pair of groups of one lab whose own statements are mostly alike.
+
+    Set aside first: the course's own code of the lab and, in a class of four hand-ins or
+    more, what at least half of them hold (what everyone writes is no sign of a copy).
+    """
+    labs: dict[str, list[Handin]] = {}
+    for h in handins:
+        if not h.status and h.units:
+            labs.setdefault(h.lab, []).append(h)
+    for lab, same in labs.items():
+        common = Counter(given.get(lab, Counter()))
+        if len(same) >= 4:
+            seen = Counter(s for h in same for s in set(h.units))
+            common |= Counter({s: 1 << 30 for s, n in seen.items() if 2 * n >= len(same)})
+        for i, a in enumerate(same):
+            for b in same[i + 1 :]:
+                if a.group == b.group or (a.file in exact and b.file in exact):
+                    continue
+                share, smaller = similarity(a.units, b.units, common)
+                if share < SIMILAR or smaller < MIN_STATEMENTS:
+                    continue
+                for h, o in ((a, b), (b, a)):
+                    notes[h.file].append(
+                        f"code much like group {o.group or '(none)'}'s ({o.file}): {share:.0%} "
+                        "of their own statements alike, once names, numbers as written, "
+                        "statement order, cells, dead code, prints and equivalent calls are "
+                        "set aside"
+                    )
 
 
 def _error_notes(outcome: RunOutcome) -> list[str]:
@@ -477,7 +558,7 @@ class _Run:
 
 def _grade_one(handin: Handin, identity: list[str], index: int, run: _Run) -> Submission:
     start = time.perf_counter()
-    sub = Submission(handin.file, handin.lab, handin.group, "ok")
+    sub = Submission(handin.file, handin.lab, handin.group, "ok", late=is_late(handin.file))
     if handin.lab in run.checks:
         sub.expected = run.checks[handin.lab].check_ids
     try:
@@ -530,20 +611,22 @@ def _run_one(sub: Submission, handin: Handin, identity: list[str], index: int, r
         handin.notebook, checks, params if key is not None else None, output_mb=limits.output_mb
     )
     folder = run.root / f"{index:04d}"
-    try:
-        outcome = run_notebook(
-            copy,
-            folder,
-            positions=positions,
-            sandbox=sandbox,
-            timeout=run.timeout,
-            cell_timeout=run.cell_timeout,
-            limits=limits,
-            stop=stop,
-            user=sandbox_user(index + 1) if sandbox else None,
-        )
-    finally:
-        _remove(folder)
+    # a user id of its own on the whole machine, held until every process of the run has ended
+    with SandboxUser() if sandbox else contextlib.nullcontext() as user:
+        try:
+            outcome = run_notebook(
+                copy,
+                folder,
+                positions=positions,
+                sandbox=sandbox,
+                timeout=run.timeout,
+                cell_timeout=run.cell_timeout,
+                limits=limits,
+                stop=stop,
+                user=user,
+            )
+        finally:
+            _remove(folder)
     if outcome.status == "interrupted":
         raise InterruptedError("the grading run was interrupted")
     sub.status = outcome.status
@@ -613,7 +696,7 @@ def write_gradebook(
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` is a folder, or its feedback folder is not one of an earlier grading.
 
     Examples
@@ -625,7 +708,7 @@ def write_gradebook(
     ...     csv_path, folder = write_gradebook([s], pathlib.Path(tmp) / "grades.csv")
     ...     print(csv_path.read_text(encoding="utf-8").splitlines()[1])
     ...     print(sorted(p.name for p in folder.iterdir()))
-    a.ipynb,pa9,g01,ok,,✗,0,1
+    a.ipynb,pa9,g01,ok,,✗,0,1,
     ['a.html', 'a.txt', 'manifest.json']
     """
     columns: list[str] = []
@@ -643,16 +726,108 @@ def _positive(name: str, value: Any) -> None:
 
 
 _SELF_TEST: dict[tuple[Any, ...], str | None] = {}
+SELF_TEST_FOLDER = "/var/tmp/uio-teach-sandbox-test-{uid}"
+"""Where a passed test of the sandbox is remembered, for every run of the machine by the same
+user (a folder of that user's alone; ``{uid}`` is the user's id)."""
+
+
+def self_test_key(limits: Limits) -> str:
+    """What a passed test of the sandbox holds for: the interpreter, the package's code (its
+    version and every module's size and time), bubblewrap and the limits (CPU time aside).
+
+    Parameters
+    ----------
+    limits : Limits
+
+    Returns
+    -------
+    str
+        A SHA-256, as 64 hexadecimal digits.
+
+    Examples
+    --------
+    >>> from uio_teach.grading.grade import Limits, self_test_key
+    >>> self_test_key(Limits()) == self_test_key(Limits(cpu_seconds=5))
+    True
+    >>> self_test_key(Limits()) == self_test_key(Limits(memory_mb=1024))
+    False
+    """
+    import uio_teach  # deferred on purpose: only to find the package's own files
+
+    package = Path(uio_teach.__file__).resolve().parent
+    files = []
+    for path in sorted(package.rglob("*.py")):
+        if "_course" in path.relative_to(package).parts:
+            continue
+        info = path.stat()
+        files.append([path.relative_to(package).as_posix(), info.st_size, info.st_mtime_ns])
+    bwrap = shutil.which("bwrap") or "/usr/bin/bwrap"
+    try:
+        bwrap_time = os.stat(bwrap).st_mtime_ns
+    except OSError:
+        bwrap_time = 0
+    what = {
+        "python": [sys.executable, sys.version],
+        "uio_teach": [uio_teach.__version__, os.fspath(package), files],
+        "bwrap": [bwrap, bwrap_time],
+        "limits": dataclasses.asdict(dataclasses.replace(limits, cpu_seconds=0)),
+        "uid": os.geteuid() if hasattr(os, "geteuid") else None,
+        "kernel": os.uname().release if hasattr(os, "uname") else "",
+    }
+    return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()
+
+
+def _self_test_folder() -> Path | None:
+    """The machine's folder of passed sandbox tests of this user, or None (then none is kept)."""
+    if not hasattr(os, "geteuid"):  # pragma: no cover - the sandbox is Linux only
+        return None
+    folder = Path(SELF_TEST_FOLDER.format(uid=os.geteuid()))
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        info = os.lstat(folder)
+    except OSError:
+        return None
+    if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.geteuid() or info.st_mode & 0o077:
+        return None  # not a folder of this user's alone: nothing read from it, nothing kept
+    return folder
 
 
 def _self_test(limits: Limits, stop: threading.Event | None = None) -> str | None:
     """Run one tiny notebook through the sandbox as a hand-in runs; why it failed, or None.
 
-    ``stop`` (the run was interrupted) ends it at once; that answer is not kept.
+    A test that passed is remembered on the machine (:data:`SELF_TEST_FOLDER`, by
+    :func:`self_test_key`): every later run and shard with the same interpreter, package, bubblewrap
+    and limits starts without it, and runs that start together wait for the one test (a lock).
+    A failure is not remembered. ``stop`` (the run was interrupted) ends it at once; that
+    answer is not kept.
     """
     key = (sys.executable, dataclasses.replace(limits, cpu_seconds=0))  # CPU time aside
     if key in _SELF_TEST:
         return _SELF_TEST[key]
+    folder = _self_test_folder()
+    if folder is None:
+        return _self_test_now(key, limits, stop)
+    import fcntl  # deferred on purpose: POSIX only, so the package imports everywhere
+
+    name = self_test_key(limits)
+    passed = folder / f"{name}.passed"
+    fd = os.open(folder / f"{name}.lock", os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)  # another run testing the same: wait for its answer
+        if passed.is_file() and not passed.is_symlink():
+            _SELF_TEST[key] = None
+            return None
+        problem = _self_test_now(key, limits, stop)
+        if problem is None:
+            passed.write_text(json.dumps({"python": sys.executable}) + "\n", encoding="utf-8")
+        return problem
+    finally:
+        os.close(fd)
+
+
+def _self_test_now(
+    key: tuple[Any, ...], limits: Limits, stop: threading.Event | None
+) -> str | None:
     problem = sandbox_problem()
     if problem is None:
         nb = nbformat.v4.new_notebook()
@@ -665,17 +840,18 @@ def _self_test(limits: Limits, stop: threading.Event | None = None) -> str | Non
         copy, positions = prepare(nb, None, None)
         root = Path(tempfile.mkdtemp(prefix=TEMP_PREFIX))
         try:
-            outcome = run_notebook(
-                copy,
-                root / "self-test",
-                positions=positions,
-                sandbox=True,
-                timeout=180,
-                cell_timeout=120,
-                limits=limits,
-                user=sandbox_user(0),
-                stop=stop,
-            )
+            with SandboxUser() as user:
+                outcome = run_notebook(
+                    copy,
+                    root / "self-test",
+                    positions=positions,
+                    sandbox=True,
+                    timeout=180,
+                    cell_timeout=120,
+                    limits=limits,
+                    user=user,
+                    stop=stop,
+                )
         finally:
             _remove(root)
         if outcome.status == "interrupted":
@@ -717,10 +893,15 @@ def grade(
     Parameters
     ----------
     submissions : path or sequence of path
-        The hand-in folder (every ``*.ipynb`` in it), or the hand-ins. They are only read.
+        The hand-in folder, or the hand-ins. They are only read. Every entry
+        of a folder named ``*.ipynb`` (any case), at any depth (an LMS's
+        download in folders), is a hand-in with its row; every other entry is
+        listed in the result's ``survey`` with why it is not graded, and what
+        appears during the run in its ``added`` (see :mod:`uio_teach.grading.survey`).
     out : path
         The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it,
-        the LMS exports to ``<stem>_canvas.csv`` and ``<stem>_groups.csv``.
+        the LMS exports to ``<stem>_groups.csv``, ``<stem>_canvas.csv`` and
+        ``<stem>_moodle.csv``.
         Each row is written as soon as its hand-in is graded.
     answer_key : path, optional
         ``answer_key.csv`` of ``uio-teach labs --groups``: each hand-in is
@@ -756,8 +937,9 @@ def grade(
 
     Returns
     -------
-    list of Submission
-        The hand-ins graded by this call (with ``resume``, not those kept).
+    Graded
+        The hand-ins graded by this call (with ``resume``, not those kept), a
+        list of Submission; with what else the folder held.
 
     Raises
     ------
@@ -766,7 +948,7 @@ def grade(
     SandboxRefused
         The sandbox is unavailable (or cannot run a one-cell notebook) and
         ``sandbox`` is True.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` is a folder, its feedback folder is not ours, or another run
         is writing it (checked before any notebook runs).
     KeyboardInterrupt
@@ -808,7 +990,10 @@ def grade(
             stacklevel=2,
         )
     clean_leftovers()
-    files = handin_files(submissions)
+    folder = _folder_of(submissions)
+    own = [out, feedback_folder(out), *(export_path(out, k) for k in EXPORTS)]
+    found = survey(folder, own=own) if folder is not None else None
+    files = found.handins if found is not None else handin_files(submissions)
     keep = {n for c in checks.values() for n in c.names}
     handins = []
     for file in files:  # every hand-in of the class, also in a shard: copies across shards
@@ -818,7 +1003,8 @@ def grade(
             handins.append(
                 Handin(file, status="grader error", reason=f"cannot be read ({type(exc).__name__})")
             )
-    identity = _identity_notes(handins)
+    given = {lab: statements(c.given, keep=c.names) for lab, c in checks.items()}
+    identity = _identity_notes(handins, given)
     columns: list[str] = []
     for h in handins:
         ids = checks[h.lab].check_ids if h.lab in checks else ()
@@ -864,7 +1050,22 @@ def grade(
     book.__exit__(None, None, None)
     order = {f: i for i, f in enumerate(files)}
     graded.sort(key=lambda s: order[s.file])
-    return graded
+    result = Graded(graded)
+    if found is not None and folder is not None:
+        result.survey = found
+        result.added = added_since(found, survey(folder, own=own))
+    return result
+
+
+def _folder_of(
+    submissions: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
+) -> Path | None:
+    """The hand-in folder, when a folder (not a link to one) was given."""
+    if isinstance(submissions, (str, os.PathLike)):
+        folder = Path(submissions)
+        if folder.is_dir() and not folder.is_symlink():
+            return folder
+    return None
 
 
 def _grade_all(
@@ -890,7 +1091,8 @@ def _grade_all(
     run = dataclasses.replace(settings, root=root)
     pool = ThreadPoolExecutor(max_workers=jobs)
     tester = ThreadPoolExecutor(max_workers=1)
-    test = tester.submit(_self_test, limits, stop) if sandbox else None
+    # nothing of a student's runs when nothing is to be graded: no test to wait for
+    test = tester.submit(_self_test, limits, stop) if sandbox and todo else None
     opened = False
     held: list[Submission] = []
     try:
@@ -935,7 +1137,11 @@ def _grade_all(
 def handin_files(
     submissions: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
 ) -> list[str]:
-    """The hand-ins: each ``*.ipynb`` entry of a folder (links and folders too), or the paths.
+    """The hand-ins: each ``*.ipynb`` entry of a folder at any depth (links too), or the paths.
+
+    A folder is surveyed (:func:`~uio_teach.grading.survey.survey`): an
+    entry named ``*.ipynb`` in any case, at any depth, is a hand-in, links
+    and folders of that name too (refused when read).
 
     Parameters
     ----------
@@ -952,10 +1158,6 @@ def handin_files(
     ['b.ipynb', 'a.ipynb']
     """
     if isinstance(submissions, (str, os.PathLike)):
-        folder = Path(submissions)
-        if not folder.is_dir() or folder.is_symlink():
-            return [os.fspath(folder)]
-        return sorted(
-            os.fspath(folder / e.name) for e in os.scandir(folder) if e.name.endswith(".ipynb")
-        )
+        folder = _folder_of(submissions)
+        return survey(folder).handins if folder is not None else [os.fspath(submissions)]
     return [os.fspath(p) for p in submissions]

@@ -37,12 +37,13 @@ import io
 import json
 import os
 import re
+import unicodedata
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..instructor.output import (
+from ..folders import (
     MANIFEST,
     FolderBusy,
     FolderLock,
@@ -64,6 +65,7 @@ __all__ = [
     "safe_cell",
     "file_cell",
     "shown",
+    "name_shown",
     "exports",
     "read_gradebook",
     "header_of",
@@ -74,9 +76,12 @@ __all__ = [
     "PASS",
     "FAIL",
     "COMMAND",
+    "EXPORTS",
 ]
 
 PASS, FAIL = "✓", "✗"
+EXPORTS = ("canvas", "groups", "moodle")
+"""The exports written beside a gradebook (:func:`export_path` of each)."""
 COMMAND = "uio-teach grade"
 """The command recorded in the feedback folder's manifest."""
 _FIRST = ["file", "lab", "group", "status", "reason"]
@@ -84,7 +89,7 @@ _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]+")
 _ONE_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 _NUMBER = re.compile(r"^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$")
 _GOOD = ("ok", "error", "timeout")  # rows whose marks stand as they are
-_LAST = ["total", "out_of"]
+_LAST = ["total", "out_of", "late"]
 
 
 class GradebookBusy(FolderBusy):
@@ -124,6 +129,8 @@ class Submission:
         Time spent grading it.
     feedback_file : pathlib.Path or None
         Its feedback text, once written.
+    late : bool
+        The LMS marked it late (its own column, ``late``, in the gradebook).
 
     Examples
     --------
@@ -131,7 +138,7 @@ class Submission:
     >>> s = Submission("pa9_g01.ipynb", "pa9", "g01", "unreadable",
     ...                errors=["not a notebook"], expected=("pa9.design",))
     >>> s.row(["pa9.design"])
-    ['pa9_g01.ipynb', 'pa9', 'g01', 'unreadable', '', '✗', 0, 1]
+    ['pa9_g01.ipynb', 'pa9', 'g01', 'unreadable', '', '✗', 0, 1, '']
     """
 
     file: str
@@ -145,6 +152,7 @@ class Submission:
     expected: tuple[str, ...] = ()
     seconds: float = 0.0
     feedback_file: Path | None = None
+    late: bool = False
 
     def verdicts(self) -> dict[str, bool]:
         """Check id -> passed (a check with no result failed)."""
@@ -164,7 +172,7 @@ class Submission:
     def feedback(self) -> str:
         """The feedback text for the group: every check's messages, then the grader's notes."""
         lines = [
-            f"Submission: {shown(self.file)}",
+            f"Submission: {name_shown(self.file)}",
             f"Lab: {self.lab or 'unknown'}    Group: {self.group or 'unknown'}",
             f"Status: {self.status}" + (f" ({self.reason})" if self.reason else ""),
         ]
@@ -194,11 +202,12 @@ class Submission:
         parts = [
             "<!DOCTYPE html>",
             '<html lang="en"><head><meta charset="utf-8">',
-            f"<title>Feedback: {e(shown(Path(self.file).name))}</title>",
+            f"<title>Feedback: {e(name_shown(Path(self.file).name))}</title>",
             "<style>body{font-family:sans-serif;max-width:50em;margin:2em auto}"
             ".ok{color:#06602a}.no{color:#a3001b}li{margin:.2em 0}</style></head><body>",
             f"<h1>Lab {e(self.lab or 'unknown')}, group {e(self.group or 'unknown')}</h1>",
-            f"<p>Hand-in: <code>{e(shown(self.file))}</code><br>Status: <strong>{e(self.status)}"
+            f"<p>Hand-in: <code>{e(name_shown(self.file))}</code><br>Status: "
+            f"<strong>{e(self.status)}"
             f"</strong>{e(' (' + self.reason + ')') if self.reason else ''}<br>"
             f"Checks passed: {self.total} of {len(verdicts)}</p>",
         ]
@@ -229,7 +238,7 @@ class Submission:
         verdicts = self.verdicts()
         marks = ["" if c not in verdicts else (PASS if verdicts[c] else FAIL) for c in columns]
         first = [file_cell(self.file), self.lab, self.group, self.status, self.reason]
-        return [*first, *marks, self.total, len(verdicts)]
+        return [*first, *marks, self.total, len(verdicts), "late" if self.late else ""]
 
 
 def shown(text: Any) -> str:
@@ -260,6 +269,34 @@ def shown(text: Any) -> str:
     except UnicodeEncodeError:
         raw = text.encode("utf-8", "surrogatepass")
     return raw.decode("utf-8", "backslashreplace")
+
+
+def name_shown(file: Any) -> str:
+    """A file name as :func:`shown` writes it, and a name not in Unicode's NFC form told apart.
+
+    Two names that differ only in their normal form (``é`` as one character,
+    or as ``e`` and a combining accent, as a macOS zip writes it) look alike;
+    the combining marks of a name that is not NFC are shown as ``\\u0301``,
+    so two such names never print alike.
+
+    Parameters
+    ----------
+    file : object
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.grading.gradebook import name_shown
+    >>> print(name_shown("Jos\u00e9.ipynb"), name_shown("Jose\u0301.ipynb"))
+    José.ipynb Jose\u0301.ipynb
+    """
+    text = shown(file)
+    if unicodedata.normalize("NFC", text) == text:
+        return text
+    return "".join(f"\\u{ord(c):04x}" if unicodedata.combining(c) else c for c in text)
 
 
 def safe_cell(value: Any) -> str:
@@ -307,7 +344,7 @@ def file_cell(file: str) -> str:
     >>> print(file_cell("a\\nb.ipynb"), file_cell("a b.ipynb"))
     a\\x0ab.ipynb a b.ipynb
     """
-    return safe_cell(_ONE_CONTROL.sub(lambda m: f"\\x{ord(m[0]):02x}", shown(file)))
+    return safe_cell(_ONE_CONTROL.sub(lambda m: f"\\x{ord(m[0]):02x}", name_shown(file)))
 
 
 def feedback_folder(out: str | os.PathLike[str]) -> Path:
@@ -332,7 +369,7 @@ def feedback_folder(out: str | os.PathLike[str]) -> Path:
 
 
 def check_gradebook_target(out: str | os.PathLike[str]) -> None:
-    """Raise :class:`~uio_teach.instructor.output.OutputError` unless ``out`` may be written.
+    """Raise :class:`~uio_teach.folders.OutputError` unless ``out`` may be written.
 
     The gradebook must not be a folder; its feedback folder must be absent,
     empty, or the feedback folder of an earlier grading (its manifest says so).
@@ -343,13 +380,13 @@ def check_gradebook_target(out: str | os.PathLike[str]) -> None:
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
 
     Examples
     --------
     >>> import tempfile, pathlib
     >>> from uio_teach.grading.gradebook import check_gradebook_target
-    >>> from uio_teach.instructor.output import OutputError
+    >>> from uio_teach.folders import OutputError
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     mine = pathlib.Path(tmp) / "grades_feedback"
     ...     mine.mkdir()
@@ -462,7 +499,7 @@ def header_of(columns: Sequence[str]) -> list[str]:
     --------
     >>> from uio_teach.grading.gradebook import header_of
     >>> header_of(["pa9.design"])
-    ['file', 'lab', 'group', 'status', 'reason', 'pa9.design', 'total', 'out_of']
+    ['file', 'lab', 'group', 'status', 'reason', 'pa9.design', 'total', 'out_of', 'late']
     """
     return [*_FIRST, *columns, *_LAST]
 
@@ -493,8 +530,14 @@ def exports(
     header: Sequence[str],
     rows: Sequence[Sequence[str]],
     students: Mapping[str, Sequence[tuple[str, str]]],
-) -> tuple[list[list[str]], list[list[str]] | None]:
-    """The export keyed by group, and Canvas's (None without students: it could match none).
+) -> tuple[list[list[str]], list[list[str]] | None, list[list[str]] | None]:
+    """The export keyed by group, Canvas's and Moodle's (None without students: they could
+    match none).
+
+    Moodle's grade import (*Grades*, *Import*, *CSV file*) maps each row to a user by the
+    column ``ID number`` (the roster's student id: choose "ID number", or the user field the
+    roster's ids are, as the mapping) and takes one column per lab, named as the grade item;
+    it has no "Points Possible" line (the maximum is the grade item's).
 
     Parameters
     ----------
@@ -507,7 +550,7 @@ def exports(
 
     Returns
     -------
-    (list, list or None)
+    (list, list or None, list or None)
     """
     at = {name: i for i, name in enumerate(header)}
     labs: dict[str, str] = {}
@@ -531,15 +574,21 @@ def exports(
         plain.append([group, lab, score, row[at["out_of"]], status, reason, files])
     plain = [[safe_cell(c) for c in r] for r in plain]
     if not students:
-        return plain, None
+        return plain, None, None
     names = [f"{lab} (uio-teach)" for lab in labs]
     canvas: list[list[Any]] = [["Student", "ID", "SIS User ID", "SIS Login ID", "Section", *names]]
     canvas.append(["Points Possible", "", "", "", "", *labs.values()])
+    moodle: list[list[Any]] = [["ID number", "Full name", "Group", *names]]
     for group in sorted({g for _, g in groups}):
         marks = [scores.get((lab, group), "") for lab in labs]
         for student, name in students.get(group, []):
             canvas.append([name or student, "", student, "", group, *marks])
-    return plain, [[safe_cell(c) for c in r] for r in canvas]
+            moodle.append([student, name, group, *marks])
+    return (
+        plain,
+        [[safe_cell(c) for c in r] for r in canvas],
+        [[safe_cell(c) for c in r] for r in moodle],
+    )
 
 
 def write_exports(
@@ -559,13 +608,14 @@ def write_exports(
     header, rows, students
         As :func:`exports` takes them.
     """
-    plain, canvas = exports(header, rows, students)
+    plain, canvas, moodle = exports(header, rows, students)
     _write_atomic(export_path(out, "groups"), _csv_text(plain))
-    target = export_path(out, "canvas")
-    if canvas is not None:
-        _write_atomic(target, _csv_text(canvas))
-    else:
-        target.unlink(missing_ok=True)
+    for kind, table in (("canvas", canvas), ("moodle", moodle)):
+        target = export_path(out, kind)
+        if table is not None:
+            _write_atomic(target, _csv_text(table))
+        else:
+            target.unlink(missing_ok=True)
 
 
 def read_gradebook(out: str | os.PathLike[str]) -> tuple[list[str], list[list[str]]]:
@@ -581,7 +631,7 @@ def read_gradebook(out: str | os.PathLike[str]) -> tuple[list[str], list[list[st
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         It cannot be read, or it is not a gradebook of uio-teach.
     """
     try:
@@ -640,7 +690,7 @@ class Gradebook:
 
     Raises
     ------
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         The CSV is a folder, or its feedback folder is not ours.
     GradebookBusy
         Another run holds the lock.
@@ -654,7 +704,7 @@ class Gradebook:
     ...     with Gradebook(out, ["a.ipynb"], ["pa9.design"]) as book:
     ...         book.add(Submission("a.ipynb", "pa9", "g01", "ok", expected=("pa9.design",)))
     ...     print(out.read_text(encoding="utf-8").splitlines()[1])
-    a.ipynb,pa9,g01,ok,,✗,0,1
+    a.ipynb,pa9,g01,ok,,✗,0,1,
     """
 
     def __init__(
@@ -697,7 +747,7 @@ class Gradebook:
 
         Raises
         ------
-        uio_teach.instructor.output.OutputError
+        uio_teach.folders.OutputError
             The CSV is a folder, or its feedback folder is not ours.
         GradebookBusy
             Another run holds the lock.

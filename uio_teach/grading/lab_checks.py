@@ -49,6 +49,7 @@ from typing import Any
 
 from ..checks.common import CheckResult
 from ..errors import UIOTeachError
+from ..folders import default_book_dir
 
 __all__ = [
     "CHECK_TAG",
@@ -176,6 +177,11 @@ class LabChecks:
         The chapter's ``parameters`` cell (the course's own numbers).
     checks : tuple of GradedCheck
         Its check cells, in order.
+    given : tuple of str
+        The code the course itself holds: every code cell of the chapter, its
+        solutions included. Copy detection sets it aside
+        (:mod:`uio_teach.grading.copies`): an untouched template, or a line
+        as the course's own solution writes it, is no sign of a copy.
     """
 
     lab: str
@@ -183,6 +189,7 @@ class LabChecks:
     setup: tuple[str, ...]
     params: str
     checks: tuple[GradedCheck, ...]
+    given: tuple[str, ...] = ()
 
     @property
     def check_ids(self) -> tuple[str, ...]:
@@ -297,7 +304,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
     Examples
     --------
     >>> from uio_teach.grading.lab_checks import read_lab_checks
-    >>> from uio_teach.instructor.book import default_book_dir
+    >>> from uio_teach.folders import default_book_dir
     >>> checks = read_lab_checks(default_book_dir() / "lab_missile.md", "missile")
     >>> checks.check_ids[:2], checks.checks[2].names
     (('missile.pmo', 'missile.ginverse'), ('vhat', 'run_pmo', 'pmo'))
@@ -314,6 +321,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
     setup: list[str] = []
     params = ""
     found: list[tuple[str, str]] = []
+    alike: list[str] = []
     title = ""
     started = False
     for cell in nb.cells:
@@ -327,6 +335,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
         if cell.cell_type != "code":
             continue
         tags = cell.metadata.get("tags", [])
+        alike.append(source)
         if "parameters" in tags:
             params = source
         elif CHECK_TAG in tags:
@@ -360,7 +369,7 @@ def read_lab_checks(path: str | os.PathLike[str], lab: str) -> LabChecks:
         if any(c.check_id == check_id for c in checks):
             raise LabChecksError(f"{where} calls checks.{function} a second time")
         checks.append(GradedCheck(check_id, function, heading, names, source))
-    return LabChecks(lab, name, tuple(setup), params, tuple(checks))
+    return LabChecks(lab, name, tuple(setup), params, tuple(checks), tuple(alike))
 
 
 @functools.lru_cache(maxsize=16)
@@ -379,7 +388,7 @@ def course_labs(book: str | os.PathLike[str] | None = None) -> dict[str, Path]:
     Parameters
     ----------
     book : path, optional
-        The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
+        The book's folder (:func:`~uio_teach.folders.default_book_dir` by default).
 
     Returns
     -------
@@ -391,8 +400,6 @@ def course_labs(book: str | os.PathLike[str] | None = None) -> dict[str, Path]:
     >>> sorted(course_labs())
     ['case_study', 'missile', 'pa9']
     """
-    from ..instructor.book import default_book_dir  # deferred: only where the chapters are
-
     folder = Path(book) if book is not None else default_book_dir()
     return {path.stem[4:]: path for path in sorted(folder.glob("lab_*.md"))}
 
@@ -405,7 +412,7 @@ def lab_checks(lab: str, book: str | os.PathLike[str] | None = None) -> LabCheck
     lab : str
         A lab of the course (:func:`course_labs`).
     book : path, optional
-        The book's folder (:func:`~uio_teach.instructor.book.default_book_dir` by default).
+        The book's folder (:func:`~uio_teach.folders.default_book_dir` by default).
 
     Returns
     -------

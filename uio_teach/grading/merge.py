@@ -35,9 +35,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ..instructor.output import MANIFEST, read_manifest, sha256_file, write_manifest
+from ..folders import MANIFEST, read_manifest, sha256_file, write_manifest
 from .gradebook import (
     COMMAND,
+    EXPORTS,
     check_gradebook_target,
     export_path,
     feedback_folder,
@@ -194,7 +195,7 @@ def shard_gradebooks(gradebooks: Sequence[str | os.PathLike[str]]) -> list[Path]
     ['grades_1.csv', 'grades_2.csv']
     """
     paths = [Path(g) for g in gradebooks]
-    exports = {export_path(p, kind).resolve() for p in paths for kind in ("groups", "canvas")}
+    exports = {export_path(p, kind).resolve() for p in paths for kind in EXPORTS}
     return [p for p in paths if p.resolve() not in exports]
 
 
@@ -222,7 +223,7 @@ def merge(gradebooks: Sequence[str | os.PathLike[str]], out: str | os.PathLike[s
         No gradebook, gradebooks of different classes or gradings, a shard
         twice or missing, a row in two gradebooks, a shard not finished, or
         ``out`` is one of the gradebooks.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         A gradebook cannot be read, or ``out``'s feedback folder is not ours.
 
     Examples

@@ -11,7 +11,11 @@
   grader is given, refusing a row that repeats another, by name.
 
 Group names ``g<number>`` are written with at least two digits everywhere
-(:func:`group_id`: ``g3`` and ``g03`` are one group).
+(:func:`group_id`: ``g3``, ``g03``, ``G3``, ``Group-3``, ``group_3`` and
+``Group 3`` are one group). Every name (a file's, a student's, a group's) is
+compared in one Unicode normal form, NFC (:func:`same_form`): a macOS zip
+writes ``é`` as ``e`` and a combining accent (NFD), a roster saved on Windows
+writes it as one character, and both name the same hand-in.
 
 Examples
 --------
@@ -27,6 +31,7 @@ import io
 import json
 import os
 import re
+import unicodedata
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -36,6 +41,7 @@ from ..errors import UIOTeachError
 __all__ = [
     "GradeError",
     "group_id",
+    "same_form",
     "group_from_name",
     "is_late",
     "read_table",
@@ -51,21 +57,55 @@ MAX_TABLE_BYTES = 16 * 1024 * 1024
 """The largest roster or answer key read."""
 _GROUP = re.compile(r"^g(?:roup)?[ _-]?0*(\d+)$", re.I)
 _COPY = re.compile(r"(?:\s*\(\d+\)|-\d+)$")  # "name (3)", Canvas's "name-1"
-_GENERIC = re.compile(r"^(?P<lab>[A-Za-z][\w-]*?)_(?P<group>g(?:roup)?[_-]?\d+)$", re.I)
+_GROUP_PART = r"(?P<group>g(?:roup)?[ _-]?\d+)"
+_GENERIC = re.compile(rf"^(?P<lab>[A-Za-z][\w-]*?)_{_GROUP_PART}$", re.I)
 _LATE = re.compile(r"(?:^|_)LATE_")
+# each column's names, the better first: a table with two of them takes the better one
+# (Canvas's gradebook export has "Student", the display name, and "SIS User ID", the id)
 _COLUMNS = {
-    "group": ("group", "group name", "gruppe", "groupe"),
+    "group": ("group", "group name", "groups", "gruppe", "groupe", "section"),
     "file": ("file", "file name", "filename", "hand-in", "handin"),
-    "student": ("student", "student id", "sis user id", "sis_user_id"),
-    "name": ("name", "student name", "full name"),
+    "student": (
+        "sis user id",
+        "student id",
+        "id number",
+        "username",
+        "email address",
+        "email",
+        "student",
+    ),
+    "name": ("name", "student name", "full name", "student"),
+    "first": ("first name",),
+    "last": ("last name", "surname"),
     "lab": ("lab",),
     "params": ("params",),
 }
+_NOT_STUDENTS = ("points possible", "test student", "student, test")
 
 
 class GradeError(UIOTeachError, ValueError):
     """Grading cannot start (a missing answer key, an unreadable key or roster, a bad option);
     one line naming the file or the option."""
+
+
+def same_form(text: str) -> str:
+    """A name in the one Unicode normal form the grader compares names in (NFC).
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.grading.rosters import same_form
+    >>> same_form("Jose\u0301") == same_form("Jos\u00e9")
+    True
+    """
+    return unicodedata.normalize("NFC", text)
 
 
 def group_id(group: str) -> str:
@@ -85,9 +125,12 @@ def group_id(group: str) -> str:
     >>> from uio_teach.grading.rosters import group_id
     >>> group_id("g3"), group_id("G03"), group_id("group_12"), group_id("red")
     ('g03', 'g03', 'g12', 'red')
+    >>> group_id("Group-30"), group_id("group_30"), group_id("G30"), group_id("Group 30")
+    ('g30', 'g30', 'g30', 'g30')
     """
-    match = _GROUP.match(group.strip())
-    return f"g{int(match[1]):02d}" if match else group.strip()
+    text = same_form(group).strip()
+    match = _GROUP.match(text)
+    return f"g{int(match[1]):02d}" if match else text
 
 
 def is_late(path: str | os.PathLike[str]) -> bool:
@@ -118,9 +161,11 @@ def group_from_name(
     The name ends in ``<lab>_<group>`` (``pa9_g03.ipynb``), after whatever an
     LMS put in front (Canvas: ``ann_48213_9920131_pa9_g03.ipynb``, late ones
     ``ann_LATE_48213_...``) and before a copy's number (``pa9_g03-1.ipynb``,
-    ``pa9_g03 (2).ipynb``). A lab of the course is found anywhere before the
-    group; another lab only as the whole of the name before it (graded as an
-    unknown lab).
+    ``pa9_g03 (2).ipynb``). The group is written as :func:`group_id` reads it
+    (``pa9_Group-30``: group 30, not group "Group" handed in again). A lab of
+    the course is found anywhere before the group; another lab only as the
+    whole of the name before it (graded as an unknown lab). The name is read
+    in NFC (:func:`same_form`).
 
     Parameters
     ----------
@@ -141,20 +186,25 @@ def group_from_name(
     (('pa9', 'g12'), ('', ''))
     >>> group_from_name("smith_john_48213_9920131_case_study_g02-1.ipynb")
     ('case_study', 'g02')
+    >>> group_from_name("pa9_Group-30.ipynb"), group_from_name("pa9_G30 (2).ipynb")
+    (('pa9', 'g30'), ('pa9', 'g30'))
     """
     if labs is None:
         from .lab_checks import course_labs  # deferred: only to find the book
 
         labs = course_labs()
-    stem = _COPY.sub("", Path(path).stem)
+    whole = same_form(Path(os.fspath(path)).stem)
     known = "|".join(re.escape(lab) for lab in sorted(labs, key=len, reverse=True))
-    if known:
-        group = r"(?P<group>g(?:roup)?[_-]?\d+)"
-        match = re.search(rf"(?:^|_)(?P<lab>{known})_{group}$", stem, re.I)
+    # the whole name first ("pa9_Group-30"), then without a copy's number ("pa9_g30-1")
+    for stem in dict.fromkeys([whole, _COPY.sub("", whole)]):
+        if known:
+            match = re.search(rf"(?:^|_)(?P<lab>{known})_{_GROUP_PART}$", stem, re.I)
+            if match:
+                return match["lab"].lower(), group_id(match["group"])
+        match = _GENERIC.match(stem)
         if match:
-            return match["lab"].lower(), group_id(match["group"])
-    match = _GENERIC.match(stem)
-    return (match["lab"], group_id(match["group"])) if match else ("", "")
+            return match["lab"], group_id(match["group"])
+    return "", ""
 
 
 def _decode(data: bytes, name: str) -> str:
@@ -246,11 +296,18 @@ def read_table(
         raise GradeError(f"{name}: empty: a {what} needs a header line ({', '.join(columns)})")
     (_, header), body = numbered[0], numbered[1:]
     index: dict[str, int] = {}
-    for i, cell in enumerate(header):
-        key = " ".join(cell.strip().lower().replace("_", " ").split())
-        for column, aliases in _COLUMNS.items():
-            if key in aliases and column not in index:
-                index[column] = i
+    rank: dict[str, int] = {}
+    keys = [" ".join(same_form(cell).strip().lower().replace("_", " ").split()) for cell in header]
+    for column, aliases in _COLUMNS.items():  # each column: the best of its names found
+        for i, key in enumerate(keys):
+            if key in aliases and aliases.index(key) < rank.get(column, len(aliases)):
+                index[column], rank[column] = i, aliases.index(key)
+    if "group" in index and keys[index["group"]] == "section" and "group" in keys:
+        index["group"] = keys.index("group")
+    if index.get("student") == index.get("name") and "name" in index:
+        # one column can only be one of them: an id column that is only "Student" is the id
+        if keys[index["name"]] == "student":
+            del index["name"]
     missing = [c for c in columns if c not in index]
     if missing:
         shown = {",": "comma", ";": "semicolon", "\t": "tab", "|": "bar"}[delimiter]
@@ -262,7 +319,7 @@ def read_table(
         )
     rows = []
     for number, row in body:
-        fields = {c: (row[i].strip() if i < len(row) else "") for c, i in index.items()}
+        fields = {c: (same_form(row[i]).strip() if i < len(row) else "") for c, i in index.items()}
         for column in _COLUMNS:
             fields.setdefault(column, "")
         rows.append((number, fields))
@@ -277,9 +334,16 @@ def read_roster(
     The table (any separator a spreadsheet writes, see :func:`read_table`) has
     a column ``group`` and at least one of ``file`` (the name of a hand-in,
     e.g. ``notebook (3).ipynb``) and ``student`` (a student's id in the LMS,
-    e.g. its SIS user id); ``lab`` and ``name`` are optional. A row with a
-    file says that file is the group's hand-in; a row with a student puts the
-    student in the group (for the Canvas export). A student or a file listed
+    e.g. its SIS user id); ``lab`` and ``name`` are optional. Canvas's own
+    gradebook export is a roster as it is saved (its ``SIS User ID`` is the
+    student, its ``Student`` the name, its ``Section`` the group unless a
+    ``Group`` column is added; its "Points Possible" line and the test student
+    are skipped); Moodle's participants export names the student by ``ID
+    number`` (else ``Username`` or ``Email address``), the name by ``First
+    name`` and ``Last name``, and the group by ``Groups``. Names are read in
+    NFC (:func:`same_form`). A row with a file says that file is the group's
+    hand-in; a row with a student puts the student in the group (for the
+    Canvas and Moodle exports). A student or a file listed
     twice is refused, naming it and both lines: one of the two rows is wrong,
     and a student listed twice would get two marks in Canvas.
 
@@ -318,6 +382,8 @@ def read_roster(
     student_lines: dict[str, int] = {}
     for number, row in rows:
         group, file, student = group_id(row["group"]), row["file"], row["student"]
+        if (row["name"] or student).strip().lower().startswith(_NOT_STUDENTS):
+            continue  # Canvas's "Points Possible" line and its test student
         if not group or not (file or student):
             raise GradeError(f"{name}: line {number}: needs a group and a file or a student")
         if file:
@@ -334,14 +400,15 @@ def read_roster(
                 )
             files[file], file_lines[file] = entry, number
         if student:
-            who = f"{student} ({row['name']})" if row["name"] else student
+            full = row["name"] or " ".join(p for p in (row["first"], row["last"]) if p)
+            who = f"{student} ({full})" if full else student
             if student in student_lines:
                 raise GradeError(
                     f"{name}: line {number}: student {who} is listed twice (also line "
                     f"{student_lines[student]}): each student in one group, once"
                 )
             student_lines[student] = number
-            students.setdefault(group, []).append((student, row["name"]))
+            students.setdefault(group, []).append((student, full))
     return files, students
 
 

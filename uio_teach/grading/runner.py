@@ -15,14 +15,20 @@ with a time limit per cell (the cell is interrupted, the next ones run) and
 for the whole notebook (then every process of the run is killed), and a cap
 on all it writes into its folder (the run is stopped beyond). It reads back
 only data: the answer files (regular files, no links, bounded size, kept as
-text for the checking process) and the runner's log of the cells that raised,
-matched against the grader's own copy (a log the notebook rewrote gives no
-cell errors, never a crash). The notebook is never saved while it runs, so a
-run costs in proportion to its cells; what it prints or displays beyond
- ``Limits.output_mb`` is cut, and the row says so. Nothing the notebook
-prints decides anything, and the runner's own output is kept to its last
-lines; a failure of the runner itself is the grader's ("grader error"), never
-the notebook's.
+text for the checking process) and the runner's records. The notebook is
+never saved while it runs, so a run costs in proportion to its cells; what it
+prints or displays beyond ``Limits.output_mb`` is cut, and the row says so.
+
+The runner's records (the cells that raised, an output that was cut, a
+failure of the runner itself, the end of the run) never pass through a place
+the notebook can write: the runner writes them into a pipe that only it holds
+inside the sandbox (:data:`RECORDS`; the pipe is not passed on to the kernel,
+and the runner makes itself undumpable, so a kernel of the same user cannot
+reach it through ``/proc``). A notebook that writes files named like the
+grader's records changes nothing, and the records' cells are matched against
+the grader's own copy. Nothing the notebook prints decides anything, and the
+runner's own output is kept to its last lines; a failure of the runner itself
+is the grader's ("grader error"), never the notebook's.
 
 :func:`clean_notebook` turns the JSON of a hand-in into a fresh notebook of the
 grader's own: code, markdown and raw cells with their source and their string
@@ -68,7 +74,10 @@ __all__ = [
     "prepare",
     "run_notebook",
     "read_limited",
+    "kept_output",
     "GRADING_TAG",
+    "RECORDS",
+    "MAX_RECORD_BYTES",
     "MAX_FILE_BYTES",
     "MAX_ANSWER_BYTES",
 ]
@@ -77,13 +86,13 @@ GRADING_TAG = "uio-teach-grade"
 """The tag of the cells the grader adds."""
 MAX_FILE_BYTES = 256 * 1024 * 1024
 """The largest file of the run read back."""
-OUTPUT_CUT = "output-cut"
-"""The file that says a run's output was cut (written in its folder)."""
-ERRORS = "errors.jsonl"
-"""The runner's log of the cells that raised, one JSON line each, written as each cell ends."""
-RUNNER_FAILED = "runner-failed.json"
-"""The file the runner writes when it fails itself (not the notebook), holding the grader's
-error."""
+RECORDS = "records"
+"""What the runner's records are: one JSON object a line, written into a pipe the grader reads
+(never a file of the run's folder). ``{"error": {...}}`` for a cell that raised, as it ends;
+``{"cut": true}`` when the output passed its cap; ``{"failed": "..."}`` for the runner's own
+failure; ``{"done": true}`` at the end of a run."""
+MAX_RECORD_BYTES = 16 * 1024 * 1024
+"""The most of the runner's records read (a run whose cells raise more is over it)."""
 MAX_ANSWER_BYTES = 64 * 1024 * 1024
 """The largest answer file read back (a larger one is a row "over limits")."""
 _TAIL_BYTES = 64 * 1024
@@ -95,14 +104,13 @@ def _uio_export(_uio_tag, _uio_names):
     with open(f"answers/{_uio_tag}.json", "w", encoding="utf-8") as _uio_fh:
         _uio_fh.write(_uio_answers.dumps(_uio_values))
 import os as _uio_os, sys as _uio_sys
-def _uio_cap(_uio_stream, _uio_left=[%d], _uio_mark=_uio_os.path.abspath("%s")):
+def _uio_cap(_uio_stream, _uio_left=[%d]):
     _uio_write = _uio_stream.write
     def write(text):
         if _uio_left[0] <= 0:
             return len(text)
         _uio_left[0] -= len(text)
         if _uio_left[0] < 0:
-            open(_uio_mark, "w").close()
             return _uio_write(text[: len(text) + _uio_left[0]]) or len(text)
         return _uio_write(text)
     _uio_stream.write = write
@@ -303,8 +311,9 @@ def prepare(
         The group's parameters from the answer key.
     output_mb : int
         The output a run keeps (``Limits.output_mb``): the notebook's streams
-        are cut at half of it in the kernel, so the runner never receives much
-        more than it keeps.
+        are cut in the kernel one character past it (:func:`kept_output`), so
+        the runner, which keeps that much and records the cut, never receives
+        much more than it keeps.
 
     Returns
     -------
@@ -314,7 +323,7 @@ def prepare(
     graded = checks.checks if checks is not None else ()
     by_function = {c.function: i for i, c in enumerate(graded)}
     every = sorted({n for c in graded for n in c.names})
-    cells = [_ours(_SETUP % (output_mb * 1024 * 1024 // 2, OUTPUT_CUT))]
+    cells = [_ours(_SETUP % (kept_output(output_mb) + 1))]
     has_params = False
     placed: set[int] = set()
     for cell in nb.cells:
@@ -350,6 +359,26 @@ def prepare(
     return nb, positions
 
 
+def kept_output(output_mb: int) -> int:
+    """How many characters of output a run keeps (``output_mb`` MiB); one more is cut.
+
+    Parameters
+    ----------
+    output_mb : int
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> from uio_teach.grading.runner import kept_output
+    >>> kept_output(2)
+    2097152
+    """
+    return output_mb * 1024 * 1024
+
+
 def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes | None:
     """The bytes of a regular file written by the sandbox; None if absent, a link or too large.
 
@@ -378,12 +407,12 @@ def _one_line(text: Any, limit: int = 200) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _errors(log: bytes, prepared: Any) -> list[CellError] | None:
-    """The student's cells that raised, from the runner's log (None if it is not the runner's).
+def _errors(entries: Sequence[Any], prepared: Any) -> list[CellError] | None:
+    """The student's cells that raised, from the runner's records (None if they are not its).
 
     The cells' code and tags come from ``prepared`` (the grader's own copy);
     only the position, the exception's class and its message are read from
-    the log, and only as strings; a position that is not a cell of the
+    the records, and only as strings; a position that is not a cell of the
     student's is not the runner's.
     """
     numbers = {}
@@ -393,11 +422,10 @@ def _errors(log: bytes, prepared: Any) -> list[CellError] | None:
             number += 1
             numbers[position] = number
     out: dict[int, CellError] = {}
-    for line in log.decode("utf-8", "replace").splitlines():
+    for entry in entries:
         try:
-            entry = json.loads(line)
             position = entry["position"]
-        except (ValueError, KeyError, TypeError, RecursionError):
+        except (KeyError, TypeError):
             return None
         if not isinstance(position, int) or position not in numbers:
             return None
@@ -507,6 +535,41 @@ class _Tail(threading.Thread):
         return b"".join(self.chunks)[-_TAIL_BYTES:].decode("utf-8", "replace")
 
 
+class _Records(threading.Thread):
+    """Read the runner's records from the grader's end of their pipe (at most
+    :data:`MAX_RECORD_BYTES`; the rest is drained and counted as too much)."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__(daemon=True)
+        self.fd = fd
+        self.data = bytearray()
+        self.too_much = False
+
+    def run(self) -> None:
+        try:
+            while chunk := os.read(self.fd, 65536):
+                if len(self.data) + len(chunk) > MAX_RECORD_BYTES:
+                    self.too_much = True
+                    continue
+                self.data += chunk
+        except OSError:
+            pass
+        finally:
+            os.close(self.fd)
+
+    def entries(self) -> list[Any]:
+        """Each record that parses as a JSON object (a line cut by a killed run does not)."""
+        out = []
+        for line in bytes(self.data).decode("utf-8", "replace").splitlines():
+            try:
+                entry = json.loads(line)
+            except (ValueError, RecursionError):
+                continue
+            if isinstance(entry, dict):
+                out.append(entry)
+        return out
+
+
 def run_notebook(
     nb: Any,
     folder: Path,
@@ -557,13 +620,14 @@ def run_notebook(
     limit_arg = f"{limits.memory_mb},{limits.processes},{limits.file_mb},{limits.cpu_seconds}"
     limit_arg += f",{limits.output_mb}"
     limit_arg += f",{user if sandbox and user is not None else ''}"
+    read_end, write_end = os.pipe()  # the runner's records: never a file the notebook can write
     command = [
         sys.executable,
         "-m",
         "uio_teach.grading.runner",
         "--run",
         os.fspath(inside / "submission.ipynb"),
-        os.fspath(inside / ERRORS),
+        str(write_end),
         repr(float(cell_timeout)),
         limit_arg,
         "" if sandbox else os.fspath(pid_file),
@@ -571,12 +635,28 @@ def run_notebook(
     status = "ok"
     notes: list[str] = []
     pipes = {"stdin": subprocess.DEVNULL, "stdout": subprocess.PIPE, "stderr": subprocess.STDOUT}
-    if sandbox:
-        proc = Sandbox(work, limits=limits, user=user).popen(command, **pipes)
-    else:
-        env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
-        env["MPLCONFIGDIR"] = os.fspath(work / ".config" / "matplotlib")
-        proc = subprocess.Popen(command, cwd=work, env=env, start_new_session=True, **pipes)
+    try:
+        if sandbox:
+            sandboxed = Sandbox(work, limits=limits, user=user)
+            proc = sandboxed.popen(command, pass_fds=(write_end,), **pipes)
+        else:
+            env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
+            env["MPLCONFIGDIR"] = os.fspath(work / ".config" / "matplotlib")
+            proc = subprocess.Popen(
+                command,
+                cwd=work,
+                env=env,
+                start_new_session=True,
+                pass_fds=(write_end,),
+                **pipes,
+            )
+    except BaseException:
+        os.close(read_end)
+        raise
+    finally:
+        os.close(write_end)
+    records = _Records(read_end)
+    records.start()
     tail = _Tail(proc.stdout)
     tail.start()
     deadline = time.monotonic() + timeout
@@ -615,22 +695,27 @@ def run_notebook(
         _kill_group(proc.pid)  # the sandbox's own session: everything it started
         proc.wait()
         tail.join(timeout=5)
+        records.join(timeout=5)
     outcome = RunOutcome(status, positions=dict(positions), notes=notes)
-    raw = read_limited(work / ERRORS)
-    errors = _errors(raw, nb) if raw is not None else []
-    if errors is None:
-        notes.append("the runner's log of cell errors was changed by the notebook: not read")
-    outcome.errors = errors or []
-    failed = read_limited(work / RUNNER_FAILED, 4096)
-    if failed is not None:  # the runner's own failure: never the notebook's
-        try:
-            why = _one_line(json.loads(failed.decode("utf-8")).get("error", ""), 160)
-        except (ValueError, AttributeError, RecursionError):
-            why = "unknown"
+    entries = records.entries()
+    errors = _errors([e["error"] for e in entries if "error" in e], nb)
+    if errors is None:  # only the runner writes there: a mismatch is the grader's own fault
         status = "grader error"
+        notes.insert(0, "the grader's notebook runner recorded a cell that is not the notebook's")
+    outcome.errors = errors or []
+    failed = next((e["failed"] for e in entries if "failed" in e), None)
+    if failed is not None:  # the runner's own failure: never the notebook's
+        status = "grader error"
+        why = _one_line(failed, 160) or "unknown"
         notes.insert(0, f"the grader's notebook runner failed ({why}), not the notebook")
-    cut = read_limited(work / OUTPUT_CUT, 4096)
-    if cut is not None and status in ("ok", "error", "timeout"):
+    if records.too_much and status in ("ok", "error"):
+        status = "over limits"
+        notes.append(
+            f"the notebook's cells raised errors of more than {MAX_RECORD_BYTES >> 20} MB in "
+            "all: the rest were not read"
+        )
+    cut = any(e.get("cut") is True for e in entries)
+    if cut and status in ("ok", "error", "timeout"):
         if not any(n.startswith("the notebook's output") for n in notes):
             notes.insert(
                 0,
@@ -686,35 +771,51 @@ def _size(msg: Mapping[str, Any]) -> int:
     return size
 
 
-def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str) -> int:
+def _execute(src: str, record_fd: int, cell_timeout: float, limits: str, pid_file: str) -> int:
     """Run a prepared copy in a fresh kernel (the process :func:`run_notebook` starts).
 
     Nothing is saved per cell: each cell that raised is appended to ``log``
     (one JSON line) as it ends, and its outputs are dropped (the grader reads
     answers from their files, never outputs), so the cost of a run grows with
     its cells and its memory does not. Output beyond the limit's ``output_mb``
-    is cut (the file :data:`OUTPUT_CUT` says so). A failure of the runner
-    itself is written to :data:`RUNNER_FAILED`, for the grader to report as
-    its own.
+    is cut. Each cell that raised, a cut, a failure of the runner itself
+    and the end of the run are written as records (:data:`RECORDS`) into the
+    pipe ``record_fd``, which the runner holds alone: it is closed for the
+    kernel, and the runner is made undumpable so a kernel of the same user
+    cannot open it through ``/proc``.
     """
     from nbclient import NotebookClient  # deferred on purpose: only the runner needs it
     from nbclient.exceptions import DeadKernelError
 
     *numbers, user = limits.split(",")
     drop_privileges(int(user) if user else None)  # before anything else: no root, no capability
+    _private()  # a kernel of the same user cannot reach into this process through /proc
+    os.set_inheritable(record_fd, False)  # the kernel does not get the records' pipe
+    records = os.fdopen(record_fd, "w", encoding="utf-8", buffering=1)
+
+    def record(entry: Mapping[str, Any]) -> None:
+        try:
+            records.write(json.dumps(entry) + "\n")
+        except (OSError, ValueError):  # the grader stopped reading: the run is being ended
+            pass
+
     memory, processes, file_mb, cpu, output_mb = (int(v) for v in numbers)
     Limits(memory, processes, file_mb, cpu).apply()
     folder = Path(src).parent
     nb = nbformat.read(src, as_version=4)
+    keep = kept_output(output_mb)
 
     class Client(NotebookClient):  # type: ignore[misc]
         kept = 0
+        cut = False
 
         def output(self, outs: Any, msg: Any, display_id: Any, cell_index: int) -> Any:
             if msg.get("msg_type") != "error":
                 self.kept += _size(msg)
-                if self.kept > output_mb * 1024 * 1024:
-                    (folder / OUTPUT_CUT).touch()
+                if self.kept > keep:
+                    if not self.cut:
+                        self.cut = True
+                        record({"cut": True})
                     return None
             return super().output(outs, msg, display_id, cell_index)
 
@@ -737,39 +838,46 @@ def _execute(src: str, log: str, cell_timeout: float, limits: str, pid_file: str
         if pid and pid_file:
             Path(pid_file).write_text(str(pid))
 
-    with open(log, "a", encoding="utf-8") as errors:
+    def executed(cell: Any, cell_index: int, **_: Any) -> None:
+        for out in cell.get("outputs", []):
+            if out.get("output_type") == "error":
+                entry = {
+                    "position": cell_index,
+                    "ename": str(out.get("ename", ""))[:200],
+                    "evalue": str(out.get("evalue", ""))[:2000],
+                }
+                record({"error": entry})
+                break
+        cell.outputs = []  # read; kept no longer
 
-        def executed(cell: Any, cell_index: int, **_: Any) -> None:
-            for out in cell.get("outputs", []):
-                if out.get("output_type") == "error":
-                    entry = {
-                        "position": cell_index,
-                        "ename": str(out.get("ename", ""))[:200],
-                        "evalue": str(out.get("evalue", ""))[:2000],
-                    }
-                    errors.write(json.dumps(entry) + "\n")
-                    errors.flush()
-                    break
-            cell.outputs = []  # read; kept no longer
-
-        client.on_notebook_start = started
-        client.on_cell_executed = executed
+    client.on_notebook_start = started
+    client.on_cell_executed = executed
+    with records:
         try:
             client.execute()
         except DeadKernelError:
             raise  # the notebook ended its kernel: the notebook's doing
         except (Exception, MemoryError) as exc:  # the runner's own failure, never the notebook's
-            why = f"{type(exc).__name__}: {_one_line(exc, 120)}".rstrip(": ")
-            try:
-                (folder / RUNNER_FAILED).write_text(json.dumps({"error": why}))
-            except OSError:
-                pass
+            record({"failed": f"{type(exc).__name__}: {_one_line(exc, 120)}".rstrip(": ")})
             return 3
+        record({"done": True})
     return 0
 
 
+def _private() -> None:
+    """Make this process undumpable (Linux ``PR_SET_DUMPABLE`` 0): a process of the same user
+    can then neither trace it nor open its files through ``/proc/<pid>/fd``."""
+    if not sys.platform.startswith("linux"):  # pragma: no cover - the sandbox is Linux only
+        return
+    import ctypes  # deferred on purpose: only the runner inside the sandbox needs it
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(4, 0, 0, 0, 0) != 0:  # PR_SET_DUMPABLE = 4
+        raise OSError(ctypes.get_errno(), "prctl(PR_SET_DUMPABLE, 0) failed")
+
+
 def main(argv: Sequence[str]) -> int:
-    """The runner's command line: ``--run SRC LOG CELL_TIMEOUT LIMITS PID_FILE``.
+    """The runner's command line: ``--run SRC RECORD_FD CELL_TIMEOUT LIMITS PID_FILE``.
 
     Parameters
     ----------
@@ -780,8 +888,8 @@ def main(argv: Sequence[str]) -> int:
     int
     """
     if len(argv) == 6 and argv[0] == "--run":
-        return _execute(argv[1], argv[2], float(argv[3]), argv[4], argv[5])
-    print("usage: python -m uio_teach.grading.runner --run SRC LOG CELL_TIMEOUT LIMITS PID")
+        return _execute(argv[1], int(argv[2]), float(argv[3]), argv[4], argv[5])
+    print("usage: python -m uio_teach.grading.runner --run SRC RECORD_FD CELL_TIMEOUT LIMITS PID")
     return 2
 
 

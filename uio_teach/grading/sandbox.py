@@ -23,9 +23,12 @@
 * resource limits (``setrlimit``, inherited by everything it starts): address
   space, number of processes, size of a written file, CPU time, no core dumps;
 * when the grader runs as root, an unprivileged user id of its own
-  (:func:`sandbox_user`, taken by :func:`drop_privileges` before any of the
+  (:class:`SandboxUser`, taken by :func:`drop_privileges` before any of the
   hand-in's code runs): root is exempt from the limit on processes, and the
   sandbox then holds no capability and no privilege on the host's files.
+  The ids are dealt machine-wide: each is held, by a lock the kernel drops
+  when its holder ends, in a folder of root's (:func:`uid_folder`), so two
+  runs or shards on one machine, started in any order, never share one.
 
 The total written into the work folder is capped by the runner
 (:mod:`uio_teach.grading.runner`), which stops a run that exceeds it.
@@ -47,6 +50,7 @@ import functools
 import json
 import os
 import shutil
+import stat
 import subprocess
 import sys
 import tempfile
@@ -63,7 +67,8 @@ __all__ = [
     "Sandbox",
     "SandboxUnavailable",
     "sandbox_problem",
-    "sandbox_user",
+    "SandboxUser",
+    "uid_folder",
     "drop_privileges",
     "package_view",
     "hidden_paths",
@@ -71,6 +76,7 @@ __all__ = [
     "HOME",
     "TEMP_PREFIX",
     "UID_BASE",
+    "UID_COUNT",
 ]
 
 BWRAP = "bwrap"
@@ -78,9 +84,12 @@ BWRAP = "bwrap"
 HOME = "/home/student"
 """Where the work folder appears inside the sandbox (also ``HOME`` and the working folder)."""
 UID_BASE = 1_700_000_000
-"""When the grader runs as root, hand-in ``k`` runs as user id ``UID_BASE + k``. These ids lie
-far above any login account, one per hand-in, so the limit on processes of one never counts
-another's."""
+"""When the grader runs as root, each running hand-in runs as a user id of its own from
+``UID_BASE`` on (:class:`SandboxUser`). These ids lie far above any login account, one per
+running hand-in on the machine, so the limit on processes of one never counts another's."""
+UID_COUNT = 1 << 20
+"""How many sandbox user ids there are: far more than hand-ins can run at once on a machine."""
+_UID_FOLDERS = ("/run/uio-teach/sandbox-uids", "/var/tmp/uio-teach-sandbox-uids")
 _PACKAGE_ROOT = "/opt/uio-teach"
 TEMP_PREFIX = "uio-teach-grade-"
 """The name of every temporary folder of a grading run starts so (removed by the next run when
@@ -282,28 +291,114 @@ def _bwrap_has_size() -> bool:
     return "--size" in done.stdout + done.stderr
 
 
-def sandbox_user(index: int) -> int | None:
-    """The user id hand-in ``index`` runs as: its own when the grader is root, else None (yours).
+def uid_folder() -> Path:
+    """The folder of root's where the sandbox user ids in use are held (made on first use).
 
-    Parameters
-    ----------
-    index : int
-        The hand-in's number in the run.
+    ``/run/uio-teach/sandbox-uids`` (gone at the next boot), else
+    ``/var/tmp/uio-teach-sandbox-uids``: machine-wide, so every grading run of
+    the machine, whatever its folder or its shard, deals from the same ids.
 
     Returns
     -------
-    int or None
+    pathlib.Path
+
+    Raises
+    ------
+    SandboxUnavailable
+        Neither can be made, or one exists that is not a folder of root's alone
+        (a link, or writable by others): it is not used.
+    """
+    problems = []
+    for name in _UID_FOLDERS:
+        folder = Path(name)
+        try:
+            folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+            info = os.lstat(folder)
+        except OSError as err:
+            problems.append(f"{name}: {err.strerror or err}")
+            continue
+        if not stat.S_ISDIR(info.st_mode) or info.st_uid != 0 or info.st_mode & 0o022:
+            problems.append(f"{name} is not a folder of root's alone")
+            continue
+        return folder
+    raise SandboxUnavailable("no folder to hold the sandbox user ids in: " + "; ".join(problems))
+
+
+def _uid_running(uid: int) -> bool:
+    """Whether any process of the machine runs with the real user id ``uid``."""
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry.name}/status", encoding="ascii", errors="replace") as fh:
+                for line in fh:
+                    if line.startswith("Uid:"):
+                        if int(line.split()[1]) == uid:
+                            return True
+                        break
+        except (OSError, ValueError, IndexError):
+            continue
+    return False
+
+
+class SandboxUser:
+    """The user id one sandboxed run takes, unique on the machine while it is held.
+
+    When the grader runs as root, :meth:`acquire` takes the lowest id from
+    :data:`UID_BASE` whose lock file in :func:`uid_folder` no other process
+    holds (an advisory ``flock``, which the kernel drops when its holder
+    ends, however it ends) and that no process of the machine runs as (what a
+    killed run may have left). Every grading run and shard on the machine
+    deals from the same ids, so a hand-in holding processes in one run never
+    counts against the limit of processes of a hand-in in another. When the
+    grader is not root, the run keeps the grader's own user (:attr:`uid` is
+    None) and nothing is held.
 
     Examples
     --------
     >>> import os
-    >>> from uio_teach.grading.sandbox import UID_BASE, sandbox_user
-    >>> sandbox_user(3) == (UID_BASE + 3 if os.geteuid() == 0 else None)
+    >>> from uio_teach.grading.sandbox import UID_BASE, SandboxUser
+    >>> with SandboxUser() as uid, SandboxUser() as other:
+    ...     print(uid is None if os.geteuid() else UID_BASE <= uid != other)
     True
     """
-    if not hasattr(os, "geteuid") or os.geteuid() != 0:
-        return None
-    return UID_BASE + int(index)
+
+    def __init__(self) -> None:
+        self.uid: int | None = None
+        self._fd: int | None = None
+
+    def acquire(self) -> int | None:
+        """Take a free id (the grader as root) or none; returns :attr:`uid`."""
+        if not hasattr(os, "geteuid") or os.geteuid() != 0:
+            return None
+        import fcntl  # deferred on purpose: POSIX only, so the package imports everywhere
+
+        folder = uid_folder()
+        for uid in range(UID_BASE, UID_BASE + UID_COUNT):
+            fd = os.open(folder / str(uid), os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                os.close(fd)
+                continue
+            if _uid_running(uid):  # left by a run that was killed: not dealt again while it runs
+                os.close(fd)
+                continue
+            self.uid, self._fd = uid, fd
+            return uid
+        raise SandboxUnavailable(f"all {UID_COUNT} sandbox user ids are in use")
+
+    def release(self) -> None:
+        """Let the id go (once every process of its run has ended)."""
+        if self._fd is not None:
+            os.close(self._fd)  # closing drops the flock
+        self.uid, self._fd = None, None
+
+    def __enter__(self) -> int | None:
+        return self.acquire()
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
 
 
 def _probe_command(user: int | None) -> list[str]:
@@ -318,8 +413,8 @@ def _probe_command(user: int | None) -> list[str]:
     return [sys.executable, "-c", code]
 
 
-@functools.lru_cache(maxsize=4)
-def _problem(user: int | None) -> str | None:
+@functools.lru_cache(maxsize=1)
+def _problem() -> str | None:
     if not sys.platform.startswith("linux"):
         return "the sandbox needs Linux namespaces (bubblewrap); this system is not Linux"
     program = _bwrap()
@@ -330,7 +425,7 @@ def _problem(user: int | None) -> str | None:
         )
     import tempfile  # deferred on purpose: only the probe needs a folder
 
-    with tempfile.TemporaryDirectory(prefix="uio-teach-probe-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="uio-teach-probe-") as tmp, SandboxUser() as user:
         work = Path(tmp) / "work"
         work.mkdir()
         if user is not None:
@@ -383,7 +478,10 @@ def sandbox_problem() -> str | None:
     >>> sandbox_problem() is None or isinstance(sandbox_problem(), str)
     True
     """
-    return _problem(sandbox_user(0))
+    try:
+        return _problem()
+    except SandboxUnavailable as err:
+        return str(err)
 
 
 def _open_parents(mounts: Sequence[tuple[str, str, str]]) -> list[str]:
@@ -412,7 +510,7 @@ class Sandbox:
     limits : Limits, optional
         Only its ``tmp_mb`` is used here (the size of ``/tmp``).
     user : int, optional
-        The user id to run as (:func:`sandbox_user`); None keeps yours.
+        The user id to run as (:class:`SandboxUser`); None keeps yours.
 
     Examples
     --------

@@ -9,7 +9,8 @@
   term, validated against a schema;
 * :mod:`~uio_teach.instructor.labs` -- the lab chapters as student and solution notebooks,
   with :mod:`~uio_teach.instructor.book` for the book's numbers, titles and references;
-* :mod:`~uio_teach.instructor.output` -- reproducible figure files and the output folder.
+* :mod:`~uio_teach.instructor.output` -- reproducible figure files; the folders they go
+  into are :mod:`uio_teach.folders`, shared with the grader.
 
 The lab notebooks need the ``instructor`` extra (``pip install "uio-teach[instructor]"``:
 jupytext, nbformat, PyYAML, pybtex); the figures need only the package.

@@ -4,12 +4,13 @@
 notebooks can write cross-references out as text ("equation (3.2)", "(De et
 al., 2014)"). The table of contents is read with PyYAML, the bibliography with
 pybtex (both come with the book's toolchain and with the ``instructor`` extra).
-:func:`default_book_dir` finds the chapters in a source checkout or in the copy
-installed with the package.
+:func:`uio_teach.folders.default_book_dir` finds the chapters in a source checkout
+or in the copy installed with the package.
 
 Examples
 --------
->>> from uio_teach.instructor.book import BookIndex, default_book_dir
+>>> from uio_teach.folders import default_book_dir
+>>> from uio_teach.instructor.book import BookIndex
 >>> index = BookIndex.from_book(default_book_dir())
 >>> index.chapters["lab_pa9"] > index.chapters["toolbox"] > index.chapters["introduction"]
 True
@@ -25,17 +26,12 @@ from pathlib import Path
 
 __all__ = [
     "BookIndex",
-    "default_book_dir",
-    "PACKAGED_COURSE",
     "HEADING",
     "TARGET",
     "LABELLED_MATH",
     "fence_states",
     "split_front_matter",
 ]
-
-PACKAGED_COURSE = Path(__file__).resolve().parents[1] / "_course"
-"""Where an installed wheel keeps ``book/*.md``, ``_toc.yml`` and ``references.bib``."""
 
 _DIRECTIVE = re.compile(r"^(?P<fence>`{3,}|:{3,})\{(?P<name>[\w:.-]+)\}[ \t]*(?P<arg>.*?)\s*$")
 _OPTION = re.compile(r"^:(?P<key>[\w-]+):[ \t]*(?P<value>.*?)\s*$")
@@ -166,7 +162,8 @@ class BookIndex:
 
     Examples
     --------
-    >>> from uio_teach.instructor.book import BookIndex, default_book_dir
+    >>> from uio_teach.folders import default_book_dir
+    >>> from uio_teach.instructor.book import BookIndex
     >>> index = BookIndex.from_book(default_book_dir())
     >>> index.chapters["introduction"], "api" in index.chapters   # numbered parts only
     (1, False)
@@ -367,27 +364,3 @@ class BookIndex:
         if kind.startswith("t"):
             return "; ".join(f"{w} ({y})" if y else w for w, y in parts)
         return "(" + "; ".join(f"{w}, {y}" if y else w for w, y in parts) + ")"
-
-
-def default_book_dir() -> Path:
-    """The book's chapters: ``book/`` of a checkout, else the copy installed with the package.
-
-    A wheel carries the chapters, ``_toc.yml`` and ``references.bib`` in
-    ``uio_teach/_course/`` (``PACKAGED_COURSE``), so the labs can be
-    written from any folder; ``./book`` is the last resort.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Examples
-    --------
-    >>> from uio_teach.instructor.book import default_book_dir
-    >>> default_book_dir().name
-    'book'
-    """
-    checkout = Path(__file__).resolve().parents[2]
-    for root in (checkout, PACKAGED_COURSE):
-        if (root / "book").is_dir() and (root / "_toc.yml").is_file():
-            return root / "book"
-    return Path.cwd() / "book"

@@ -34,8 +34,9 @@ from typing import Any, NoReturn, TextIO
 import matplotlib
 
 from .. import __version__
+from ..folders import MANIFEST, OutputError, check_output_folder
 from .config import DPI_RANGE, ConfigError, FigureConfig, check_dpi, load_config
-from .output import FORMATS, MANIFEST, OutputError, check_output_folder
+from .output import FORMATS
 
 # Each command imports the module that does its work only when it runs (figures draws with
 # matplotlib, grade starts kernels): deferred on purpose, so `uio-teach --help` and a usage
@@ -196,14 +197,18 @@ row says "check by hand". The verdicts the notebook prints count for nothing.
 Every hand-in gets its row, whatever happens to it: links, folders and
 devices are refused, a file that is not a notebook is unreadable, answers
 over the size caps are "over limits"; the run goes on and says at the end
-how many rows need a look.
+how many rows need a look. A hand-in is any entry named *.ipynb (any case) of
+the folder, at any depth (an LMS's download in folders); every other entry
+(an archive, a script, a folder) gets a line saying why it is not graded,
+and what appears during the run is listed as not graded.
 
 Writes FILE (one row per hand-in: file, lab, group, status, reason, one
-column per check with ✓ or ✗, total and out_of), FILE's stem + _feedback/
+column per check with ✓ or ✗, total, out_of and late), FILE's stem + _feedback/
 (a text and an HTML page per hand-in), FILE's stem + _groups.csv (one row per
-group) and + _canvas.csv (Canvas's gradebook import, with its "Points
-Possible" row; only with a --roster naming the students, since without one
-no row could be matched to a student). Each row is written as soon as its
+group), + _canvas.csv (Canvas's gradebook import, with its "Points
+Possible" row) and + _moodle.csv (Moodle's grade import, by ID number); the
+last two only with a --roster naming the students, since without one no row
+could be matched to a student. Each row is written as soon as its
 hand-in is graded; --resume grades only the missing ones; Ctrl-C stops at
 once and keeps them.
 
@@ -781,6 +786,7 @@ def _grade(args: argparse.Namespace) -> int:
         _error("grade", f"cannot write the gradebook {args.out}: {_os_error(err)}")
         return 1
     out = Path(args.out)
+    _not_graded(results, quiet=args.quiet)
     if not args.quiet:
         elapsed = time.perf_counter() - start
         part = f" (shard {args.shard[0]}/{args.shard[1]})" if args.shard else ""
@@ -790,6 +796,26 @@ def _grade(args: argparse.Namespace) -> int:
         )
     _summary("grade", out, roster=args.roster is not None, quiet=args.quiet)
     return 0
+
+
+def _not_graded(results: Any, *, quiet: bool) -> None:
+    """A line for every entry of the hand-in folder that has no row, and what the folder held.
+
+    The folders of an LMS's download are listed only without ``--quiet`` (their entries have
+    their own lines); every other entry always, on the standard error.
+    """
+    found = getattr(results, "survey", None)
+    if found is None:
+        return
+    added = list(getattr(results, "added", []))
+    for path, why in found.others:
+        if not (quiet and why.startswith("a folder:")):
+            _say(f"not graded: {path}: {why}", sys.stderr)
+    for path, why in added:
+        _say(f"not graded: {path}: {why}", sys.stderr)
+    more = f", and {len(added)} added during the run, not graded" if added else ""
+    if found.others or added or not quiet:
+        _say(f"the hand-in folder {found.folder} held {found.counts()}{more}", sys.stderr)
 
 
 def _os_error(err: OSError) -> str:
@@ -833,8 +859,9 @@ def _summary(command: str, out: Path, *, roster: bool, quiet: bool) -> None:
             )
     if not roster and not quiet and command == "grade":
         _say(
-            f"no Canvas import written: without --roster no group can be matched to its "
-            f"students (give a roster with a student column to get {out.stem}_canvas.csv)",
+            "no Canvas or Moodle import written: without --roster no group can be matched to "
+            f"its students (give a roster with a student column to get {out.stem}_canvas.csv "
+            f"and {out.stem}_moodle.csv)",
             sys.stderr,
         )
 

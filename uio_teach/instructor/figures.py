@@ -44,6 +44,7 @@ from typing import Any
 
 import matplotlib.style
 
+from ..folders import MANIFEST, OutputError, StagedFolder, prepare_output_dir, write_manifest
 from ..worked import WORKED, RegistryView, run_from_config
 from .config import (
     ConfigError,
@@ -53,16 +54,7 @@ from .config import (
     design_observer,
     load_config,
 )
-from .output import (
-    FORMATS,
-    MANIFEST,
-    OutputError,
-    StagedFolder,
-    prepare_output_dir,
-    save_description,
-    save_figure,
-    write_manifest,
-)
+from .output import FORMATS, save_description, save_figure
 
 __all__ = [
     "FORMATS",
@@ -235,7 +227,7 @@ def generate(
     ------
     ValueError
         An unknown name or format, or a ``dpi`` out of range.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` cannot be created or written to, or is a folder that does not
         look like an earlier output (not empty, no manifest).
 

@@ -484,7 +484,7 @@ def make_notebook(
 
     Examples
     --------
-    >>> from uio_teach.instructor.book import default_book_dir
+    >>> from uio_teach.folders import default_book_dir
     >>> from uio_teach.instructor.lab_notebook import find_labs, make_notebook
     >>> lab = find_labs(default_book_dir())[0]
     >>> student = make_notebook(lab, "student")
@@ -574,7 +574,7 @@ def find_labs(book_dir: str | os.PathLike[str]) -> list[Path]:
 
     Examples
     --------
-    >>> from uio_teach.instructor.book import default_book_dir
+    >>> from uio_teach.folders import default_book_dir
     >>> from uio_teach.instructor.lab_notebook import find_labs
     >>> [p.name for p in find_labs(default_book_dir())]
     ['lab_case_study.md', 'lab_missile.md', 'lab_pa9.md']

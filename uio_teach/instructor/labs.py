@@ -5,7 +5,7 @@ with ``groups``), the student and the solution notebook
 (:func:`~uio_teach.instructor.lab_notebook.make_notebook`) with the term's
 numbers or the group's variant (:mod:`~uio_teach.instructor.variants`), and
 writes them with the answer key through one
-:class:`~uio_teach.instructor.output.StagedFolder`: a run that fails or is
+:class:`~uio_teach.folders.StagedFolder`: a run that fails or is
 killed leaves the folder as it was, a finished run replaces it whole (no
 notebook of an earlier run is left) and adds ``manifest.json``.
 
@@ -36,8 +36,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import UIOTeachWarning
+from ..folders import MANIFEST, StagedFolder, default_book_dir, write_manifest
 from . import lab_registry
-from .book import BookIndex, default_book_dir
+from .book import BookIndex
 from .config import config_schema
 from .lab_notebook import (
     LAB_PATTERN,
@@ -48,7 +49,6 @@ from .lab_notebook import (
     params_source,
 )
 from .lab_registry import Lab, LabError, LabUsageError, lab_of
-from .output import MANIFEST, StagedFolder, write_manifest
 from .variants import ANSWER_KEY, draw_variants, write_answer_key
 
 __all__ = [
@@ -318,7 +318,7 @@ def write_labs(
     JSON). Always ``out/manifest.json``: the command, the configuration and
     its hash, the options, the versions and every file with its SHA-256.
 
-    All or nothing (``uio_teach.instructor.output.StagedFolder``): the
+    All or nothing (``uio_teach.folders.StagedFolder``): the
     notebooks are written into a staging folder beside ``out`` that replaces
     ``out`` whole when every file is written, so a rerun (``groups=3``, then
     ``groups=2``) leaves no notebook of the earlier run, and a failed or
@@ -334,7 +334,7 @@ def write_labs(
         The lab chapters; by default every ``*lab*.md`` of ``book_dir``.
     book_dir : str or path-like, optional
         The book's chapters (for the cross-references and the default
-        sources); :func:`~uio_teach.instructor.book.default_book_dir` by default.
+        sources); :func:`~uio_teach.folders.default_book_dir` by default.
     progress : callable, optional
         Called as ``progress(index, total, result)`` after each notebook pair.
     config : mapping, optional
@@ -356,7 +356,7 @@ def write_labs(
         A lab cannot be converted; a ``LabUsageError`` (a subclass) for a
         missing folder or file, a source that is not a lab, a bad ``groups``
         or numbers that make no fair exercise.
-    uio_teach.instructor.output.OutputError
+    uio_teach.folders.OutputError
         ``out`` cannot be written, is not ours (not empty, no manifest), or
         another run is writing it.
 

@@ -139,6 +139,13 @@ class Converter:
         text = _ROLE.sub(self.role, "\n".join(lines))
         # "eq. {eq}`x`" in the source: the role already says "eq."
         text = re.sub(r"\b([Ee]q\.|[Ee]quations?)(\s+)eq\. \(", r"\1\2(", text)
+        # "equations {eq}`a`, {eq}`b` and {eq}`c`": the word is said once for the whole list
+        sep = r"(?:,\s*|\s+and\s+)"
+        listed = re.compile(
+            rf"(\b(?:[Ee]qs\.|[Ee]quations)\s+\([^()]*\)(?:{sep}\([^()]*\))*{sep})eq\. \("
+        )
+        while listed.search(text):
+            text = listed.sub(r"\1(", text)
         return re.sub(r"\n{3,}", "\n\n", text).strip("\n")
 
     def directive(self, d: Directive, exercise_number: str | None = None) -> str:
