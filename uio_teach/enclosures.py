@@ -509,12 +509,18 @@ def _tall_zero_disks(red: ReducedZeros, discrete: bool) -> Disks:
         nX = max(float(np.linalg.norm(Xc, 2)), np.finfo(float).tiny)
         Cc = Cz @ Xc / nX
         Bc = T[a:b, a:b] - disks.centre[a] * np.eye(b - a)
+        nB = float(np.linalg.norm(Bc))
+        Bc = Bc / nB if nB > 0 else Bc
         # the observability of the cluster's own pair: [Cc; Cc Bc; ...]
         blocks, cur = [Cc], Cc
         for _ in range(b - a - 1):
             cur = cur @ Bc
             blocks.append(cur)
-        sv = np.linalg.svd(np.vstack(blocks), compute_uv=False)
+        with np.errstate(all="ignore"):
+            stack = np.vstack(blocks)
+        if not np.all(np.isfinite(stack)):
+            stack = Cc
+        sv = np.linalg.svd(stack, compute_uv=False)
         k = (b - a) - int(np.sum(sv > thr))
         if k <= 0:
             if _inside(disks.centre[a : a + 1], disks.radius[a : a + 1], discrete)[0]:

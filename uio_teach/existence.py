@@ -457,12 +457,6 @@ def rank_condition(bal: Plant, plant: Plant | None = None) -> tuple[Condition, i
     undecided = False
     if ok:
         reason = f"{lhs} = {rhs.split(' = ')[0]}: the unknown inputs can be decoupled"
-        if below < tols.DROP_MARGIN and (
-            dE.below < tols.DROP_MARGIN or dD.below < tols.DROP_MARGIN
-        ):
-            # a singular value of E or D just below its bound: a plant that close has a
-            # larger rank(E) + rank(D)
-            undecided = True
     else:
         reason = (
             f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
@@ -471,16 +465,28 @@ def rank_condition(bal: Plant, plant: Plant | None = None) -> tuple[Condition, i
         if not exact_rank_deficient(plant):
             undecided = True
     if undecided:
-        s = np.linalg.svd(G, compute_uv=False) if G.size else np.zeros(0)
-        k = min(rE + rD, s.size) - 1 if not ok else max(rG - 1, 0)
+        if rG < rE + rD:
+            # a singular value of [CE D] that the ranks of E and D need lies within its bound
+            s = np.linalg.svd(G, compute_uv=False) if G.size else np.zeros(0)
+            k = min(rG, s.size - 1)
+            which, scale, bound_ = name, max(nC * nE, nD), dG.threshold
+            of = "||C|| ||E||" if not bal.nv else "its factors"
+        else:
+            # a singular value of E (or D) just below its own bound: a plant that close has
+            # a larger rank(E) + rank(D)
+            X, d_ = (E, dE) if dE.below <= dD.below else (D, dD)
+            s = np.linalg.svd(X, compute_uv=False)
+            k = min(d_.rank, s.size - 1)
+            which = "E" if X is E else "D"
+            scale, bound_ = (float(s[0]) if s.size else 1.0), d_.threshold
+            of = f"||{which}||"
         sv = float(s[k]) if 0 <= k < s.size else 0.0
-        scale = max(nC * nE, nD)
         cond = Condition(
             "rank condition",
             None,
-            f"cannot be decided at this precision: singular value {k + 1} of {name} is "
-            f"{sv / scale:.3g} of ||C|| ||E|| (balanced units), within its bound "
-            f"{dG.threshold / scale:.3g} (the rounding of the data and of the product): a "
+            f"cannot be decided at this precision: singular value {k + 1} of {which} is "
+            f"{sv / scale:.3g} of {of} (balanced units), within its bound "
+            f"{bound_ / scale:.3g} (the rounding of the data and of the product {name}): a "
             "plant that close meets the rank condition, another does not",
             margin=min(margin, below),
             undecided=True,
@@ -770,7 +776,17 @@ def check_existence(plant: Plant) -> ExistenceReport:
     zs = None
     if rank_cond.holds:
         # proven disks on the structure-revealing reduction (square and tall plants alike)
-        zs = validated_zeros(bal0.A, bal0.E, bal0.C, bal0.D, discrete=discrete)
+        # (continuous time: in the balanced time unit, then back in the plant's)
+        src = bal0 if discrete else bal
+        zs = validated_zeros(src.A, src.E, src.C, src.D, discrete=discrete)
+        if zs is not None and not discrete:
+            f = scaling.sigma
+            zs = zs._replace(
+                zeros=zs.zeros * f,
+                radius=zs.radius * f,
+                distance=zs.distance * f,
+                scale=zs.scale * f,
+            )
     if zs is None:
         Bz = np.hstack([bal0.E, np.zeros((plant.n, plant.nv))])
         Dz = np.hstack([np.zeros((plant.p, plant.q)), bal0.D])
