@@ -111,6 +111,12 @@ def test_a_small_ce_design_is_refused_or_warned_never_silently_leaking(design):
         except DecouplingError as exc:
             assert "does not decouple" in str(exc) and "amplifies round-off" in str(exc)
             return
+        except ut.UIOExistenceError as exc:
+            # the zeros of a plant with a C E this small are bounded only loosely: refused
+            # because the report cannot decide, and saying so
+            assert "cannot be decided at this precision" in str(exc)
+            assert not exc.report.decided
+            return
     warned = [w for w in caught if issubclass(w.category, DecouplingWarning)]
     leak = exact_leak(plant, obs)
     assert leak <= (LEAK_REFUSE if warned else 1e-6)

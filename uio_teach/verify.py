@@ -35,6 +35,7 @@ from scipy.optimize import linear_sum_assignment
 from . import tolerances as tols
 from ._display import format_complex
 from .errors import UIOTeachError, UIOTeachWarning
+from .linalg import is_stable
 
 __all__ = [
     "POLE_RTOL",
@@ -617,6 +618,19 @@ def check_decoupling(
     why = f"the realization amplifies round-off by {res.amplification:.2g}" + (
         f" ({cause})" if cause else ""
     )
+    lam = np.linalg.eigvals(np.asarray(A, float)) if np.all(np.isfinite(A)) else np.zeros(0)
+    growing = lam[~is_stable(lam, discrete, margin=0.0)] if lam.size else lam
+    if growing.size and not res.bound <= tols.LEAK_RTOL:
+        # the leak is a fraction of the state's response; an unstable plant's state grows
+        # without bound under a bounded unknown input, and that fraction of it with it
+        raise DecouplingError(
+            f"{what} does not decouple: the unknown input may reach the estimation error with "
+            f"up to {res.bound:.2g} of its gain on the state, and the plant is unstable (modes "
+            + ", ".join(f"{complex(z):.3g}" for z in growing[:4])
+            + "): its state grows without bound under a bounded unknown input, and that "
+            f"fraction of it with it, so the estimation error diverges; {why}. The design is "
+            "refused"
+        )
     if not res.bound <= tols.LEAK_REFUSE:
         raise DecouplingError(
             f"{what} does not decouple: the unknown input may reach the estimation error with "
