@@ -142,7 +142,13 @@ def test_the_exact_judge_and_the_designs_own_check_agree(ce):
     plant = small_ce_plant(ce)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DecouplingWarning)
-        obs = ut.design_uio(plant, poles=[-1, -2, -3, -4])
+        try:
+            obs = ut.design_uio(plant, poles=[-1, -2, -3, -4])
+        except DecouplingError as exc:
+            # this plant is unstable: a leak beyond round-off would grow with its state
+            assert "the plant is unstable" in str(exc) and "diverges" in str(exc)
+            assert np.any(np.linalg.eigvals(plant.A).real >= 0)
+            return
     exact = exact_leak(plant, obs)
     # the design's bound is a bound: the exact leak is within it (1 % for its own rounding)
     assert exact <= obs.leak.bound * 1.01

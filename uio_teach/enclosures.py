@@ -219,6 +219,11 @@ def eigenvalue_disks(M: np.ndarray, perturbation: float, *, basis: bool = False)
         lam = np.full(n, np.nan + 0j)
         disks = Disks(lam, lam, np.full(n, np.inf), np.zeros(n, int))
         return (disks, (np.eye(n), np.diag(lam), [0, n])) if basis else disks
+    with np.errstate(all="ignore"):
+        return _disks(M, n, perturbation, basis)
+
+
+def _disks(M, n, perturbation, basis):
     T, Q = sla.schur(M.astype(complex), output="complex")
     normM = float(np.linalg.norm(M))
     # the Schur form is exact for a matrix within this of M (backward stable, with room)
