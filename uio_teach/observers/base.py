@@ -151,12 +151,14 @@ class Observer:
         """
         from ..verify import PlacementAccuracyError
 
-        if requested is None or self.is_stable:
+        if requested is None:
             return
         discrete = self.plant.is_discrete
         if not np.all(is_stable(np.asarray(requested, complex), discrete, margin=0.0)):
             return  # unstable poles were asked for: warn_if_unstable says so
-        bad = [p for p in self.poles() if not is_stable([p], discrete)[0]]
+        bad = [p for p in self.poles() if not is_stable([p], discrete, margin=0.0)[0]]
+        if not bad:
+            return
         region = "unit disk" if discrete else "left half-plane"
         raise PlacementAccuracyError(
             f"the {self.family} design has error pole(s) "
