@@ -319,10 +319,14 @@ def _fr(M):
 def _mul(X, Y):
     from fractions import Fraction
 
-    return [
-        [sum((X[i][k] * Y[k][j] for k in range(len(Y))), Fraction(0)) for j in range(len(Y[0]))]
-        for i in range(len(X))
-    ] if X and Y and Y[0] else [[] for _ in X]
+    return (
+        [
+            [sum((X[i][k] * Y[k][j] for k in range(len(Y))), Fraction(0)) for j in range(len(Y[0]))]
+            for i in range(len(X))
+        ]
+        if X and Y and Y[0]
+        else [[] for _ in X]
+    )
 
 
 def _to_float(X) -> np.ndarray:
