@@ -206,8 +206,8 @@ def eigenvalue_disks(M: np.ndarray, perturbation: float, *, basis: bool = False)
     >>> import numpy as np
     >>> from uio_teach.enclosures import eigenvalue_disks
     >>> disks = eigenvalue_disks(np.diag([-1.0, -2.0]), 1e-10)
-    >>> disks.radius.round(12).tolist()
-    [1e-10, 1e-10]
+    >>> bool(np.all((disks.radius >= 1e-10) & (disks.radius < 1e-9)))  # with room: a bound
+    True
     """
     M = np.atleast_2d(np.asarray(M))
     n = M.shape[0]
