@@ -505,9 +505,9 @@ def _tall_zero_disks(red: ReducedZeros, discrete: bool) -> Disks:
     """
     Z, Cz, dZ, dC = red.Z, red.Cz, red.dZ, red.dC
     disks, (X, T, starts) = eigenvalue_disks(Z, dZ, basis=True)
-    nC = max(float(np.linalg.norm(Cz, 2)), np.finfo(float).tiny)
     keep = np.zeros(Z.shape[0], bool)
-    thr = 10.0 * (dC + dZ * nC / max(float(np.linalg.norm(Z, 2)), np.finfo(float).tiny))
+    # (balanced data: Z and Cz of comparable size, their perturbations in one unit)
+    thr = 10.0 * (dC + dZ)
     for j in range(len(starts) - 1):
         a, b = starts[j], starts[j + 1]
         Xc = X[:, a:b]
