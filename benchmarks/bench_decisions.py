@@ -30,15 +30,95 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from zero_families import FAMILIES, build, judge, slicot_zero_count  # noqa: E402
+from zero_families import (  # noqa: E402
+    EXACT_KINDS,
+    FAMILIES,
+    ab08nd_verdict,
+    build,
+    build_exact,
+    confidently_wrong,
+    judge,
+    said,
+    slicot_zero_count,
+)
 
 import uio_teach as ut  # noqa: E402
+
+
+def exact_table(seeds: int) -> dict:
+    """The exact-truth families: verdicts against the truth and against AB08ND's, one table."""
+    print(
+        "| family | plants | exists | no | cannot be decided | confidently wrong | "
+        "raw exceptions | zeros counted right (square) | AB08ND confidently wrong | "
+        "check_existence ms | AB08ND ms |"
+    )
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    total, why = Counter(), Counter()
+    for kind in EXACT_KINDS:
+        c = Counter()
+        for seed in range(seeds):
+            case = build_exact(kind, seed)
+            c["plants"] += 1
+            start = time.process_time()
+            try:
+                report = ut.check_existence(case.plant)
+            except Exception as exc:  # counted: the table's column says how many
+                c["raw"] += 1
+                print(f"<!-- raw exception: {case.label}: {exc!r} -->")
+                continue
+            c["ours"] += time.process_time() - start
+            verdict = said(report)
+            c[verdict] += 1
+            c["wrong"] += confidently_wrong(verdict, case.truth)
+            if verdict == "undecided":
+                failed = report.failed[0]
+                if failed.name == "rank condition":
+                    why["the rank condition within its bound"] += 1
+                elif case.truth == "boundary":
+                    why["a zero exactly on the boundary"] += 1
+                elif "holds only by the structure" in failed.reason:
+                    why["a tall plant's zero outside the region (a plant that close has none)"] += 1
+                else:
+                    why["a zero's proven disk reaches the boundary"] += 1
+            square = case.plant.p == case.plant.q
+            if square and case.zeros is not None and report["rank condition"].holds:
+                c["square"] += 1
+                c["count right"] += report.invariant_zeros.size == case.zeros.size
+            start = time.process_time()
+            _, theirs = ab08nd_verdict(case.plant)
+            c["ab08nd"] += time.process_time() - start
+            if theirs is not None:
+                c["ab08nd wrong"] += confidently_wrong(theirs, case.truth)
+        ms = 1e3 * c["ours"] / max(c["plants"] - c["raw"], 1)
+        ms_ref = 1e3 * c["ab08nd"] / max(c["plants"], 1)
+        print(
+            f"| {kind} | {c['plants']} | {c['exists']} | {c['no']} | {c['undecided']} | "
+            f"{c['wrong']} | {c['raw']} | {c['count right']} of {c['square']} | "
+            f"{c['ab08nd wrong']} | {ms:.1f} | {ms_ref:.2f} |"
+        )
+        total.update(c)
+    print()
+    print("Why the undecided plants are undecided:")
+    for reason, k in why.most_common():
+        print(f"- {reason}: {k}")
+    print()
+    return {
+        "exact_plants": int(total["plants"]),
+        "exact_wrong": int(total["wrong"]),
+        "exact_raw": int(total["raw"]),
+        "exact_undecided": int(total["undecided"]),
+        "exact_ab08nd_wrong": int(total["ab08nd wrong"]),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=48, help="plants per family")
+    parser.add_argument(
+        "--exact", type=int, default=120, help="plants per exact-truth family (second table)"
+    )
     args = parser.parse_args(argv)
+    exact = exact_table(args.exact)
     rows, total, notes = [], Counter(), []
     ours = slicot = 0.0
     for family in FAMILIES:
@@ -106,6 +186,7 @@ def main(argv: list[str] | None = None) -> int:
         key: int(total[key])
         for key in ("plants", "right", "undecided", "wrong", "count right", "slicot agrees")
     }
+    result.update(exact)
     result.update(
         designs=int(total["designs"]),
         silent_leaks=int(total["silent leaks"]),

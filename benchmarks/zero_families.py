@@ -290,3 +290,216 @@ def judge(case: Case) -> Outcome:
             if exact_leak(case.plant, obs) > (LEAK_REFUSE if warned else LEAK_RTOL):
                 leaks += 1
     return Outcome(verdict, count_right, slicot_zero_count(case.plant), designs, leaks, report)
+
+
+# families with exact truth -------------------------------------------------------------------
+# Every number below is a small dyadic rational, and every mixing of coordinates an integer
+# matrix of determinant 1 applied in rational arithmetic: the doubles stored are the plant
+# built, and its zeros are exactly the eigenvalues of the block J, with J's Jordan structure.
+
+EXACT_KINDS = ("jordan", "boundary", "unimodular", "tall", "rank edge", "time units")
+"""The families of the exact-truth table."""
+
+
+class ExactCase(NamedTuple):
+    """A plant stored exactly, its zeros (``None`` when only their side is known), the truth."""
+
+    plant: ut.Plant
+    zeros: np.ndarray | None
+    truth: str  # "exists", "no" or "boundary"
+    label: str
+
+
+def _fr(M):
+    from fractions import Fraction
+
+    return [[Fraction(x) for x in row] for row in np.atleast_2d(np.asarray(M, float))]
+
+
+def _mul(X, Y):
+    from fractions import Fraction
+
+    return (
+        [
+            [sum((X[i][k] * Y[k][j] for k in range(len(Y))), Fraction(0)) for j in range(len(Y[0]))]
+            for i in range(len(X))
+        ]
+        if X and Y and Y[0]
+        else [[] for _ in X]
+    )
+
+
+def _to_float(X) -> np.ndarray:
+    out = np.array([[float(x) for x in row] for row in X], float) if X else np.zeros((0, 0))
+    # exact: every rational is a double
+    assert all(float(x) == x for row in X for x in row), "not exactly representable"
+    return out
+
+
+def _unimodular(n: int, rng: np.random.Generator, steps: int):
+    """An integer matrix of determinant 1 and its integer inverse (products of shears)."""
+    from fractions import Fraction
+
+    P = [[Fraction(int(i == j)) for j in range(n)] for i in range(n)]
+    Pi = [row[:] for row in P]
+    for _ in range(steps):
+        i, j = (int(v) for v in rng.choice(n, 2, replace=False))
+        k = int(rng.choice([-2, -1, 1, 2]))
+        # P <- (I + k e_i e_j^T) P ; Pi <- Pi (I - k e_i e_j^T)
+        P[i] = [a + k * b for a, b in zip(P[i], P[j], strict=True)]
+        for row in Pi:
+            row[j] = row[j] - k * row[i]
+    return P, Pi
+
+
+def _exact_plant(J, rng, *, q, p, dt, mix_steps, time_exp=0):
+    """The plant of ``zero_families.plant_with_zeros``' form, stored exactly."""
+    k = J.shape[0]
+    n = k + q
+    A = np.zeros((n, n))
+    A[:k, :k] = J
+    A[:k, k:] = rng.integers(-4, 5, (k, q)) / 4
+    A[k:, :k] = rng.integers(-4, 5, (q, k)) / 4
+    A[k:, k:] = rng.integers(-4, 5, (q, q)) / 4 - (0 if dt else 2 * np.eye(q))
+    E = np.zeros((n, q))
+    E[k:] = np.eye(q)
+    C = np.zeros((p, n))
+    C[:, k:] = rng.integers(-2, 3, (p, q)) + 2 * np.eye(p, q)
+    if np.linalg.matrix_rank(C[:, k:]) < q:
+        C[:q, k:] += 4 * np.eye(q)
+    if mix_steps:
+        P, Pi = _unimodular(n, rng, mix_steps)
+        A = _to_float(_mul(_mul(P, _fr(A)), Pi))
+        E = _to_float(_mul(P, _fr(E)))
+        C = _to_float(_mul(_fr(C), Pi))
+    f = 2.0**time_exp
+    return ut.Plant(A * f, C, E=E * f, dt=dt)
+
+
+def _truth_of(zeros: np.ndarray, discrete: bool) -> str:
+    # the zeros are dyadic rationals or exact multiples of i: their side is exact
+    return _truth(zeros, discrete)
+
+
+def _zero_block(rng, discrete: bool, boundary: bool, kmax: int = 6):
+    """A block J of Jordan blocks with dyadic eigenvalues (or exactly on the boundary)."""
+    blocks, zeros = [], []
+    size = 0
+    while size < 2 or (size < kmax and rng.random() < 0.5):
+        k = int(rng.integers(1, kmax - size + 1))
+        if boundary and not blocks:
+            if discrete:
+                z = float(rng.choice([1.0, -1.0]))
+            else:
+                z = 0.0
+            if rng.random() < 0.3 and kmax - size >= 2:
+                # a pair exactly on the boundary: +-i (discrete) or +-2i (continuous)
+                w = 1.0 if discrete else 2.0
+                blocks.append(np.array([[0.0, w], [-w, 0.0]]))
+                zeros += [1j * w, -1j * w]
+                size += 2
+                continue
+        else:
+            pool = [-0.5, 0.25, 0.5, -0.75, 1.5] if discrete else [-1.0, -0.5, -2.0, 0.5, 1.0]
+            z = float(rng.choice(pool))
+        blocks.append(_jordan(z, k))
+        zeros += [z] * k
+        size += k
+    J = np.zeros((size, size))
+    at = 0
+    for b in blocks:
+        J[at : at + b.shape[0], at : at + b.shape[0]] = b
+        at += b.shape[0]
+    return J, np.array(zeros, complex)
+
+
+def build_exact(kind: str, seed: int) -> ExactCase:
+    """The ``seed``-th plant of an exact-truth family (deterministic)."""
+    rng = np.random.default_rng([100 + EXACT_KINDS.index(kind), seed])
+    discrete = bool(seed % 2)
+    dt = 1.0 if discrete else None
+    q = 1 + int(seed % 5 == 4)
+    if kind == "rank edge":
+        # C E = 2^-e exactly (or 0): n = 2, one zero, computed exactly from the data
+        from fractions import Fraction
+
+        e = [48, 49, 50, 51, 52, None][seed % 6]
+        eps = 0.0 if e is None else 2.0**-e
+        a, b, c, d = (rng.integers(-4, 5, 4) / 4).tolist()
+        if not discrete:
+            a, d = a - 2, d - 2
+        A = np.array([[a, b], [c, d]])
+        E = np.array([[1.0], [-1.0 + eps]])
+        plant = ut.Plant(A, [[1.0, 1.0]], E=E, dt=dt)
+        if e is None:
+            return ExactCase(plant, np.zeros(0, complex), "no", "rank edge C E = 0")
+        F = Fraction
+        e2 = F(-1.0 + eps)
+        z = -((F(c) - F(d)) + (F(b) - F(a)) * e2) / (1 + e2)
+        zeros = np.array([complex(float(z))])
+        if discrete:
+            truth = "no" if abs(z) > 1 else ("boundary" if abs(z) == 1 else "exists")
+        else:
+            truth = "no" if z > 0 else ("boundary" if z == 0 else "exists")
+        return ExactCase(plant, zeros, truth, f"rank edge C E = 2^-{e}")
+    boundary = kind == "boundary"
+    J, zeros = _zero_block(rng, discrete, boundary, kmax=6)
+    p = q + (1 + int(seed % 3 == 0) if kind == "tall" else 0)
+    steps = {"unimodular": 6 + seed % 10, "boundary": seed % 8, "tall": seed % 6}.get(kind, 0)
+    if kind == "jordan":
+        steps = 2 * (seed % 4)
+    time_exp = 0
+    if kind == "time units" and not discrete:
+        time_exp = int([-27, -13, 0, 13, 27][seed % 5])
+        zeros = zeros * 2.0**time_exp
+    plant = _exact_plant(J, rng, q=q, p=p, dt=dt, mix_steps=steps, time_exp=time_exp)
+    label = f"{kind} {'discrete' if discrete else 'continuous'} n={plant.n} p={p} q={q}"
+    return ExactCase(plant, np.sort_complex(zeros), _truth_of(zeros, discrete), label)
+
+
+def said(report: ut.ExistenceReport) -> str:
+    """The report's verdict as "exists", "no" or "undecided"."""
+    if report.ok:
+        return "exists"
+    if any(c.holds is False for c in report.conditions if c.required):
+        return "no"
+    return "undecided"
+
+
+def confidently_wrong(verdict: str, truth: str) -> bool:
+    """A decided verdict the exact truth contradicts (a zero on the boundary makes "no" true)."""
+    if verdict == "exists":
+        return truth != "exists"
+    if verdict == "no":
+        return truth == "exists"
+    return False
+
+
+def ab08nd_verdict(plant: ut.Plant):
+    """AB08ND's zeros (ctrlsys) and the verdict their signs give, or (None, None)."""
+    try:
+        import ctrlsys
+    except ImportError:  # pragma: no cover
+        return None, None
+
+    def f(M):
+        return np.array(M, dtype=float, order="F", copy=True)
+
+    n, q, p = plant.n, plant.q, plant.p
+    out = ctrlsys.ab08nd("S", n, q, p, f(plant.A), f(plant.E), f(plant.C), f(np.zeros((p, q))))
+    nz = int(out[0])
+    # the finite zeros: generalized eigenvalues of the returned pencil (Af, Bf)
+    zeros = np.zeros(0, complex)
+    try:
+        Af, Bf = np.asarray(out[8])[:nz, :nz], np.asarray(out[9])[:nz, :nz]
+        import scipy.linalg as sla
+
+        zeros = sla.eigvals(Af, Bf) if nz else zeros
+    except Exception:  # pragma: no cover - layout of the wrapper's outputs
+        zeros = np.full(nz, np.nan + 0j)
+    if plant.is_discrete:
+        ok = bool(np.all(np.abs(zeros) < 1))
+    else:
+        ok = bool(np.all(zeros.real < 0))
+    rank_ok = np.linalg.matrix_rank(plant.C @ plant.E) == np.linalg.matrix_rank(plant.E)
+    return zeros, ("exists" if ok and rank_ok else "no")

@@ -21,14 +21,28 @@ def test_rank_of_a_product_is_judged_against_its_factors():
     assert rank(CE, scale=scale) == 0
 
 
-def test_product_zero_in_exact_arithmetic_fails_the_rank_condition():
+def test_a_product_within_its_rounding_cannot_be_decided():
+    # 0.1 + 0.2 - 0.3 is 5.6e-17 for the doubles stored, not 0: a plant that close has
+    # C E = 0, the data themselves do not; the verdict names the singular value and its bound
     report = ut.check_existence(ROUND_OFF_PLANT)
-    assert not report.ok
+    assert not report.ok and not report.decided
     cond = report["rank condition"]
-    assert cond.holds is False
-    assert "rank(CE) = 0 but rank(E) = 1" in cond.reason
+    assert cond.holds is None and cond.undecided
+    assert "singular value 1 of CE is 8.57e-17" in cond.reason and "within its bound" in cond.reason
+    assert report.verdict == "cannot be decided at this precision"
     with pytest.raises(ut.UIOExistenceError, match="rank condition"):
         ut.design_uio(ROUND_OFF_PLANT, poles=[-5])
+
+
+def test_product_zero_in_exact_arithmetic_fails_the_rank_condition():
+    exact = ut.Plant(ROUND_OFF_PLANT.A, [[1, 1, 1]], E=[1.0, 2.0, -3.0])  # C E = 0 exactly
+    report = ut.check_existence(exact)
+    cond = report["rank condition"]
+    assert cond.holds is False and not cond.undecided
+    assert "rank(CE) = 0 but rank(E) = 1" in cond.reason
+    assert report.verdict == "no UIO with stable error dynamics exists"
+    with pytest.raises(ut.UIOExistenceError, match="rank condition"):
+        ut.design_uio(exact, poles=[-5])
 
 
 def test_rank_decision_reports_a_marginal_verdict():

@@ -111,6 +111,12 @@ def test_a_small_ce_design_is_refused_or_warned_never_silently_leaking(design):
         except DecouplingError as exc:
             assert "does not decouple" in str(exc) and "amplifies round-off" in str(exc)
             return
+        except ut.UIOExistenceError as exc:
+            # the zeros of a plant with a C E this small are bounded only loosely: refused
+            # because the report cannot decide, and saying so
+            assert "cannot be decided at this precision" in str(exc)
+            assert not exc.report.decided
+            return
     warned = [w for w in caught if issubclass(w.category, DecouplingWarning)]
     leak = exact_leak(plant, obs)
     assert leak <= (LEAK_REFUSE if warned else 1e-6)
@@ -136,7 +142,13 @@ def test_the_exact_judge_and_the_designs_own_check_agree(ce):
     plant = small_ce_plant(ce)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DecouplingWarning)
-        obs = ut.design_uio(plant, poles=[-1, -2, -3, -4])
+        try:
+            obs = ut.design_uio(plant, poles=[-1, -2, -3, -4])
+        except DecouplingError as exc:
+            # this plant is unstable: a leak beyond round-off would grow with its state
+            assert "the plant is unstable" in str(exc) and "diverges" in str(exc)
+            assert np.any(np.linalg.eigvals(plant.A).real >= 0)
+            return
     exact = exact_leak(plant, obs)
     # the design's bound is a bound: the exact leak is within it (1 % for its own rounding)
     assert exact <= obs.leak.bound * 1.01

@@ -319,6 +319,19 @@ def _stable_poles(rng, k, discrete):
 COUNTS = {"tried": 0, "right": 0, "refused": 0, "wrong": 0}
 
 
+def _near_a_bound(report):
+    """A decision of the report within a factor of 4 of its bound (rank margin, zero disk)."""
+    rank = report["rank condition"]
+    if rank.undecided or (rank.margin is not None and rank.margin < 10):
+        return True
+    zs = report.zero_set
+    if zs is None or not zs.zeros.size:
+        return False
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = zs.distance / zs.radius
+    return bool(np.any((ratio > 0.25) & (ratio < 4)))
+
+
 def run_case(seed, discrete, design):
     """One case: verdicts in random units equal the base verdicts; a design is right or refused.
 
@@ -332,7 +345,13 @@ def run_case(seed, discrete, design):
         return "wrong"
     s, other = random_units(rng, base)
     report = ut.check_existence(other)
-    if verdict(report) != verdict(ref) or not same_values(report.invariant_zeros, zeros, 1e-6):
+    if verdict(report) != verdict(ref):
+        # round-off of other units may move a plant between decided and undecided only where
+        # a decision sits at its bound; a decided verdict never turns into the other
+        decided = [r for r in (ref, report) if r.decided]
+        if len(decided) == 2 or not any(_near_a_bound(r) for r in (ref, report)):
+            return "wrong"
+    if not same_values(report.invariant_zeros, zeros, 1e-6):
         return "wrong"
     if not report.ok:
         return "right"  # refused by the existence check, as the base plant is

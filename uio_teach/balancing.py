@@ -399,9 +399,11 @@ def _split_from_modes(A: np.ndarray, C: np.ndarray, modes: np.ndarray):
         M = np.vstack([z * np.eye(n) - A, C.astype(complex)])
         v = np.linalg.svd(M)[2][-1].conj()
         vecs.extend([v.real, v.imag] if z.imag > 0 else [v.real])
+    k = len(modes)
+    if len(vecs) != k:
+        return None  # a complex mode without its conjugate: no real subspace
     V = np.array(vecs).T
     U, sv, _ = np.linalg.svd(V, full_matrices=True)
-    k = len(modes)
     if V.shape[1] != k or sv.size < k or sv[k - 1] <= tols.SPAN_RTOL * sv[0]:
         return None  # repeated modes: their vectors do not span the subspace
     Vu, Vo = U[:, :k], U[:, k:]

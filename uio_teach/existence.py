@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from .balancing import (
     modes_agree,
     plant_scaling,
 )
+from .enclosures import validated_zeros
 from .errors import UIOTeachError
 from .linalg import (
     ObservabilitySplit,
@@ -361,8 +363,55 @@ def _margin_note(margin: float, what: str = "a singular value") -> str:
     )
 
 
-def rank_condition(bal: Plant) -> tuple[Condition, int]:
+def _exact(M: np.ndarray) -> list[list[Fraction]]:
+    return [[Fraction(float(x)) for x in row] for row in np.atleast_2d(M)]
+
+
+def _exact_rank(rows: list[list[Fraction]]) -> int:
+    """The rank of a matrix of rationals, by exact Gaussian elimination."""
+    rows = [list(r) for r in rows if any(r)]
+    rank = 0
+    ncol = len(rows[0]) if rows else 0
+    for j in range(ncol):
+        pivot = next((i for i in range(rank, len(rows)) if rows[i][j] != 0), None)
+        if pivot is None:
+            continue
+        rows[rank], rows[pivot] = rows[pivot], rows[rank]
+        for i in range(rank + 1, len(rows)):
+            if rows[i][j]:
+                f = rows[i][j] / rows[rank][j]
+                rows[i] = [a - f * b for a, b in zip(rows[i], rows[rank], strict=True)]
+        rank += 1
+    return rank
+
+
+def exact_rank_deficient(plant: Plant) -> bool:
+    """True when ``rank([C E, D]) < rank(E) + rank(D)`` holds exactly for the data as stored.
+
+    The products are formed in rational arithmetic from the stored doubles: a ``C E`` that is
+    zero in exact arithmetic is told from one that is ``2^-52`` of its factors.
+    """
+    C, E, D = _exact(plant.C), _exact(plant.E), _exact(plant.D)
+    p, n = plant.p, plant.n
+    CE = [
+        [sum((C[i][k] * E[k][j] for k in range(n)), Fraction(0)) for j in range(plant.q)]
+        for i in range(p)
+    ]
+    G = [CE[i] + (D[i] if plant.nv else []) for i in range(p)]
+    rE = _exact_rank(E) if plant.q else 0
+    rD = _exact_rank(D) if plant.nv else 0
+    return _exact_rank(G) < rE + rD
+
+
+def rank_condition(bal: Plant, plant: Plant | None = None) -> tuple[Condition, int]:
     """The rank condition, decided on the balanced plant ``bal``; returns it and rank(E).
+
+    Three ways: it holds when every singular value it needs is above its bound (the rounding
+    of the product ``C E`` and of the data, ``RANK_RTOL n eps`` of the factors); it fails when
+    a needed singular value is within the bound and the data as stored (``plant``) are
+    rank-deficient in exact arithmetic; otherwise it cannot be decided (a plant within the
+    bound has the rank, another does not), and the reason names the singular value and the
+    bound.
 
     Parameters
     ----------
@@ -370,6 +419,8 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
         The plant in balanced units (:func:`uio_teach.balancing.balanced_plant`):
         ranks are then judged against factors of comparable size, whatever
         the units of the data.
+    plant : Plant, optional
+        The data as given (for the exact check of a rank deficiency); default ``bal``.
 
     Returns
     -------
@@ -383,6 +434,7 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     >>> cond.holds, rE
     (True, 1)
     """
+    plant = bal if plant is None else plant
     C, E, D = bal.C, bal.E, bal.D
     nC, nE, nD = (float(np.linalg.norm(X, 2)) if X.size else 0.0 for X in (C, E, D))
     # data known to double precision; C E is a sum of n products, so its round-off
@@ -390,17 +442,19 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
     eps = np.finfo(float).eps
     rtol = tols.RANK_RTOL * eps
     dE, dD = rank_decision(E, rtol=rtol), rank_decision(D, rtol=rtol)
-    dG = rank_decision(
-        np.hstack([C @ E, D]), scale=max(nC * nE, nD), rtol=tols.RANK_RTOL * max(bal.n, 1) * eps
-    )
+    G = np.hstack([C @ E, D])
+    dG = rank_decision(G, scale=max(nC * nE, nD), rtol=tols.RANK_RTOL * max(bal.n, 1) * eps)
     rE, rD, rG = dE.rank, dD.rank, dG.rank
     margin = min(dE.margin, dD.margin, dG.margin)
     below = min(dE.below, dD.below, dG.below)
     if bal.nv:
         lhs, rhs = f"rank([CE D]) = {rG}", f"rank(E) + rank(D) = {rE} + {rD}"
+        name = "[CE D]"
     else:
         lhs, rhs = f"rank(CE) = {rG}", f"rank(E) = {rE}"
+        name = "CE"
     ok = rG == rE + rD
+    undecided = False
     if ok:
         reason = f"{lhs} = {rhs.split(' = ')[0]}: the unknown inputs can be decoupled"
     else:
@@ -408,6 +462,36 @@ def rank_condition(bal: Plant) -> tuple[Condition, int]:
             f"{lhs} but {rhs}: part of the unknown input does not show in the outputs "
             "at once, so it cannot be cancelled"
         )
+        if not exact_rank_deficient(plant):
+            undecided = True
+    if undecided:
+        if rG < rE + rD:
+            # a singular value of [CE D] that the ranks of E and D need lies within its bound
+            s = np.linalg.svd(G, compute_uv=False) if G.size else np.zeros(0)
+            k = min(rG, s.size - 1)
+            which, scale, bound_ = name, max(nC * nE, nD), dG.threshold
+            of = "||C|| ||E||" if not bal.nv else "its factors"
+        else:
+            # a singular value of E (or D) just below its own bound: a plant that close has
+            # a larger rank(E) + rank(D)
+            X, d_ = (E, dE) if dE.below <= dD.below else (D, dD)
+            s = np.linalg.svd(X, compute_uv=False)
+            k = min(d_.rank, s.size - 1)
+            which = "E" if X is E else "D"
+            scale, bound_ = (float(s[0]) if s.size else 1.0), d_.threshold
+            of = f"||{which}||"
+        sv = float(s[k]) if 0 <= k < s.size else 0.0
+        cond = Condition(
+            "rank condition",
+            None,
+            f"cannot be decided at this precision: singular value {k + 1} of {which} is "
+            f"{sv / scale:.3g} of {of} (balanced units), within its bound "
+            f"{bound_ / scale:.3g} (the rounding of the data and of the product {name}): a "
+            "plant that close meets the rank condition, another does not",
+            margin=min(margin, below),
+            undecided=True,
+        )
+        return cond, rE
     note = _margin_note(margin)
     if below < tols.DROP_MARGIN:
         note += (
@@ -451,7 +535,8 @@ def zero_condition(zs: ZeroSet) -> Condition:
     where = "unit circle" if discrete else "imaginary axis"
     zeros, und, stable = zs.zeros, zs.undecided, zs.stable
     bound = f"{zs.backward_error:.1g}"
-    bad = ~stable & ~und
+    fragile = np.zeros(zeros.size, bool) if zs.fragile is None else zs.fragile
+    bad = ~stable & ~und & ~fragile
     if np.any(bad):
         return Condition(
             name,
@@ -468,7 +553,15 @@ def zero_condition(zs: ZeroSet) -> Condition:
             f"perturbation of the data within its backward error ({bound} relative) sends them "
             "through infinity, so they may lie on either side or not exist"
         )
-    near = und & ~far
+    gone = fragile & ~stable
+    if np.any(gone):
+        parts.append(
+            f"zero(s) {_listed(zeros[gone], zs.radius[gone])} may lie outside {region}, but "
+            "with more outputs than unknown inputs a zero holds only by the structure of the "
+            f"data: a plant within its backward error ({bound} relative) has it, another has "
+            "none, and the data themselves may have either"
+        )
+    near = und & ~far & ~gone
     for z, r, d in zip(zeros[near], zs.radius[near], zs.distance[near], strict=True):
         parts.append(
             f"zero {format_complex(z)} lies {d:.2g} from the {where}, and a perturbation of the "
@@ -676,14 +769,47 @@ def check_existence(plant: Plant) -> ExistenceReport:
     plant = check_plant(plant)
     discrete = plant.is_discrete
     bal, scaling = balanced_plant(plant, time=True)
-    rank_cond, rE = rank_condition(bal)
+    rank_cond, rE = rank_condition(bal, plant)
     conds = [rank_cond]
     # the zeros in the plant's own time unit (the states, inputs and outputs balanced)
     bal0, _ = balanced_plant(plant, scaling)
-    Bz = np.hstack([bal0.E, np.zeros((plant.n, plant.nv))])
-    Dz = np.hstack([np.zeros((plant.p, plant.q)), bal0.D])
-    zs = checked_zeros(bal0.A, Bz, bal0.C, Dz, discrete=discrete)
-    zero_cond = zero_condition(zs)
+    zs = None
+    if rank_cond.holds:
+        # proven disks on the structure-revealing reduction (square and tall plants alike)
+        # (continuous time: in the balanced time unit, then back in the plant's)
+        src = bal0 if discrete else bal
+        zs = validated_zeros(src.A, src.E, src.C, src.D, discrete=discrete)
+        if zs is not None and not discrete:
+            f = scaling.sigma
+            zs = zs._replace(
+                zeros=zs.zeros * f,
+                radius=zs.radius * f,
+                distance=zs.distance * f,
+                scale=zs.scale * f,
+            )
+    if zs is None:
+        Bz = np.hstack([bal0.E, np.zeros((plant.n, plant.nv))])
+        Dz = np.hstack([np.zeros((plant.p, plant.q)), bal0.D])
+        zs = checked_zeros(bal0.A, Bz, bal0.C, Dz, discrete=discrete)
+    if rank_cond.undecided:
+        zero_cond = Condition(
+            "invariant zeros stable",
+            None,
+            "not evaluated: the rank condition cannot be decided, and plants that close differ "
+            f"in their zeros (these data's: {_listed(zs.zeros)})",
+        )
+    elif rank_cond.holds and not zs.validated:
+        zero_cond = Condition(
+            "invariant zeros stable",
+            None,
+            "cannot be decided at this precision: the rank condition holds by too little "
+            "for the zeros to be bounded (a plant within round-off has some of them at "
+            f"infinity); these data's zeros: {_listed(zs.zeros)}",
+            margin=1.0,
+            undecided=True,
+        )
+    else:
+        zero_cond = zero_condition(zs)
     conds.append(zero_cond)
     zeros = zs.zeros
     fixed = np.zeros(0, complex)

@@ -601,11 +601,21 @@ class ZeroSet(NamedTuple):
     crossing: bool = False
     discrete: bool = False
     scale: float = 1.0
+    fragile: np.ndarray | None = None
+    """For each zero, whether a plant within ``backward_error`` of the data lacks it (a zero of
+    a plant with more outputs than unknown inputs is not generic: it holds by the structure of
+    the data, and a perturbation of that size removes it); ``None``: no zero is fragile."""
+    validated: bool = False
+    """True when ``radius`` is a proven bound (:mod:`uio_teach.enclosures`), not an estimate."""
 
     @property
     def undecided(self) -> np.ndarray:
-        """For each zero, whether round-off of the data can move it across the boundary."""
-        return self.unresolved | (self.radius >= self.distance)
+        """For each zero, whether round-off of the data can move it across the boundary, or
+        remove it while it may lie outside the stability region."""
+        und = self.unresolved | (self.radius >= self.distance)
+        if self.fragile is not None:
+            und = und | (self.fragile & ~self.stable)
+        return und
 
     @property
     def decided(self) -> bool:

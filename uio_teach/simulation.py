@@ -339,6 +339,12 @@ def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.nda
     if value is None:
         return np.zeros((k, N))
     if k == 0:
+        if not callable(value) and not (
+            isinstance(value, (list, tuple)) and value and all(callable(f) for f in value)
+        ):
+            arr = np.asarray(value, dtype=object) if not isinstance(value, np.ndarray) else value
+            if arr.size == 0 and arr.ndim in (1, 2) and (arr.ndim == 1 or arr.shape[1] in (0, N)):
+                return np.zeros((0, N))  # an absent input given as an empty array
         what, dim, mat = _WHAT[name]
         raise ValueError(
             f"{name} was given but the plant has no {what} ({dim} = 0, {mat} has no columns)"

@@ -141,6 +141,33 @@ class Observer:
         )
 
     # helpers ----------------------------------------------------------------
+    def refuse_if_unstable(self, requested: np.ndarray | None) -> None:
+        """Refuse a design whose error poles leave the stability region when none requested did.
+
+        The fixed modes (the invariant zeros) are decided inside the region by the existence
+        check, and the requested poles are inside it: an error pole on or beyond the boundary
+        then comes from round-off of the design, and the observer's error would not decay.
+        Raises ``uio_teach.verify.PlacementAccuracyError`` naming the poles.
+        """
+        from ..verify import PlacementAccuracyError
+
+        if requested is None:
+            return
+        discrete = self.plant.is_discrete
+        if not np.all(is_stable(np.asarray(requested, complex), discrete, margin=0.0)):
+            return  # unstable poles were asked for: warn_if_unstable says so
+        bad = [p for p in self.poles() if not is_stable([p], discrete, margin=0.0)[0]]
+        if not bad:
+            return
+        region = "unit disk" if discrete else "left half-plane"
+        raise PlacementAccuracyError(
+            f"the {self.family} design has error pole(s) "
+            + ", ".join(format_complex(p) for p in bad)
+            + f" on or outside the open {region}, although every requested pole and every "
+            "fixed mode lies inside: round-off of the design moved them there, so the "
+            "estimation error would not decay; no observer is returned"
+        )
+
     def warn_if_unstable(self) -> None:
         """Warn (``UnstableObserverWarning``) when the error dynamics are not stable."""
         if not self.is_stable:

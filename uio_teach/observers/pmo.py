@@ -212,5 +212,6 @@ def design_pmo(
             zeros=report.invariant_zeros,
             radius=report.zero_radius,
         )
+    obs.refuse_if_unstable(requested)
     obs.warn_if_unstable()
     return obs

@@ -149,5 +149,6 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
             zeros=report.invariant_zeros,
             radius=report.zero_radius,
         )
+    obs.refuse_if_unstable(requested)
     obs.warn_if_unstable()
     return obs
