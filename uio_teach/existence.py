@@ -268,6 +268,15 @@ class ExistenceReport:
         return "no UIO with stable error dynamics exists"
 
     @property
+    def delayed(self):
+        """When no plain UIO exists: whether one that waits ``L`` samples does, and the smallest
+        ``L`` (discrete time), or what the missing derivatives would cost (continuous time);
+        ``None`` when the plain UIO exists. See :func:`uio_teach.delay_verdict`."""
+        from .observers.delayed import delay_verdict  # deferred: the observers import this
+
+        return None if self.ok else delay_verdict(self.plant, self)
+
+    @property
     def failed(self) -> tuple[Condition, ...]:
         """The required conditions that do not hold or cannot be decided."""
         return tuple(c for c in self.conditions if c.required and (c.holds is False or c.undecided))

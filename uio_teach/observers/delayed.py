@@ -209,10 +209,11 @@ def delay_verdict(plant: Plant, report: ExistenceReport | None = None) -> DelayV
         return DelayVerdict(False, None, tuple(inc), needed, strong, discrete, reason)
     if not discrete:
         cost = (
-            f"the unknown input shows in the {delay}-th derivative of y: an observer would need "
-            f"{delay} derivative(s) of the measurement; a differentiator multiplies noise at "
-            f"frequency w by w^{delay} (and a filtered one lags), so the course builds none: "
-            "discretize the plant and wait for samples instead, or estimate only what is needed"
+            f"the unknown input shows only in the derivative of order {delay + 1} of y: an "
+            f"observer would need {delay} derivative(s) of the measurement (y' ... y^({delay})) "
+            f"as inputs; a differentiator of order {delay} multiplies noise at frequency w by "
+            f"w^{delay} (and a filtered one lags), so the course builds none: sample the plant "
+            "and wait for later samples instead, or estimate only what is needed"
         )
         if strong is False:
             cost += "; and an invariant zero outside the left half-plane would remain a pole"
