@@ -59,7 +59,9 @@ def test_missile_has_no_free_pole_and_the_full_uio_s_fixed_modes():
     report = ut.check_existence(missile)
     obs = ut.design_reduced_uio(missile, poles=[])
     assert obs.order == 2 == report.fixed_modes.size
-    assert _matched(obs.poles(), report.fixed_modes) <= 100 * eigenvalue_roundoff(obs.F) + 1e-9 * 200
+    assert (
+        _matched(obs.poles(), report.fixed_modes) <= 100 * eigenvalue_roundoff(obs.F) + 1e-9 * 200
+    )
     with pytest.raises(ValueError, match=r"0 pole\(s\) can be placed, got 2.*invariant zeros"):
         ut.design_reduced_uio(missile, poles=[-150, -160])
 

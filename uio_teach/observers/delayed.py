@@ -33,10 +33,10 @@ from .. import tolerances as tols
 from .._validation import read_only
 from ..errors import UIOTeachError
 from ..existence import ExistenceReport, check_existence
-from ..linalg import observability_decomposition, one_blas_thread, pinv, rank_decision
+from ..linalg import observability_decomposition, one_blas_thread, rank_decision
 from ..placement import place_observer_poles, requested_poles
 from ..plant import Plant, check_plant
-from ..verify import check_fixed_modes, check_identity, check_poles, product_bound
+from ..verify import check_fixed_modes, check_identity, check_poles
 from .base import Observer, ObserverRealization
 
 __all__ = [
@@ -107,10 +107,17 @@ def stacked_matrices(plant: Plant, a: int) -> tuple[np.ndarray, np.ndarray, np.n
     return Theta, M, J
 
 
-def _rank(M: np.ndarray) -> int:
+def _rank(M: np.ndarray, Theta: np.ndarray, Dt: np.ndarray) -> int:
+    """The rank of ``M`` judged against the size of the data it is made of.
+
+    Its blocks are ``C A^i E~`` (``E~`` has orthonormal columns) and ``D~``: a block that is
+    zero in exact arithmetic is round-off of the size of ``||C A^i||``, which ``Theta``
+    stacks, not of ``M``'s own (possibly tiny) norm.
+    """
     if not M.size:
         return 0
-    return rank_decision(M, rtol=tols.RANK_RTOL * max(M.shape) * tols.EPS).rank
+    scale = max(float(np.linalg.norm(Theta, 2)), float(np.linalg.norm(Dt, 2)) if Dt.size else 0.0)
+    return rank_decision(M, scale=scale, rtol=tols.RANK_RTOL * max(M.shape) * tols.EPS).rank
 
 
 @dataclass(frozen=True)
@@ -150,9 +157,11 @@ class DelayVerdict:
 
 def _increments(plant: Plant, top: int) -> list[int]:
     """``rank M_a - rank M_(a-1)`` for ``a = 1 .. top``."""
-    ranks = [_rank(stacked_matrices(plant, 0)[1])]
-    for a in range(1, top + 1):
-        ranks.append(_rank(stacked_matrices(plant, a)[1]))
+    _, Dt = _unknown_inputs(plant)
+    ranks = []
+    for a in range(top + 1):
+        Theta, M, _ = stacked_matrices(plant, a)
+        ranks.append(_rank(M, Theta, Dt))
     return [ranks[a] - ranks[a - 1] for a in range(1, top + 1)]
 
 
@@ -370,14 +379,17 @@ class DelayedUIO(Observer):
         return super()._title().replace(" for ", f" with delay {self._delay} for ", 1)
 
 
-def _verify(obs: DelayedUIO, M: np.ndarray, Et: np.ndarray, zeros: np.ndarray) -> None:
-    """``F M = [E~ 0 ... 0]`` on the returned gain, and the fixed modes among the poles."""
+def _verify(obs: DelayedUIO, M: np.ndarray, Theta: np.ndarray, Et: np.ndarray, zeros) -> None:
+    """``F M = [E~ 0 ... 0]`` on the returned gain, and the fixed modes among the poles.
+
+    The identity is judged against ``||F|| ||Theta||``: ``M``'s blocks ``C A^i E~`` that are
+    zero in exact arithmetic are round-off of that size, and so is their product with ``F``.
+    """
     what = f"the delayed UIO (delay {obs.delay})"
     target = np.zeros((obs.plant.n, M.shape[1]))
     target[:, : Et.shape[1]] = Et
-    check_identity(
-        "F M = [E 0 ... 0]", obs.F @ M - target, product_bound((obs.F, M), target), what=what
-    )
+    scale = float(np.linalg.norm(obs.F, 2)) * max(float(np.linalg.norm(Theta, 2)), 1.0) + 1.0
+    check_identity("F M = [E 0 ... 0]", obs.F @ M - target, scale, what=what)
     check_fixed_modes(obs.poles(), zeros, what=what)
 
 
@@ -456,17 +468,20 @@ def design_delayed_uio(plant: Plant, poles: Any, delay: Any = None) -> DelayedUI
         )
     a = L + 1
     Theta, M, J = stacked_matrices(plant, a)
-    Et, _ = _unknown_inputs(plant)
+    Et, Dt = _unknown_inputs(plant)
     target = np.zeros((plant.n, M.shape[1]))
     target[:, : Et.shape[1]] = Et
-    F0 = target @ pinv(M)
-    U, _, _ = np.linalg.svd(M, full_matrices=True)
-    Nm = U[:, _rank(M) :].T  # rows annihilating M: the free part of F
+    # F0 = [E~ 0] M^+, with M's rank judged as the verdict judged it (a block that is zero in
+    # exact arithmetic is not inverted)
+    U, s, Vt = np.linalg.svd(M, full_matrices=True)
+    r = _rank(M, Theta, Dt)
+    F0 = (target @ Vt[:r].T / s[:r]) @ U[:, :r].T
+    Nm = U[:, r:].T  # rows annihilating M: the free part of F
     A0, C0 = plant.A - F0 @ Theta, Nm @ Theta
     split = observability_decomposition(A0, C0)
     Z = place_observer_poles(A0, C0, poles, split=split, fixed_name="invariant zeros", verify=False)
     obs = DelayedUIO(plant, L, F0 + Z @ Nm, Theta, J)
-    _verify(obs, M, Et, report.invariant_zeros)
+    _verify(obs, M, Theta, Et, report.invariant_zeros)
     req = requested_poles(
         np.atleast_1d(np.asarray(poles, complex)), split.unobservable_modes, split.Ao.shape[0]
     )
