@@ -217,10 +217,11 @@ def delay_verdict(plant: Plant, report: ExistenceReport | None = None) -> DelayV
         )
         return DelayVerdict(False, None, tuple(inc), needed, strong, discrete, reason)
     if not discrete:
+        needs = "y'" if delay == 1 else f"the derivatives y' ... y^({delay})"
         cost = (
             f"the unknown input shows only in the derivative of order {delay + 1} of y: an "
-            f"observer would need {delay} derivative(s) of the measurement (y' ... y^({delay})) "
-            f"as inputs; a differentiator of order {delay} multiplies noise at frequency w by "
+            f"observer would need {needs} of the measurement as inputs; a differentiator of "
+            f"order {delay} multiplies noise at frequency w by "
             f"w^{delay} (and a filtered one lags), so the course builds none: sample the plant "
             "and wait for later samples instead, or estimate only what is needed"
         )
