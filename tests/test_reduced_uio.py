@@ -169,3 +169,24 @@ def test_residual_and_python_control_view():
     assert_rounding_close(r, resp.residual, size=size_of(resp.outputs), terms=9, steps=t.size)
     # the residual of a reduced-order UIO is zero: y is used as it is (x = R y + V2 eta)
     assert np.abs(resp.residual).max() <= 1e-9 * size_of(resp.outputs)
+
+
+def test_the_explorer_and_the_checks_accept_it():
+    from uio_teach.explorers import make_scenario
+    from uio_teach.explorers.frames import compute_frame
+
+    # the explorer: one movable pole on PA9, none on the missile (both are its zeros)
+    sc = make_scenario(ut.examples.pa9(), "reduced")
+    assert sc.movable == 1 and len(sc.defaults.poles) == 1
+    frame = compute_frame(sc)
+    assert isinstance(frame.observer, ut.ReducedUIO) and frame.observer.order == 1
+    assert frame.response is not None and not frame.observer_message
+    missile = make_scenario(ut.examples.missile_autopilot(), "reduced")
+    assert missile.movable == 0 and compute_frame(missile).observer.order == 2
+    # a lab check of a simulation: the error ignores d and decays
+    plant = ut.examples.pa9()
+    obs = ut.design_reduced_uio(plant, poles=[-3])
+    t = np.linspace(0, 10, 1001)
+    resp = ut.simulate(plant, obs, t, d=ut.signals.sinusoid(1.0, 2.0), initial_state=[1, 1, 1])
+    result = ut.checks.pa9_simulation(resp)
+    assert any("does not depend on d" in m for ok, m in result.items if ok), result

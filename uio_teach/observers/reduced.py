@@ -40,7 +40,7 @@ from ..verify import check_fixed_modes, check_identity, check_poles, product_bou
 from .base import Observer, ObserverRealization
 from .projection import require_existence
 
-__all__ = ["ReducedUIO", "ReducedPair", "design_reduced_uio", "reduced_pair"]
+__all__ = ["ReducedUIO", "ReducedPair", "design_reduced_uio", "reduced_movable", "reduced_pair"]
 
 
 class ReducedPair(NamedTuple):
@@ -111,6 +111,19 @@ def reduced_pair(plant: Plant) -> ReducedPair:
     C2 = Pi @ Ct @ A @ V2
     split = observability_decomposition(A22, C2)
     return ReducedPair(W, Ct, V2, R, P, Pi, A22, C2, split)
+
+
+def reduced_movable(plant: Plant, report: ExistenceReport) -> int:
+    """How many poles of the reduced-order UIO a gain places (0 when no UIO exists).
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> plant = ut.examples.missile_autopilot()
+    >>> reduced_movable(plant, ut.check_existence(plant))
+    0
+    """
+    return int(reduced_pair(plant).split.Ao.shape[0]) if report.ok else 0
 
 
 class ReducedUIO(Observer):
