@@ -269,9 +269,11 @@ class ExistenceReport:
 
     @property
     def delayed(self):
-        """When no plain UIO exists: whether one that waits ``L`` samples does, and the smallest
-        ``L`` (discrete time), or what the missing derivatives would cost (continuous time);
-        ``None`` when the plain UIO exists. See :func:`uio_teach.delay_verdict`."""
+        """Whether a UIO that waits ``L`` samples exists when the plain one does not.
+
+        The smallest ``L`` (discrete time), or what the missing derivatives would cost
+        (continuous time); ``None`` when the plain UIO exists. See
+        :func:`uio_teach.delay_verdict`."""
         from .observers.delayed import delay_verdict  # deferred: the observers import this
 
         return None if self.ok else delay_verdict(self.plant, self)

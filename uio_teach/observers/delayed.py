@@ -50,7 +50,18 @@ __all__ = [
 
 
 class DelayedUIOExistenceError(UIOTeachError, ValueError):
-    """No delayed UIO exists for the plant (or not with the delay asked); ``.verdict`` says why."""
+    """No delayed UIO exists for the plant (or not with the delay asked); ``.verdict`` says why.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> plant = ut.Plant([[0.5, 1.0], [0.0, 0.3]], [[1.0, 0.0]], E=[0.0, 1.0], dt=1)
+    >>> try:
+    ...     ut.design_uio(plant, poles=[0.1, 0.2], delay=0)
+    ... except ut.UIOExistenceError as err:
+    ...     print(err.report.delayed.delay)
+    1
+    """
 
     def __init__(self, message: str, verdict: DelayVerdict) -> None:
         super().__init__(message)
@@ -141,6 +152,14 @@ class DelayVerdict:
     discrete : bool
     reason : str
         The verdict in a sentence.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> plant = ut.Plant([[0.5, 1.0], [0.0, 0.3]], [[1.0, 0.0]], E=[0.0, 1.0], dt=1)
+    >>> v = ut.check_existence(plant).delayed
+    >>> v.exists, v.delay, v.increments[:2]
+    (True, 1, (0, 1))
     """
 
     exists: bool
@@ -291,7 +310,7 @@ class DelayedUIO(Observer):
 
     @property
     def delay(self) -> int:
-        """``L``: the estimate of ``x[k]`` uses the outputs up to ``y[k + L]``."""
+        """The delay ``L`` in samples (the estimate of ``x[k]`` uses ``y`` up to ``y[k + L]``)."""
         return self._delay
 
     @property

@@ -194,12 +194,12 @@ class ReducedUIO(Observer):
 
     @property
     def P(self) -> np.ndarray:
-        """``xhat = P w + Q y``: the observer state's map into the state (n x r)."""
+        """The observer state's map into the state estimate (n x r), ``xhat = P w + Q y``."""
         return self._P
 
     @property
     def Q(self) -> np.ndarray:
-        """``xhat = P w + Q y``: the measurement's direct part."""
+        """The measurement's direct part of the estimate, ``xhat = P w + Q y``."""
         return self._Q
 
     @property
@@ -209,12 +209,15 @@ class ReducedUIO(Observer):
 
     @property
     def theta(self) -> np.ndarray:
-        """What the observer state estimates: ``w -> theta x`` (``theta E = 0``)."""
+        """What the observer state estimates, ``w -> theta x`` (``theta E = 0``)."""
         return self._theta
 
     @property
     def error_matrix(self) -> np.ndarray:
-        """``F``: the error ``eps = theta x - w`` obeys ``eps' = F eps``; ``x - xhat = P eps``."""
+        """The error dynamics ``F`` (``eps' = F eps`` for ``eps = theta x - w``).
+
+        The estimation error is ``x - xhat = P eps``.
+        """
         return self._F
 
     def realization(self) -> ObserverRealization:
