@@ -220,3 +220,15 @@ def test_other_bad_input():
     obs = ut.design_uio(plant, poles=[0.1, 0.2, 0.3], delay=1)
     with pytest.raises(ValueError, match="observer_state"):
         ut.simulate(plant, obs, np.arange(10), observer_state=np.zeros(7))
+
+
+def test_observer_residual_uses_the_aligned_estimate():
+    plant = ut.Plant(A3, [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], B=[1.0, 0.0, 1.0], E=[0, 1, 0], dt=1)
+    obs = ut.design_uio(plant, poles=[0.2, 0.3, 0.4], delay=1)
+    t = np.arange(20)
+    rng = np.random.default_rng(4)
+    resp = ut.simulate(plant, obs, t, u=rng.normal(size=20), d=rng.normal(size=20))
+    r = ut.observer_residual(obs, t, resp.inputs.u, resp.outputs)
+    assert np.all(np.isnan(r[:, -1])) and np.all(np.isnan(resp.residual[:, -1]))
+    size = size_of(resp.outputs, resp.estimates[:, :-1])
+    assert_rounding_close(r[:, :-1], resp.residual[:, :-1], size=size, terms=9, steps=20)
