@@ -270,6 +270,17 @@ class ExistenceReport:
         return "no UIO with stable error dynamics exists"
 
     @property
+    def delayed(self):
+        """Whether a UIO that waits ``L`` samples exists when the plain one does not.
+
+        The smallest ``L`` (discrete time), or what the missing derivatives would cost
+        (continuous time); ``None`` when the plain UIO exists. See
+        :func:`uio_teach.delay_verdict`."""
+        from .observers.delayed import delay_verdict  # deferred: the observers import this
+
+        return None if self.ok else delay_verdict(self.plant, self)
+
+    @property
     def failed(self) -> tuple[Condition, ...]:
         """The required conditions that do not hold or cannot be decided."""
         return tuple(c for c in self.conditions if c.required and (c.holds is False or c.undecided))

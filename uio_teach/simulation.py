@@ -1165,7 +1165,10 @@ def simulate(
         Plant state at ``timepts[0]``; zero by default.
     observer_state : array_like, shape (n_w,), optional
         Observer state ``w`` at ``timepts[0]``; zero by default. The first
-        estimate is then ``xhat = D_y y`` (``H y`` for the UIO).
+        estimate is then ``xhat = D_y y`` (``H y`` for the UIO). For a delayed UIO
+        (``design_uio(..., delay=L)``) it is the first estimate ``xhat[0]`` (n values), and
+        column ``k`` of the estimates is the estimate of ``x[k]``, known ``L`` samples later:
+        the last ``L`` columns are ``nan``.
     noise : float or array_like, shape (p,), optional
         Standard deviation of white Gaussian measurement noise, one value for
         all outputs or one per output. It is sampled at the time points and,
@@ -1283,7 +1286,9 @@ def simulate(
     x0 = _vector(
         "initial_state", initial_state, plant.n, f"one value per plant state, n = {plant.n}"
     )
-    w0 = _vector("observer_state", observer_state, nw, f"one value per observer state, n_w = {nw}")
+    # a delayed observer (delay L > 0) starts from its estimate xhat[0]: n values
+    delay = getattr(observer, "delay", 0)
+    w0 = _vector("observer_state", None if delay else observer_state, nw, "n_w values")
     z0 = np.concatenate([x0, w0])
 
     Az, Bz = _joint(plant, real)
@@ -1312,6 +1317,9 @@ def simulate(
     signals.setflags(write=False)
     x, w = signals[:n], signals[n : n + nw]
     y, xhat = signals[n + nw : n + nw + p], signals[n + nw + p :]
+    if delay:  # the estimate of x[k] in column k (known L samples later); the last L are nan
+        xhat0 = _vector("observer_state", observer_state, n, f"xhat[0], n = {n} values")
+        xhat = observer.aligned_estimates(y, inputs.u, xhat0)
     return UIOResponse(
         time=t,
         states=x,

@@ -47,6 +47,7 @@ from ..observers import (
     design_ginverse,
     design_luenberger,
     design_pmo,
+    design_reduced_uio,
     design_uio,
 )
 from ..reconstruction import InputEstimate, reconstruct_input
@@ -257,7 +258,9 @@ def _design_now(scenario: Scenario, s: Settings) -> tuple[Observer | None, str, 
                 obs = scenario.cache[key]
             else:
                 poles = expand_poles(s.poles)
-                design = design_uio if scenario.family == "uio" else design_pmo
+                design = {"uio": design_uio, "reduced": design_reduced_uio}.get(
+                    scenario.family, design_pmo
+                )
                 obs = design(plant, poles=poles)
     except (LMIInfeasibleError, LMISolverError) as exc:
         return None, lmi_message(scenario, float(s.decay), exc), notes
@@ -528,6 +531,8 @@ def _modes(run: _Run) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, n
     excited = np.zeros(poles.size, bool)
     e0 = run.starts.get("uio", np.zeros(0))
     if obs is not None and "uio" in run.starts:
+        if obs.error_matrix.shape[0] != e0.size:  # a reduced-order observer: x - xhat = C_o eps
+            e0 = np.linalg.lstsq(obs.realization().C, e0, rcond=None)[0]
         excited = match_poles(poles, excited_modes(obs.error_matrix, e0))
         scale = max(1.0, float(np.abs(poles).max()))
         for i in range(poles.size):  # a repeated pole: one excited copy excites that value

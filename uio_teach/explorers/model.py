@@ -31,6 +31,7 @@ import numpy as np
 
 from .. import signals
 from ..existence import ExistenceReport
+from ..observers.reduced import reduced_movable
 from ..plant import Plant
 
 __all__ = [
@@ -50,7 +51,12 @@ __all__ = [
 DISTURBANCES = ("sinusoid", "piecewise constant", "damped sinusoid", "random steps")
 """The disturbance types an explorer offers."""
 
-FAMILIES = {"uio": "UIO", "pmo": "PMO", "ginverse": "g-inverse observer"}
+FAMILIES = {
+    "uio": "UIO",
+    "pmo": "PMO",
+    "ginverse": "g-inverse observer",
+    "reduced": "reduced-order UIO",
+}
 """Observer families, each argument value with its display name."""
 
 STARTS = {
@@ -319,6 +325,8 @@ class Scenario:
     @property
     def movable(self) -> int:
         """How many observer poles the controls set (0 for the g-inverse observer)."""
+        if self.family == "reduced":
+            return reduced_movable(self.plant, self.existence)
         return 0 if self.family == "ginverse" else self.existence.movable
 
     @property

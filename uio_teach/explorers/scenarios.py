@@ -25,6 +25,7 @@ import numpy as np
 from ..existence import check_existence
 from ..experiments import experiment_params
 from ..linalg import is_stable, rank
+from ..observers.reduced import reduced_movable
 from ..plant import Plant
 from ..worked import WORKED, RegistryError
 from .model import (
@@ -225,6 +226,8 @@ def make_scenario(
     report = check_existence(plant)
     discrete = plant.is_discrete
     k = 0 if observer_family == "ginverse" else report.movable
+    if observer_family == "reduced":
+        k = reduced_movable(plant, report)
     fixed = report.fixed_modes
     if poles is None:
         eig = np.abs(np.linalg.eigvals(plant.A)) if plant.n else np.zeros(0)

@@ -12,17 +12,27 @@ these matrices, :meth:`Observer.as_statespace` the python-control system, and
 
 The package is split by family: :mod:`.base` (the observer, its
 realization), :mod:`.projection` (what the UIO and the PMO share),
-:mod:`.uio`, :mod:`.pmo`, :mod:`.ginverse` and :mod:`.luenberger_observer`.
+:mod:`.uio`, :mod:`.pmo`, :mod:`.ginverse`, :mod:`.luenberger_observer`,
+:mod:`.reduced` (the reduced-order UIO) and :mod:`.delayed` (the UIO that waits for
+later samples).
 Every name is importable from ``uio_teach.observers``.
 """
 
 from __future__ import annotations
 
 from .base import Observer, ObserverRealization, UnstableObserverWarning
+from .delayed import (
+    DelayedUIO,
+    DelayedUIOExistenceError,
+    DelayVerdict,
+    delay_verdict,
+    design_delayed_uio,
+)
 from .ginverse import GInverseObserver, design_ginverse
 from .luenberger_observer import LuenbergerObserver, design_luenberger
 from .pmo import PMO, design_pmo
 from .projection import ProjectionObserver
+from .reduced import ReducedUIO, design_reduced_uio
 from .uio import UIO, design_uio
 
 __all__ = [
@@ -38,6 +48,13 @@ __all__ = [
     "design_pmo",
     "design_ginverse",
     "design_luenberger",
+    "ReducedUIO",
+    "design_reduced_uio",
+    "DelayedUIO",
+    "DelayVerdict",
+    "DelayedUIOExistenceError",
+    "delay_verdict",
+    "design_delayed_uio",
 ]
 
 # documented (and shown in tracebacks) under the name they are imported by

@@ -12,6 +12,7 @@ from ..linalg import one_blas_thread
 from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
 from ..verify import check_poles
+from .delayed import DelayedUIO, design_delayed_uio
 from .projection import ProjectionObserver, decoupled_gain, require_existence, verify_projection
 
 __all__ = ["UIO", "design_uio"]
@@ -69,7 +70,9 @@ class UIO(ProjectionObserver):
 
 
 @one_blas_thread()
-def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
+def design_uio(
+    plant: Plant, poles: Any = None, *, K1: Any = None, delay: int = 0
+) -> UIO | DelayedUIO:
     """Design the unknown-input decoupling observer of Practical Assignment 9.
 
     ``H = E (CE)^+``, ``T = I - H C``, ``F = T A - K1 C``, ``K2 = F H``,
@@ -87,10 +90,15 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
         :func:`check_existence`, ``fixed_modes``).
     K1 : array_like, shape (n, p), optional
         An explicit gain instead of ``poles`` (to reproduce a printed design).
+    delay : int, optional
+        ``L > 0``: a discrete-time UIO that estimates ``x[k]`` from the outputs up to
+        ``y[k + L]``, for plants whose rank condition fails
+        (:func:`~uio_teach.design_delayed_uio`, which it returns); 0, the default, is this UIO.
 
     Returns
     -------
     UIO
+        (a :class:`~uio_teach.DelayedUIO` when ``delay > 0``)
 
     Raises
     ------
@@ -128,6 +136,10 @@ def design_uio(plant: Plant, poles: Any = None, *, K1: Any = None) -> UIO:
            [0.  , 0.  ],
            [0.24, 0.06]])
     """
+    if delay is not None and not (isinstance(delay, int | np.integer) and delay == 0):
+        if K1 is not None:
+            raise ValueError("give poles= with delay= (a delayed UIO is designed by its poles)")
+        return design_delayed_uio(plant, poles, delay)  # checks the delay and the plant
     plant = check_plant(plant)
     if (poles is None) == (K1 is None):
         raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
