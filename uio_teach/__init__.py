@@ -35,6 +35,13 @@ from .errors import UIOTeachError, UIOTeachWarning
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
 from .lmi import LMIError, LMIInfeasibleError, LMIResult, LMISolverError, lmi_gain
+from .nullspace import (
+    FaultModel,
+    NullspaceFilter,
+    NullspaceFilterError,
+    design_nullspace_filter,
+    fault_model,
+)
 from .observers import (
     PMO,
     UIO,
@@ -130,5 +137,10 @@ __all__ = [
     "UIOBank",
     "BankMember",
     "Isolation",
+    "fault_model",
+    "FaultModel",
+    "design_nullspace_filter",
+    "NullspaceFilter",
+    "NullspaceFilterError",
     "explorers",
 ]
