@@ -39,6 +39,7 @@ from .nullspace import (
     FaultModel,
     NullspaceFilter,
     NullspaceFilterError,
+    decoupling_gap,
     design_nullspace_filter,
     fault_model,
 )
@@ -142,5 +143,6 @@ __all__ = [
     "design_nullspace_filter",
     "NullspaceFilter",
     "NullspaceFilterError",
+    "decoupling_gap",
     "explorers",
 ]

@@ -54,6 +54,7 @@ __all__ = [
     "FilterResponse",
     "fault_model",
     "design_nullspace_filter",
+    "decoupling_gap",
 ]
 
 
@@ -445,6 +446,8 @@ class FilterResponse:
     ----------
     time : numpy.ndarray
         Shape (N,).
+    states : numpy.ndarray
+        Shape (n, N): the plant's state.
     outputs : numpy.ndarray
         Shape (p, N): the measurements ``y`` (noise included).
     residual : numpy.ndarray
@@ -463,6 +466,7 @@ class FilterResponse:
     """
 
     time: np.ndarray
+    states: np.ndarray
     outputs: np.ndarray
     residual: np.ndarray
     u: np.ndarray
@@ -536,7 +540,7 @@ class NullspaceFilter:
     basis = property(lambda self: self._basis, doc="Coefficients of [w_y(s), w_u(s)] per row.")
     fault_basis = property(lambda self: self._fault_basis, doc="Coefficients of w_y(s) Gf(s).")
     structure = property(lambda self: self._structure, doc="Fault j reaches residual i.")
-    detected = property(lambda self: self._detected, doc="Per fault: it reaches the residual.")
+    detected = property(lambda self: self._detected, doc="True for each fault that reaches the residual.")
 
     @property
     def fault_names(self) -> tuple[str, ...]:
@@ -545,7 +549,7 @@ class NullspaceFilter:
 
     @property
     def order(self) -> int:
-        """The number of states of ``Q`` (and of ``Rf``): the sum of the degrees."""
+        """The number of states of ``Q`` (and of ``Rf``), the sum of the degrees."""
         return int(sum(self._degrees))
 
     @property
@@ -641,7 +645,7 @@ class NullspaceFilter:
         >>> filt.decoupling_gap() < 1e-12
         True
         """
-        return _gap(self._Q, self._model, points, self._scale)
+        return decoupling_gap(self._Q, self._model, points)
 
     def residual(
         self, timepts: Any, outputs: Any, inputs: Any = None, *, initial_state: Any = None
@@ -804,6 +808,7 @@ class NullspaceFilter:
         B = np.vstack([Bcol, Bqy @ Dcol + np.hstack([Bqu, np.zeros((nq, md + mf + p))])])
         out = np.block(
             [
+                [np.eye(n), np.zeros((n, nq + mu + md + mf + p))],
                 [model.C, np.zeros((p, nq)), Dcol],
                 [
                     Dqy @ model.C,
@@ -819,7 +824,16 @@ class NullspaceFilter:
                 discrete=model.is_discrete, output=out,
             )
         )  # fmt: skip
-        return FilterResponse(time=t, outputs=yr[:p], residual=yr[p:], u=us, d=ds, f=fs, noise=ns)
+        return FilterResponse(
+            time=t,
+            states=yr[:n],
+            outputs=yr[n : n + p],
+            residual=yr[n + p :],
+            u=us,
+            d=ds,
+            f=fs,
+            noise=ns,
+        )
 
     # display ----------------------------------------------------------------------------------
     def report(self) -> str:
@@ -857,34 +871,89 @@ class NullspaceFilter:
         return self.report()
 
 
-def _gap(Q: Any, model: FaultModel, points: Any, scale: float) -> float:
+def decoupling_gap(Q: Any, model: FaultModel, points: Any = None) -> float:
+    """Largest entry of ``Q(s) [[Gu, Gd], [I, 0]]`` at ``points``, relative to its terms' size.
+
+    The check of any residual generator ``r = Q [y; u]`` (a designed one, or
+    one built by hand): zero in exact arithmetic when ``Q`` annihilates the
+    known inputs and the disturbances, a few ``eps`` times the conditioning
+    after rounding, of order 1 when it does not.
+
+    Parameters
+    ----------
+    Q : control.StateSpace or control.TransferFunction
+        Inputs ``[y; u]`` (p + mu of them).
+    model : FaultModel
+        The plant (:func:`fault_model`).
+    points : array_like of complex, optional
+        Values of ``s`` (or ``z``); default five generic points near the
+        imaginary axis on the plant's time scale (near the unit circle in
+        discrete time).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    NullspaceFilterError
+        If ``Q`` does not have ``p + mu`` inputs.
+
+    Examples
+    --------
+    ``[I, -Gu]`` cancels the known inputs but not the disturbance:
+
+    >>> import numpy as np
+    >>> import control as ct
+    >>> import uio_teach as ut
+    >>> model = ut.fault_model(ut.examples.varga_5_4(), [2, 3], known=[0], disturbances=[1])
+    >>> sys = ut.examples.varga_5_4()
+    >>> I_minus_Gu = ct.ss(sys.A, np.hstack([np.zeros((3, 2)), -sys.B[:, :1]]), sys.C,
+    ...                    np.hstack([np.eye(2), -sys.D[:, :1]]))
+    >>> ut.decoupling_gap(I_minus_Gu, model) > 0.1
+    True
+    """
+    import control as ct  # deferred on purpose: python-control takes a second to import
+
+    Q = ct.ss(Q)
+    if Q.ninputs != model.p + model.mu:
+        raise NullspaceFilterError(
+            f"Q has {Q.ninputs} inputs, expected p + mu = {model.p + model.mu} ([y; u])"
+        )
     n = model.n
+    scale = float(np.linalg.norm(model.A, 2)) if n else 1.0
+    scale = scale or 1.0
     if points is None:  # generic points (no pole of the data sits on them), on the data's scale
         w = np.array([0.1, 0.5, 1.0, 2.0, 3.0])
         points = 0.9 * np.exp(1j * w) if model.is_discrete else scale * (0.05 + 1j * w)
     worst = 0.0
+    nq = Q.nstates
+    Aq, Bq, Cq, Dq = (
+        np.asarray(M, float).reshape(shape)
+        for M, shape in (
+            (Q.A, (nq, nq)),
+            (Q.B, (nq, Q.ninputs)),
+            (Q.C, (Q.noutputs, nq)),
+            (Q.D, (Q.noutputs, Q.ninputs)),
+        )
+    )
     for s in np.atleast_1d(np.asarray(points, dtype=complex)):
-        R = np.linalg.solve(s * np.eye(n) - model.A, np.hstack([model.Bu, model.Bd])) if n else None
-        G = np.hstack([model.Du, model.Dd]) + (model.C @ R if n else 0)
+        G = np.hstack([model.Du, model.Dd]).astype(complex)
+        if n:
+            G = G + model.C @ np.linalg.solve(
+                s * np.eye(n) - model.A, np.hstack([model.Bu, model.Bd])
+            )
         big = np.vstack([G, np.hstack([np.eye(model.mu), np.zeros((model.mu, model.md))])])
-        nq = Q.nstates
-        Aq, Bq, Cq, Dq = (np.asarray(M, float) for M in (Q.A, Q.B, Q.C, Q.D))
         Qs = Dq + (Cq @ np.linalg.solve(s * np.eye(nq) - Aq, Bq) if nq else 0)
-        prod = Qs @ big
         size = np.linalg.norm(Qs, 2) * np.linalg.norm(big, 2)
         if size > 0:
-            worst = max(worst, float(np.abs(prod).max() / size))
+            worst = max(worst, float(np.abs(Qs @ big).max() / size))
     return worst
 
 
 def _allot(poles: np.ndarray, degrees: list[int], discrete: bool) -> list[np.ndarray]:
     order = sum(degrees)
-    if poles.size == 1 and order != 1:
-        if poles[0].imag != 0:
-            raise NullspaceFilterError(
-                "poles: a single complex pole cannot be repeated for every state; give the "
-                f"filter's {order} poles in conjugate pairs"
-            )
+    if poles.size == 1 and order != 1 and poles[0].imag == 0:
         poles = np.repeat(poles, order)
     if poles.size != order:
         raise NullspaceFilterError(
