@@ -540,7 +540,9 @@ class NullspaceFilter:
     basis = property(lambda self: self._basis, doc="Coefficients of [w_y(s), w_u(s)] per row.")
     fault_basis = property(lambda self: self._fault_basis, doc="Coefficients of w_y(s) Gf(s).")
     structure = property(lambda self: self._structure, doc="Fault j reaches residual i.")
-    detected = property(lambda self: self._detected, doc="True for each fault that reaches the residual.")
+    detected = property(
+        lambda self: self._detected, doc="True for each fault that reaches the residual."
+    )
 
     @property
     def fault_names(self) -> tuple[str, ...]:
