@@ -397,3 +397,21 @@ def test_a_conjugate_pair_is_placed(pa9):
     got = np.sort_complex(filt.poles())
     assert np.abs(got - np.array([-1 - 2j, -1 + 2j])).max() <= eigenvalue_roundoff(filt.Q.A)
     assert_decoupled(filt)
+
+
+def test_redundant_sensors_give_a_static_filter():
+    # three sensors of one state (the triplex redundancy of Varga's examples): constant rows
+    plant = ut.Plant([[-1.0]], [[1.0], [1.0], [1.0]], B=[[1.0]], E=[[1.0]])
+    step = ut.signals.step(1.0, 1.0)
+    faults = [ut.sensor_fault(plant, j, step) for j in range(3)]
+    filt = ut.design_nullspace_filter(plant, faults, poles=-1)
+    assert filt.degrees == (0, 0) and filt.order == 0 and filt.poles().size == 0
+    assert filt.detected == (True, True, True)
+    assert_decoupled(filt)
+    t = np.linspace(0, 3, 301)
+    run = filt.simulate(t, u=ut.signals.sinusoid(1.0, 2.0),
+                        d=ut.signals.step(2.0, 0.5), fault=faults[1])  # fmt: skip
+    before = run.residual[:, t < 1.0]
+    assert_rounding_close(before, 0.0, size=size_of(run.outputs), terms=3)
+    # after the fault: the fault's column of Rf, a constant gain
+    assert_rounding_close(run.residual[:, -1], filt.Rf.D[:, 1], size=1.0, terms=3)
