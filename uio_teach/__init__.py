@@ -42,6 +42,14 @@ from .errors import UIOTeachError, UIOTeachWarning
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
 from .lmi import LMIError, LMIInfeasibleError, LMIResult, LMISolverError, lmi_gain
+from .nullspace import (
+    FaultModel,
+    NullspaceFilter,
+    NullspaceFilterError,
+    decoupling_gap,
+    design_nullspace_filter,
+    fault_model,
+)
 from .observers import (
     PMO,
     UIO,
@@ -157,5 +165,11 @@ __all__ = [
     "UIOBank",
     "BankMember",
     "Isolation",
+    "fault_model",
+    "FaultModel",
+    "design_nullspace_filter",
+    "NullspaceFilter",
+    "NullspaceFilterError",
+    "decoupling_gap",
     "explorers",
 ]

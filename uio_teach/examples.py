@@ -18,6 +18,10 @@ scrambled text) and Johansson's quadruple tank, built from the paper's parameter
   pump voltages (:func:`tank_operating_point`), both pump flows unknown
   (``E = B``); the paper's parameters, levels, time constants and zeros in
   :data:`QUADRUPLE_TANK_PUBLISHED`.
+* :func:`varga_5_4` -- Varga, *Solving Fault Diagnosis Problems* (Springer, 2024),
+  Example 5.4: a plant given by transfer functions with feedthrough, one known input,
+  one disturbance and two faults; the printed nullspace filter ``Q`` and ``Rf`` in
+  :data:`VARGA_5_4_PUBLISHED`.
 """
 
 from __future__ import annotations
@@ -49,6 +53,8 @@ __all__ = [
     "TankOperatingPoint",
     "TANK_OUTLETS",
     "QUADRUPLE_TANK_PUBLISHED",
+    "varga_5_4",
+    "VARGA_5_4_PUBLISHED",
 ]
 
 
@@ -527,3 +533,51 @@ def quadruple_tank(
         E=[[g1 * k1 / A1, 0], [0, g2 * k2 / A2], [0, (1 - g2) * k2 / A3], [(1 - g1) * k1 / A4, 0]],
         name=name,
     )
+
+
+def varga_5_4():
+    """Example 5.4 of Varga, *Solving Fault Diagnosis Problems*: a minimal realization.
+
+    ``Gu = [(s+1)/(s-2); (s+2)/(s-3)]``, ``Gd = [(s-1)/(s+2); 0]``,
+    ``Gf = [(s+1)/(s-2), 0; (s+2)/(s-3), 1]`` (the first fault acts as the
+    known input does, the second on the second output). Written as
+    ``(s+1)/(s-2) = 1 + 3/(s-2)``, ``(s+2)/(s-3) = 1 + 5/(s-3)`` and
+    ``(s-1)/(s+2) = 1 - 3/(s+2)``, one state per pole.
+
+    Returns
+    -------
+    control.StateSpace
+        Inputs ``u, d, f1, f2``; outputs ``y1, y2``; 3 states.
+
+    Examples
+    --------
+    >>> from uio_teach import examples
+    >>> sys = examples.varga_5_4()
+    >>> sys.input_labels, sorted(sys.poles().real.tolist())
+    (['u', 'd', 'f1', 'f2'], [-2.0, 2.0, 3.0])
+    """
+    import control as ct  # deferred on purpose: python-control takes a second to import
+
+    A = np.diag([2.0, 3.0, -2.0])
+    B = np.array([[1.0, 0, 1, 0], [1, 0, 1, 0], [0, 1, 0, 0]])
+    C = np.array([[3.0, 0, -3], [0, 5, 0]])
+    D = np.array([[1.0, 1, 1, 0], [1, 0, 1, 1]])
+    return ct.ss(A, B, C, D, inputs=["u", "d", "f1", "f2"], outputs=["y1", "y2"], name="varga_5_4")
+
+
+VARGA_5_4_PUBLISHED = Published(
+    source="Varga, Solving Fault Diagnosis Problems, Example 5.4",
+    decimals=4,
+    values=MappingProxyType(
+        {
+            # numerators and denominators, descending powers of s; Q's inputs are y1, y2, u
+            "Q_num": ((0.0, 0.0), (1.0, -3.0), (-1.0, -2.0)),
+            "Rf_num": ((1.0, 2.0), (1.0, -3.0)),
+            "den": (1.0, 3.0),
+            "poles": read_only([-3.0]),
+        }
+    ),
+)
+"""Printed ``Q = [0, (s-3)/(s+3), -(s+2)/(s+3)]`` and ``Rf = [(s+2)/(s+3), (s-3)/(s+3)]``
+(4 significant digits, after dividing by ``Rf``'s first entry at infinity; the printed first
+entry of ``Q``, ``(1.54e-16 s + 3.966e-17)/(s+3)``, is zero to rounding)."""
