@@ -12,8 +12,9 @@
      scroll it. The side where content is cut off carries a visible bar (data-uio-cut, a11y.css)
      while there is more to scroll to there. Boxes that stop overflowing lose all of it again.
    * Code cells are announced as code with their number of lines (a group whose role
-     description is "code"), the hidden-code toggles by the words they show ("Show code cell
-     source", not "Toggle hidden content").
+     description is "code"), their copy buttons by the cell they copy ("copy code cell 4", not
+     forty times "Copy to clipboard"), the hidden-code toggles by the words they show ("Show
+     code cell source", not "Toggle hidden content").
    Run once the page, its pictures and its mathematics are laid out, and again when the window's
    width changes. */
 (function () {
@@ -66,8 +67,13 @@
         ", scrolls sideways";
     }
     if (el.matches("pre")) {
-      return (n ? "code cell " + n : "code") + ", " + count(lines(el), "line") +
-        ", scrolls sideways";
+      if (n) return "code cell " + n + ", " + count(lines(el), "line") + ", scrolls sideways";
+      /* a block of code outside the cells (an example of the API page): its place and whose */
+      var k = Array.prototype.indexOf.call(document.querySelectorAll("main pre"), el) + 1;
+      var dd = el.closest("dl.py > dd");
+      var dt = dd && dd.previousElementSibling;
+      var whose = dt && dt.id ? " of " + dt.id.split(".").pop() : "";
+      return "code block " + k + whose + ", " + count(lines(el), "line") + ", scrolls sideways";
     }
     if (el.matches("div.math")) return "equation, scrolls sideways";
     if (el.matches("table, .table-wrapper")) {
@@ -144,6 +150,8 @@
       input.setAttribute("aria-roledescription", "code");
       input.setAttribute("aria-label", "code cell " + cellNumber(input) + ", " +
         count(lines(pre), "line"));
+      var copy = input.querySelector("button.copybtn");
+      if (copy) copy.setAttribute("aria-label", "copy code cell " + cellNumber(input));
     });
   }
 

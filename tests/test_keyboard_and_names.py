@@ -122,8 +122,9 @@ _FACTS_JS = """
 
 _PRESS_M_JS = """
 () => { const f = document.activeElement;
-  return f && f.tagName === "MJX-CONTAINER" ? f === document.querySelector(
-    "main mjx-container[jax]") : false; }
+  const first = Array.from(document.querySelectorAll("main mjx-container[jax]"))
+    .find((c) => c.getClientRects().length > 0);
+  return f === first; }
 """
 
 
@@ -140,6 +141,17 @@ def _value(node: dict, key: str) -> str:
     return str((node.get(key) or {}).get("value") or "")
 
 
+def _words(text: str) -> list[str]:
+    return re.sub(r"[^\w ]+", " ", text).lower().split()
+
+
+def _in_order(shown: list[str], name: list[str]) -> bool:
+    """Every word shown is in the name, in the order shown (a formula between them is said in
+    words in the name, and left out of what is shown)."""
+    rest = iter(name)
+    return all(word in rest for word in shown)
+
+
 def ax_problems(nodes: list[dict]) -> list[str]:
     """The nodes of an accessibility tree that need a name and have none, and the controls whose
     name leaves out the words they show."""
@@ -150,6 +162,8 @@ def ax_problems(nodes: list[dict]) -> list[str]:
         for child in node.get("childIds", []):
             c = by_id.get(child)
             if c is None or c.get("ignored"):
+                continue
+            if _value(c, "role") == "math":  # a formula: the name says it in words
                 continue
             if _value(c, "role") in ("StaticText", "InlineTextBox"):
                 words.append(_value(c, "name"))
@@ -166,12 +180,7 @@ def ax_problems(nodes: list[dict]) -> list[str]:
             found.append(f"{role} without a name (shows {shown(node)[:60]!r})")
         if role in LABEL_IN_NAME and name:
             text = shown(node)
-            words = re.sub(r"[^\w ]+", " ", text).split()
-            if (
-                len(words) >= 2
-                and " ".join(words).lower()
-                not in " ".join(re.sub(r"[^\w ]+", " ", name).split()).lower()
-            ):
+            if len(_words(text)) >= 2 and not _in_order(_words(text), _words(name)):
                 found.append(f"{role} named {name!r} shows {text!r}")
         if role == "region" and "scrolls sideways" in name:
             found.append(f"a frame that scrolls is a landmark: {name!r}")
@@ -197,7 +206,10 @@ def page_walk(browser, book_server: str, page: str, scheme: str) -> dict:
                 for n in ax_tree(tab)
                 if _value(n, "role") in ("heading", "link")
             }
-            tab.evaluate("() => { document.activeElement && document.activeElement.blur(); }")
+            tab.evaluate(
+                "() => { document.activeElement && document.activeElement.blur(); "
+                "window.scrollTo(0, 0); }"
+            )
             facts["m_reaches_first_formula"] = None
             if facts["formulas"]:
                 tab.keyboard.press("m")
@@ -217,6 +229,7 @@ def test_tab_reaches_links_and_controls_not_formulas(page: str, book_server: str
     first = next((i for i, s in enumerate(stops) if s["explorer"]), None)
     if first is not None:
         print(f"{page}: {first} Tab stops before the first explorer's first control")
+        print("  " + "\n  ".join(f"{s['tag']} {s['text']!r}" for s in stops[:first]))
         before = stops[:first]
         assert all(s["tag"] in ("a", "button", "input", "select", "summary", "label", "textarea")
                    or s["text"] for s in before), before  # fmt: skip

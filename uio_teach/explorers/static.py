@@ -725,7 +725,8 @@ def _html(
         f'<div id="{eid}" class="uio-static-explorer" role="group" '
         f'aria-label="{esc(scenario.title)} explorer">'
         f"<style>{css}</style>"
-        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}">'
+        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}" '
+        f'aria-label="controls of the {esc(scenario.title)} explorer">'
         f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
         f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
         f'step="1" value="{i0}" aria-label="{label}" aria-valuetext="{esc(first.label)}"> '
