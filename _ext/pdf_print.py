@@ -297,10 +297,11 @@ async (opts) => {
       }
       return {level: Number(h.tagName[1]), text: copy.textContent.replace(/\\s+/g, ' ').trim()};
     });
-  // the formulas: each printed as an image of its TeX (role img, named by the TeX), which
-  // Chromium tags as a /Figure with that /Alt; finish_pdf makes each a /Formula. Their hidden
-  // MathML copy (for screen readers of the web page) is left out of the print: the PDF's reader
-  // reads the /Alt.
+  // the formulas: over each, a transparent image as large as the formula whose text
+  // alternative is its TeX, which Chromium tags as a /Figure with that /Alt where the formula
+  // stands in the text; finish_pdf makes each a /Formula. The formula's glyphs stay as
+  // printed; its hidden MathML copy (for screen readers of the web page) is left out of the
+  // print: the PDF's reader reads the /Alt.
   const items = window.MathJax && window.MathJax.startup && window.MathJax.startup.document
     ? Array.from(window.MathJax.startup.document.math) : [];
   const shown = items.filter((item) => item.typesetRoot && item.typesetRoot.isConnected &&
@@ -308,13 +309,19 @@ async (opts) => {
   shown.sort((a, b) => a.typesetRoot.compareDocumentPosition(b.typesetRoot) &
     Node.DOCUMENT_POSITION_FOLLOWING ? -1 : 1);
   const formulas = [];
+  const BLANK = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8/5+hHgAHggJ/PchI7wAAAABJRU5ErkJggg==';
   for (const item of shown) {
     const root = item.typesetRoot;
     const tex = String(item.math).replace(/\\s+/g, ' ').trim();
-    root.setAttribute('role', 'img');
-    root.setAttribute('aria-label', tex);
-    root.removeAttribute('aria-labelledby');
     for (const m of root.querySelectorAll('mjx-assistive-mml')) m.remove();
+    const img = document.createElement('img');
+    img.className = 'print-formula';
+    img.alt = tex;
+    img.src = BLANK;
+    img.style.cssText = 'position:absolute;left:0;top:0;width:100%;height:100%;' +
+      'margin:0;padding:0;border:0;opacity:0.01';
+    root.style.position = 'relative';
+    root.insertBefore(img, root.firstChild);
     formulas.push(tex);
   }
   const author = document.querySelector('p.component-author');

@@ -233,8 +233,8 @@ def test_the_whole_book_has_every_page_and_a_table_of_contents(printed, built_bo
 
 
 _FORMULA = re.compile(
-    r'<(span|div) class="math notranslate nohighlight"[^>]*>\s*(?:\\\(|\\\[|\$\$?)?(?P<tex>.*?)'
-    r"(?:\\\)|\\\]|\$\$?)?\s*</(?P=1)>",
+    r'<(?P<tag>span|div) class="math notranslate nohighlight"[^>]*>\s*(?:\\\(|\\\[|\$\$?)?'
+    r"(?P<tex>.*?)(?:\\\)|\\\]|\$\$?)?\s*</(?P=tag)>",
     flags=re.S,
 )
 
