@@ -309,7 +309,8 @@ async (opts) => {
   shown.sort((a, b) => a.typesetRoot.compareDocumentPosition(b.typesetRoot) &
     Node.DOCUMENT_POSITION_FOLLOWING ? -1 : 1);
   const formulas = [];
-  const BLANK = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8/5+hHgAHggJ/PchI7wAAAABJRU5ErkJggg==';
+  const BLANK = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR4' +
+    '2mP8/5+hHgAHggJ/PchI7wAAAABJRU5ErkJggg==';
   for (const item of shown) {
     const root = item.typesetRoot;
     const tex = String(item.math).replace(/\\s+/g, ' ').trim();
