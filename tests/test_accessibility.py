@@ -379,7 +379,8 @@ def test_a_static_explorer_speaks_once_after_the_control_rests():
     page = static_explorer(scenario_of("pa9"), values=(-1.0, 0.5), disturbances=("sinusoid",))
     text = page.html
     # one live region, the status; the caption (poles and notes) is not read at every step
-    assert text.count("aria-live") == 1 and 'role="status"' in text
+    assert text.count('aria-live="polite"') == 1 and 'role="status"' in text
+    assert '<output name="mainval" aria-live="off">' in text  # the slider says its value
     assert '<p class="uio-caption">' in text
     for frame in page.frames:
         assert f'data-said="{html.escape(frame.said)}"' in text

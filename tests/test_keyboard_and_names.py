@@ -142,6 +142,8 @@ def _value(node: dict, key: str) -> str:
 
 
 def _words(text: str) -> list[str]:
+    """The words of a text, without the letters of formulas (mathematical italic, Greek)."""
+    text = re.sub("[\U0001d400-\U0001d7ff\u0370-\u03ff]+\\w*", " ", text)
     return re.sub(r"[^\w ]+", " ", text).lower().split()
 
 
@@ -163,8 +165,8 @@ def ax_problems(nodes: list[dict]) -> list[str]:
             c = by_id.get(child)
             if c is None or c.get("ignored"):
                 continue
-            if _value(c, "role") == "math":  # a formula: the name says it in words
-                continue
+            if _value(c, "role") == "math" or _value(c, "role").startswith("MathML"):
+                continue  # a formula: the name says it in words
             if _value(c, "role") in ("StaticText", "InlineTextBox"):
                 words.append(_value(c, "name"))
             else:

@@ -730,7 +730,7 @@ def _html(
         f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
         f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
         f'step="1" value="{i0}" aria-label="{label}" aria-valuetext="{esc(first.label)}"> '
-        f'<output name="mainval">{esc(first.label)}</output></span></label>'
+        f'<output name="mainval" aria-live="off">{esc(first.label)}</output></span></label>'
         f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
         "</form>"
