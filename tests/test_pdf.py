@@ -233,7 +233,8 @@ def test_the_whole_book_has_every_page_and_a_table_of_contents(printed, built_bo
 
 
 _FORMULA = re.compile(
-    r'<(?P<tag>span|div) class="math notranslate nohighlight"[^>]*>\s*(?:\\\(|\\\[|\$\$?)?'
+    r'<(?P<tag>span|div) class="math notranslate nohighlight"[^>]*>\s*'
+    r'(?:<span class="eqno">.*?</span>)?\s*(?:\\\(|\\\[|\$\$?)?'  # an equation's number first
     r"(?P<tex>.*?)(?:\\\)|\\\]|\$\$?)?\s*</(?P=tag)>",
     flags=re.S,
 )
