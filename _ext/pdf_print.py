@@ -297,9 +297,38 @@ async (opts) => {
       }
       return {level: Number(h.tagName[1]), text: copy.textContent.replace(/\\s+/g, ' ').trim()};
     });
+  // the formulas: over each, a transparent image as large as the formula whose text
+  // alternative is its TeX, which Chromium tags as a /Figure with that /Alt where the formula
+  // stands in the text; finish_pdf makes each a /Formula. The formula's glyphs stay as
+  // printed; its hidden MathML copy (for screen readers of the web page) is left out of the
+  // print: the PDF's reader reads the /Alt.
+  const items = window.MathJax && window.MathJax.startup && window.MathJax.startup.document
+    ? Array.from(window.MathJax.startup.document.math) : [];
+  const shown = items.filter((item) => item.typesetRoot && item.typesetRoot.isConnected &&
+    item.typesetRoot.getClientRects().length > 0);
+  shown.sort((a, b) => a.typesetRoot.compareDocumentPosition(b.typesetRoot) &
+    Node.DOCUMENT_POSITION_FOLLOWING ? -1 : 1);
+  const formulas = [];
+  const BLANK = 'data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR4' +
+    '2mP8/5+hHgAHggJ/PchI7wAAAABJRU5ErkJggg==';
+  for (const item of shown) {
+    const root = item.typesetRoot;
+    const tex = String(item.math).replace(/\\s+/g, ' ').trim();
+    for (const m of root.querySelectorAll('mjx-assistive-mml')) m.remove();
+    const img = document.createElement('img');
+    img.className = 'print-formula';
+    img.alt = tex;
+    img.src = BLANK;
+    img.style.cssText = 'position:absolute;left:0;top:0;width:100%;height:100%;' +
+      'margin:0;padding:0;border:0;opacity:0.01';
+    root.style.position = 'relative';
+    root.insertBefore(img, root.firstChild);
+    formulas.push(tex);
+  }
   const author = document.querySelector('p.component-author');
   return {
     headings,
+    formulas,
     overflow,
     width,
     author: author ? author.textContent.trim().replace(/^By\\s+/, '') : '',
@@ -514,13 +543,23 @@ def outline_items(root) -> list:  # noqa: ANN001 (a pypdf dictionary)
 
 
 def finish_pdf(
-    path: Path, title: str, author: str = "", headings: Sequence[str] | None = None
+    path: Path,
+    title: str,
+    author: str = "",
+    headings: Sequence[str] | None = None,
+    formulas: Sequence[str] | None = None,
 ) -> int:
     """Write the title (and author) into the PDF's metadata and ask viewers to show the title.
 
     With ``headings`` (the printed headings' texts, in order), the outline's entries are
     named by them: Chromium takes their text from the printed lines, where a heading broken over
     two lines loses the space between them and one broken across two pages is named twice.
+
+    With ``formulas`` (the printed formulas' TeX, in the page's order), each is tagged as a
+    ``/Formula`` with its TeX as ``/Alt``: Chromium writes a formula printed as an image of its
+    TeX as a ``/Figure`` with that ``/Alt``, in the structure's reading order; they are found
+    in that order, and a formula missing there (untagged, or read out of the page's order)
+    fails the printing.
 
     An incremental update: Chromium's structure tree, outline (destinations) and language stay
     as written. Returns the number of pages.
@@ -546,10 +585,59 @@ def finish_pdf(
             )
         for item, text in zip(items, headings, strict=True):
             item[NameObject("/Title")] = TextStringObject(text)
+    if formulas:
+        tagged = tag_formulas(writer.root_object, formulas)
+        if tagged < len(formulas):
+            raise PrintError(
+                f"{path.name}: {tagged} of {len(formulas)} formulas tagged in the page's order; "
+                f"the first not found: {formulas[tagged]!r}"
+            )
     pages = len(writer.pages)
     with open(path, "wb") as out:
         writer.write(out)
     return pages
+
+
+def _struct_elements(root) -> Iterator:  # noqa: ANN001 (a pypdf dictionary)
+    """The structure elements under ``root`` (a catalog), in reading order (depth first)."""
+    from pypdf.generic import ArrayObject, DictionaryObject
+
+    tree = root.get("/StructTreeRoot")
+    if tree is None:
+        return
+
+    def walk(node):  # noqa: ANN001, ANN202
+        node = node.get_object()
+        if isinstance(node, ArrayObject):
+            for kid in node:
+                yield from walk(kid)
+            return
+        if not isinstance(node, DictionaryObject) or "/S" not in node:
+            return
+        yield node
+        if "/K" in node:
+            yield from walk(node["/K"])
+
+    tree = tree.get_object()
+    if "/K" in tree:
+        yield from walk(tree["/K"])
+
+
+def tag_formulas(root, formulas: Sequence[str]) -> int:  # noqa: ANN001 (a pypdf dictionary)
+    """Tag the figures whose ``/Alt`` is a formula's TeX, in order, as ``/Formula``; how many of
+    ``formulas`` were found (a figure of another alternative text, a picture, is left alone)."""
+    from pypdf.generic import NameObject
+
+    found = 0
+    for node in _struct_elements(root):
+        if found == len(formulas):
+            break
+        if node["/S"] in ("/Figure", "/Formula") and " ".join(
+            str(node.get("/Alt", "")).split()
+        ) == " ".join(formulas[found].split()):
+            node[NameObject("/S")] = NameObject("/Formula")
+            found += 1
+    return found
 
 
 def destination_pages(pdf: bytes, names: Sequence[str]) -> dict[str, int]:
@@ -570,12 +658,13 @@ def destination_pages(pdf: bytes, names: Sequence[str]) -> dict[str, int]:
 
 def structure(reader) -> dict[str, list]:  # noqa: ANN001 (a pypdf PdfReader)
     """The structure tree of a tagged PDF: its element types in reading order, and the
-    alternative text (``/Alt``, or None) of every ``/Figure``."""
+    alternative text (``/Alt``, or None) of every ``/Figure`` and every ``/Formula``."""
     from pypdf.generic import ArrayObject, DictionaryObject
 
     root = reader.trailer["/Root"].get("/StructTreeRoot")
     types: list[str] = []
     alts: list[str | None] = []
+    formulas: list[str | None] = []
 
     def walk(node) -> None:  # noqa: ANN001
         node = node.get_object()
@@ -586,15 +675,17 @@ def structure(reader) -> dict[str, list]:  # noqa: ANN001 (a pypdf PdfReader)
         if not isinstance(node, DictionaryObject) or "/S" not in node:
             return  # a marked-content reference, an object reference or a number
         types.append(str(node["/S"]))
-        if node["/S"] == "/Figure":
+        if node["/S"] in ("/Figure", "/Formula"):
             alt = node.get("/Alt")
-            alts.append(str(alt) if alt is not None else None)
+            (alts if node["/S"] == "/Figure" else formulas).append(
+                str(alt) if alt is not None else None
+            )
         if "/K" in node:
             walk(node["/K"])
 
     if root is not None and "/K" in root.get_object():
         walk(root.get_object()["/K"])
-    return {"types": types, "figure_alts": alts}
+    return {"types": types, "figure_alts": alts, "formula_alts": formulas}
 
 
 def audit_pdf(path: Path) -> list[str]:
@@ -623,6 +714,9 @@ def audit_pdf(path: Path) -> list[str]:
     missing = sum(1 for alt in tree["figure_alts"] if not (alt or "").strip())
     if missing:
         problems.append(f"{missing} figure(s) without a text alternative (/Alt)")
+    missing = sum(1 for alt in tree["formula_alts"] if not (alt or "").strip())
+    if missing:
+        problems.append(f"{missing} formula(s) without a text alternative (/Alt)")
     return [f"{path.name}: {p}" for p in problems]
 
 
@@ -675,7 +769,7 @@ async def print_page(context, job: Job, page: Page) -> tuple[Path, list[str]]:  
             **PDF_OPTIONS,
         )
         headings = [h["text"] for h in prepared["headings"]]
-        finish_pdf(target, title, prepared["author"], headings)
+        finish_pdf(target, title, prepared["author"], headings, prepared["formulas"])
         return target, prepared["overflow"]
     finally:
         await tab.close()
@@ -738,7 +832,7 @@ async def print_book(context, job: Job) -> tuple[Path, list[str]]:  # noqa: ANN0
         target = job.out / f"{job.book_name}.pdf"
         target.write_bytes(pdf)
         headings = [h["text"] for h in prepared["headings"]]
-        finish_pdf(target, _running_head(job), prepared["author"], headings)
+        finish_pdf(target, _running_head(job), prepared["author"], headings, prepared["formulas"])
         return target, prepared["overflow"]
     finally:
         await tab.close()

@@ -258,3 +258,201 @@ def test_no_prose_points_at_the_left_or_the_right_of_a_figure_alone():
                 if not re.search(r"phone|wide screen|side of|half-plane|\$", around):
                     found.append(f"{source.name}: {around}")
     assert not found, found
+
+
+# --- names that keep their mathematics (_ext/a11y.py) -------------------------------------------
+
+
+def _a11y_extension():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("uio_a11y_ext", ROOT / "_ext" / "a11y.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize(
+    ("tex", "words"),
+    [
+        (r"\gamma_1 + \gamma_2 = 1", "gamma sub 1 plus gamma sub 2 equals 1"),
+        (r"(TA, C)", "(T A, C)"),
+        (r"0.5^k", "0.5 to the power k"),
+        (r"M_v", "M sub v"),
+        (r"K_{1}", "K sub 1"),
+        (r"Dv", "D v"),
+        (r"CE = 0", "C E equals 0"),
+        (r"(I - MC)E = 0", "(I minus M C) E equals 0"),
+        (r"\hat{x}", "x hat"),
+        (r"E^{+}", "E pseudo-inverse"),
+        (r"(CE)^T", "(C E) transpose"),
+        (r"\operatorname{rank}(CE) = \operatorname{rank} E", "rank (C E) equals rank E"),
+        (r"\frac{1}{s}", "1 over s"),
+        (r"\mathbf{x}_{k+1}", "x sub k plus 1"),
+    ],
+)
+def test_a_formula_is_said_in_words(tex, words):
+    assert _a11y_extension().tex_words(tex) == words
+
+
+def test_headings_and_links_holding_a_formula_are_named_with_it_in_words():
+    ext = _a11y_extension()
+    math = '<span class="math notranslate nohighlight">\\({}\\)</span>'
+    page = (
+        f'<h3><span class="section-number">4.5.1. </span>{math.format("H")} and '
+        f'{math.format("T")}, and how the assignment printed them<a class="headerlink" '
+        'href="#h" title="Link to this heading">#</a></h3>\n'
+        f'<a class="reference internal nav-link" href="#v">Why {math.format("M_v")} and '
+        f"{math.format('K_v')} do nothing here</a>\n"
+        '<a href="#plain">No formula</a>\n'
+        f'<a aria-label="given" href="#g">{math.format("x &lt; 1")}</a>'
+    )
+    named, count = ext.name_formulas(page)
+    assert count == 2
+    assert '<h3 aria-label="4.5.1. H and T, and how the assignment printed them">' in named
+    assert 'aria-label="Why M sub v and K sub v do nothing here">' in named
+    assert '<a href="#plain">No formula</a>' in named  # no formula: left alone
+    assert named.count('aria-label="given"') == 1  # a name given already is kept
+    assert ext.name_formulas(named) == (named, 0)  # done once
+    assert ext.spoken_name(math.format("x &lt; 1")) == "x less than 1"
+
+
+# --- the explorers say what the error did -------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "settings"),
+    [
+        ("pa9", {}),
+        ("pa9", {"poles": (0.5, -2.0, -3.0)}),  # an unstable pole: the error grows
+        ("case_study", {}),
+        ("case_study", {"poles": (1.05,)}),
+        ("missile", {}),
+        ("quadruple_tank", {}),
+    ],
+)
+def test_the_live_region_says_what_the_error_did_and_how_fast_from_the_data(name, settings):
+    from uio_teach.explorers import compute_frame, scenario_of
+    from uio_teach.explorers.static import frame_status
+
+    sc = scenario_of(name)
+    frame = compute_frame(sc, sc.defaults.replace(**settings) if settings else sc.defaults)
+    said = frame_status(frame, "main control (others 1, 2)", "-1")
+    assert said.startswith(f"main control = -1, {frame.disturbance}.")
+    assert "(others" not in said and "poles" not in said  # the outcome, not the settings' list
+    t = np.asarray(frame.time, dtype=float)
+    for who, response in (
+        (sc.observer_name, frame.response),
+        ("Luenberger observer", frame.luenberger_response),
+    ):
+        if response is None:
+            continue
+        size = np.sqrt(np.sum(np.asarray(response.error, dtype=float) ** 2, axis=0))
+        sentence = re.search(rf"{re.escape(who)}: the error ([^.]*(?:\.\d[^.]*)*)\.", said)
+        assert sentence, (who, said)
+        words = sentence.group(1)
+        if not np.all(np.isfinite(size)):
+            continue
+        start, end = size[0], size[-1]
+        # the verb and the numbers: the sizes |e| at the start and the end of the data
+        numbers = [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", words)]
+        if "decays" in words or "grows" in words or "shrinks" in words:
+            assert ("grows" in words) == (end > start), (who, words, start, end)
+            assert any(np.isclose(n, start, rtol=6e-3) for n in numbers), (words, start)
+            assert any(np.isclose(n, end, rtol=6e-3) for n in numbers), (words, end)
+        # how fast: tenfold every tau, so that start * 10**(+-span / tau) is the end
+        pace = re.search(r"ten times (smaller|larger) every ([\d.e+-]+) (s|steps)", words)
+        if pace:
+            tau = float(pace.group(2))
+            sign = 1 if pace.group(1) == "larger" else -1
+            predicted = np.log10(start) + sign * (t[-1] - t[0]) / tau
+            # two significant digits of tau: the decades agree to about 5 %
+            assert abs(predicted - np.log10(end)) <= 0.05 * abs(np.log10(end / start)) + 1e-9
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_a_static_explorer_speaks_once_after_the_control_rests():
+    from uio_teach.explorers import scenario_of
+    from uio_teach.explorers.static import SETTLE_MS, static_explorer
+
+    page = static_explorer(scenario_of("pa9"), values=(-1.0, 0.5), disturbances=("sinusoid",))
+    text = page.html
+    # one live region, the status; the caption (poles and notes) is not read at every step
+    assert text.count('aria-live="polite"') == 1 and 'role="status"' in text
+    assert '<output name="mainval" aria-live="off">' in text  # the slider says its value
+    assert '<p class="uio-caption">' in text
+    for frame in page.frames:
+        assert f'data-said="{html.escape(frame.said)}"' in text
+        assert frame.said.split(". ")[0] == f"UIO pole 1 = {frame.label}, {'sinusoid'}" or (
+            frame.said.startswith("UIO pole 1 = ")
+        )
+    # the words of the unstable frame: the error grows
+    assert "the error grows" in page.frames[1].said
+    # it speaks when the control has rested (a timer reset by every move), only if new words
+    assert f"}},{SETTLE_MS});" in text.replace("&#x27;", "'")
+    assert "o.textContent!==s" in text.replace("&#x27;", "'").replace("&quot;", '"')
+
+
+def test_the_error_panels_name_their_channels():
+    from uio_teach.explorers import compute_frame, scenario_of
+    from uio_teach.explorers._figure import ExplorerFigure
+
+    for name in ("pa9", "quadruple_tank"):
+        sc = scenario_of(name)
+        fig = ExplorerFigure(sc, dpi=60, sticky=False)
+        fig.update(compute_frame(sc))
+        for who in ("uio", "lb"):
+            legend = fig.axes[f"{who}.error"].get_legend()
+            assert legend is not None, (name, who)
+            texts = [t.get_text() for t in legend.get_texts()]
+            channels = [plotting.symbol("e", i) for i in range(sc.plant.n)]
+            assert texts[: sc.plant.n] == channels, (name, who, texts)
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+# --- areas of a figure stand out: 3:1 (WCAG 2.1, 1.4.11) ----------------------------------------
+
+
+def test_a_shaded_band_stands_out_and_a_faint_one_is_found():
+    fig = plotting.new_figure()
+    ax = fig.subplots()
+    plotting.shade_band(ax, 0.0, 0.5, "no UIO")
+    assert plotting.low_contrast_areas(fig) == []
+    ax.axvspan(0.6, 0.8, color=plotting.COLORS[3], alpha=0.08, label="faint")
+    assert plotting.low_contrast_areas(fig) == [("faint", 1.08)]
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_the_packages_bands_stand_out():
+    """The figures of the package that shade a region: the tank's "no UIO" band, the bank's
+    start before monitoring begins (every area checked, named in the legend or not)."""
+    from uio_teach.instructor.config import FigureConfig
+    from uio_teach.instructor.figures import FIGURES, _Runs
+
+    fig = FIGURES["tank_zeros"].draw(_Runs(FigureConfig()))
+    for ax in fig.axes:
+        for patch in ax.patches:
+            patch.set_label("band")
+    assert plotting.low_contrast_areas(fig) == []
+    assert any(ax.patches for ax in fig.axes)
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_the_chapters_shade_areas_with_the_course_band_and_colours():
+    """No chapter draws a faint band or picks matplotlib's named colours ("tab:red"): a band is
+    ``ut.plotting.shade_band``, colours come from the course's palette."""
+    found = []
+    for source in sorted((ROOT / "book").glob("*.md")):
+        text = source.read_text(encoding="utf-8")
+        for cell in re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S):
+            for m in re.finditer(r"axvspan\(|axhspan\(|[\"']tab:\w+[\"']", cell):
+                found.append(f"{source.name}: {m.group(0)}")
+    assert not found, found

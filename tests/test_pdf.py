@@ -230,3 +230,36 @@ def test_the_whole_book_has_every_page_and_a_table_of_contents(printed, built_bo
     tree = pdf_print.structure(reader)
     alts = [alt for page in pages for alt in article(built_book / page.path).alts]
     assert tree["figure_alts"] == alts
+
+
+_FORMULA = re.compile(
+    r'<(?P<tag>span|div) class="math notranslate nohighlight"[^>]*>\s*'
+    r'(?:<span class="eqno">.*?</span>)?\s*(?:\\\(|\\\[|\$\$?)?'  # an equation's number first
+    r"(?P<tex>.*?)(?:\\\)|\\\]|\$\$?)?\s*</(?P=tag)>",
+    flags=re.S,
+)
+
+
+def page_formulas(html_file: Path) -> list[str]:
+    """The TeX of every formula of a page's article, in the page's order."""
+    import html as html_module
+
+    text = html_file.read_text(encoding="utf-8")
+    start = text.find('<article class="bd-article"')
+    end = text.find("</article>", start)
+    return [
+        " ".join(html_module.unescape(m["tex"]).split()) for m in _FORMULA.finditer(text[start:end])
+    ]
+
+
+@pytest.mark.parametrize("name", PAGES)
+def test_every_formula_is_tagged_as_a_formula_with_its_tex_in_the_pages_order(
+    printed, built_book: Path, name: str
+) -> None:
+    page = next(p for p in printed[1] if p.name == name)
+    wanted = page_formulas(built_book / page.path)
+    tree = pdf_print.structure(PdfReader(_pdf(printed, name)))
+    said = [" ".join((alt or "").split()) for alt in tree["formula_alts"]]
+    assert said == wanted, (name, len(said), len(wanted))
+    # and none is left a loose figure: every figure is a picture of the page
+    assert not set(tree["figure_alts"]) & set(wanted)

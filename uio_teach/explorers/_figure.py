@@ -434,15 +434,16 @@ class ExplorerFigure:
                 if who == "uio" or self.narrow:
                     text = axis_label(r, sym) if r != "error" else "|error| (log)"
                     ax.set_ylabel(text if who == "uio" else "", fontsize=8 * k)
-                if counts[r] and (who == "uio" or r == "input"):
+                if counts[r] and (who == "uio" or r in ("input", "error")):
                     # the log error axis reaches a decade above the clipping bound, so its
-                    # top band is free of curves: a wide, flat legend sits there
-                    if r == "error":  # the guides (the channels' colours are e_1, e_2, ...)
+                    # top band is free of curves: a wide, flat legend sits there, naming each
+                    # error channel e_1, e_2, ... (in both observers' panels) and the guides
+                    if r == "error":
                         shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
-                        if shown:
-                            ax.legend(
-                                handles=shown, **{**_LEGEND, "fontsize": self.legend_pt, "ncol": 1}
-                            )
+                        ax.legend(
+                            handles=[*self.lines[f"{who}.error"], *(shown if who == "uio" else [])],
+                            **{**_LEGEND, "fontsize": self.legend_pt},
+                        )
                     else:
                         ax.legend(**{**_LEGEND, "fontsize": self.legend_pt})
             axes[f"{who}.{rows[-1]}"].set_xlabel(self._xlabel(), fontsize=8 * k)

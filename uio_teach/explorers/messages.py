@@ -36,6 +36,7 @@ from .modes import damping_ratio, match_poles, points_per_period, pole_rate, slo
 __all__ = [
     "ErrorVerdict",
     "error_grows",
+    "pace_words",
     "stability_message",
     "overflow_message",
     "lmi_message",
@@ -190,6 +191,51 @@ class ErrorVerdict:
             return f"decays from {a} to {b}"
         text = f"ends about where it starts ({a} to {b})"
         return text + (f", peaking at {m}" if self.outgrows_start else "")
+
+
+def pace_words(verdict: ErrorVerdict | None, span: float, unit: str = "s") -> str:
+    """How fast the error changed over the window, on average, in words.
+
+    The words follow the verdict's ("the error decays from 1.5 to 1.5e-05, ..."): from the
+    sizes at the start and the end of the window and its length, the time the error took, on
+    average, to fall (or grow) tenfold; a change of less than tenfold is said as a percentage
+    over the window. An error that is zero to rounding, overflowed, starts or ends at zero, or
+    ends where it started, has no pace ("").
+
+    Parameters
+    ----------
+    verdict : ErrorVerdict or None
+        The verdict on the simulated error.
+    span : float
+        The length of the simulated window.
+    unit : str
+        The unit of ``span``: ``"s"`` (seconds) or ``"steps"``.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers.messages import ErrorVerdict, pace_words
+    >>> pace_words(ErrorVerdict(start=1.5, end=1.5e-5, peak=1.5), 10.0)
+    'ten times smaller every 2 s on average'
+    >>> pace_words(ErrorVerdict(start=1.0, end=7.04, peak=7.04), 40.0, "steps")
+    'up by 604 % over 40 steps'
+    >>> pace_words(ErrorVerdict(start=1.0, end=1.0, peak=1.0), 10.0)
+    ''
+    """
+    if verdict is None or not verdict.finite or verdict.zero or not span > 0:
+        return ""
+    if not (verdict.start > 0 and verdict.end > 0) or not (verdict.grows or verdict.decays):
+        return ""
+    decades = float(np.log10(verdict.end / verdict.start))
+    how = "larger" if decades > 0 else "smaller"
+    if abs(decades) >= 1:
+        every = float(f"{span / abs(decades):.2g}")  # two digits, never in exponent form
+        return f"ten times {how} every {every:g} {unit} on average"
+    change = 100 * abs(verdict.end / verdict.start - 1)
+    return f"{'up' if decades > 0 else 'down'} by {change:.3g} % over {span:.3g} {unit}"
 
 
 def error_grows(error: np.ndarray | None) -> bool:

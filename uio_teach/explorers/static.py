@@ -46,6 +46,7 @@ from .._display import format_complex, format_poles
 from ..linalg import is_stable
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
+from .messages import pace_words
 from .model import DISTURBANCES, Scenario, Settings
 
 __all__ = [
@@ -54,6 +55,7 @@ __all__ = [
     "frame_settings",
     "frame_caption",
     "frame_alt",
+    "frame_status",
     "static_explorer",
     "static_html",
 ]
@@ -83,6 +85,9 @@ class StaticFrame:
     png_narrow : bytes
         The same frame drawn for a phone (two columns, larger text); empty
         when the explorer has no phone layout.
+    said : str
+        What a screen reader hears once the control has come to rest on this
+        frame (:func:`frame_status`): what each observer's error does, and how fast.
 
     Examples
     --------
@@ -100,6 +105,7 @@ class StaticFrame:
     label: str
     alt: str = ""
     png_narrow: bytes = b""
+    said: str = ""
 
     @property
     def data_url(self) -> str:
@@ -303,6 +309,65 @@ def frame_alt(frame: Frame, label: str, value: str) -> str:
     return " ".join(parts)
 
 
+def frame_status(frame: Frame, label: str, value: str) -> str:
+    """What the explorer's live region says once a control has come to rest on a frame.
+
+    The setting, then for each observer what its error does (the frame's verdict on the
+    simulated error: "decays from 1.5 to 1.5e-05", "grows from 1 to 32.8") and how fast, on
+    average over the window (:func:`~uio_teach.explorers.messages.pace_words`): the outcome
+    that the picture shows, in a few words, where the caption lists the poles and the notes.
+
+    Parameters
+    ----------
+    frame : Frame
+        The frame.
+    label, value : str
+        The main control's name (other controls' values in brackets after it) and value.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from uio_teach.explorers import compute_frame, scenario_of
+    >>> from uio_teach.explorers.static import frame_status
+    >>> said = frame_status(compute_frame(scenario_of("pa9")), "UIO pole 1", "-1")
+    >>> print(said.replace(". ", ".\\n").replace(", ten", ",\\n  ten"))
+    UIO pole 1 = -1, sinusoid, amplitude 1, frequency 2 rad/s.
+    UIO: the error decays from 1.5 to 1.5e-05,
+      ten times smaller every 2 s on average.
+    Luenberger observer: the error decays from 1.5 to 0.0754,
+      ten times smaller every 7.7 s on average.
+    """
+    sc = frame.scenario
+    name = label.partition(" (")[0]
+    unit_step = sc.plant.dt is True or (sc.discrete and float(sc.plant.dt) == 1.0)
+    t = np.asarray(frame.time, dtype=float)
+    span = float(t[-1] - t[0]) if t.size else 0.0
+    unit = "steps" if unit_step else "s"
+    parts = [f"{name} = {value}, {frame.disturbance}."]
+    rows = (
+        (sc.observer_name, frame.observer, frame.verdict, frame.observer_message, frame.poles),
+        ("Luenberger observer", frame.luenberger, frame.luenberger_verdict,
+         frame.luenberger_message, frame.luenberger_poles),
+    )  # fmt: skip
+    for who, observer, verdict, message, poles in rows:
+        if verdict is not None:
+            stable = bool(np.all(is_stable(poles, sc.discrete))) if poles.size else True
+            pace = pace_words(verdict, span, unit)
+            parts.append(
+                f"{who}: the error {verdict.words(stable)}" + (f", {pace}." if pace else ".")
+            )
+        elif observer is None:
+            parts.append(f"{who}: no design.")
+        elif "overflows" in message:
+            parts.append(f"{who}: the error overflows.")
+        else:
+            parts.append(f"{who}: the simulation failed.")
+    return " ".join(parts)
+
+
 _GUIDE_STYLE = {"certified": "dash-dotted", "rate of slowest moved": "dashed",
                 "rate of slowest fixed": "dotted"}  # fmt: skip
 """The line style of each guide over ``|e|`` (as ``_figure`` draws them), by its label's start."""
@@ -458,6 +523,7 @@ def static_explorer(
                 label=f"{value:g}",
                 alt=frame_alt(frame, main_control_label(scenario, base), f"{value:g}"),
                 png_narrow=small,
+                said=frame_status(frame, main_control_label(scenario, base), f"{value:g}"),
             )
     frames = [made[(i, j)] for j in range(len(disturbances)) for i in range(len(values))]
     eid = element_id or f"uio-explorer-{scenario.name}-{next(_IDS)}"
@@ -553,8 +619,15 @@ _JS = (
     "r.querySelector('.uio-caption').textContent=f.getAttribute('data-caption');"
     "this.mainval.value=f.getAttribute('data-label');"
     "this.main.setAttribute('aria-valuetext',f.getAttribute('data-label'));"
-    "r.classList.add('uio-live');}"
+    "r.classList.add('uio-live');"
+    "var o=r.querySelector('.uio-status'),s=f.getAttribute('data-said');clearTimeout(r.uioSaid);"
+    "r.uioSaid=setTimeout(function(){if(o.textContent!==s)o.textContent=s;"
+    "},@REST@);}"
 )
+
+SETTLE_MS = 700
+"""The live region speaks once a control has rested this long (milliseconds) on a frame: a
+slider dragged or held down over many frames is announced once, where it stops."""
 
 NARROW_PX = 700
 """At this width (CSS pixels) or less (a phone), the controls stack and the phone pictures show."""
@@ -591,6 +664,9 @@ max-width:100%}
 .uio-static-explorer .uio-captions>p{grid-area:1/1;font-size:0.85em;margin:0.2em 0}
 .uio-static-explorer .uio-sizer{visibility:hidden;display:none}
 .uio-static-explorer.uio-live .uio-sizer{display:block}
+.uio-static-explorer .uio-status{position:absolute;width:1px;height:1px;overflow:hidden;
+clip:rect(0,0,0,0);white-space:nowrap;margin:-1px;padding:0;border:0}
+.uio-static-explorer{position:relative}
 .uio-static-explorer .uio-note{font-size:0.8em;opacity:0.75;margin:0.2em 0}
 @media (max-width:@NARROW@px){
 .uio-static-explorer form{flex-direction:column;align-items:stretch;gap:0.6em}
@@ -627,7 +703,7 @@ def _html(
         f'<span data-k="{f.index[0]}-{f.index[1]}" data-src="{f.data_url}" '
         + (f'data-narrow="{f.narrow_url}" ' if phone else "")
         + f'data-caption="{esc(f.caption)}" data-alt="{esc(f.alt)}" '
-        f'data-label="{esc(f.label)}"></span>'
+        f'data-said="{esc(f.said)}" data-label="{esc(f.label)}"></span>'
         for f in frames
     )
     # every caption, invisible, in the caption's grid cell: once a control has moved, the box is
@@ -637,7 +713,7 @@ def _html(
         for c in dict.fromkeys(f.caption for f in frames)
     )
     label = esc(main_control_label(scenario, base))
-    handler = esc(_JS, quote=True)
+    handler = esc(_JS.replace("@REST@", str(SETTLE_MS)), quote=True)
     alt = esc(first.alt)
     hidden_select = "" if len(disturbances) > 1 else ' style="display:none"'
     css = _CSS.replace("@NARROW@", str(NARROW_PX))
@@ -649,18 +725,21 @@ def _html(
         f'<div id="{eid}" class="uio-static-explorer" role="group" '
         f'aria-label="{esc(scenario.title)} explorer">'
         f"<style>{css}</style>"
-        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}">'
+        f'<form onsubmit="return false" oninput="{handler}" onchange="{handler}" '
+        f'aria-label="controls of the {esc(scenario.title)} explorer">'
         f'<label class="uio-main"><span>{label}:</span> <span class="uio-slider">'
         f'<input type="range" name="main" min="0" max="{len(values) - 1}" '
         f'step="1" value="{i0}" aria-label="{label}" aria-valuetext="{esc(first.label)}"> '
-        f'<output name="mainval">{esc(first.label)}</output></span></label>'
+        f'<output name="mainval" aria-live="off">{esc(first.label)}</output></span></label>'
         f'<label class="uio-dist"{hidden_select}><span>disturbance:</span> '
         f'<select name="dist" aria-label="disturbance type">{options}</select></label>'
         "</form>"
         f'<div class="uio-picture"><picture>{source}'
         f'<img class="uio-frame" src="{first.data_url}" alt="{alt}"></picture></div>'
-        f'<div class="uio-captions"><p class="uio-caption" aria-live="polite">'
+        f'<div class="uio-captions"><p class="uio-caption">'
         f"{esc(first.caption)}</p>{sizers}</div>"
+        f'<p class="uio-status" role="status" aria-live="polite" aria-atomic="true">'
+        f"{esc(first.said)}</p>"
         '<p class="uio-note">Pre-computed pictures: move the '
         "slider or pick a disturbance. Open this page as a notebook with a Python kernel for "
         "the live explorer, where every control can be set.</p>"

@@ -65,7 +65,7 @@ from .scenarios import (
     make_scenario,
     scenario_of,
 )
-from .static import frame_alt, static_html
+from .static import frame_alt, frame_status, static_html
 
 __all__ = [
     "Explorer",
@@ -565,10 +565,15 @@ class Explorer(DragPoles):
             else ""
         )
         self.message.value = _message_html(frame) + refused
-        said = frame_alt(frame, "observer poles", format_poles(self.settings.poles, 3))
+        # the live region says what the error did and how fast, once per change; the picture's
+        # full description (its panels, the pole map) follows, not spoken at every change
+        poles = format_poles(self.settings.poles, 3)
+        said = frame_status(frame, "observer poles", poles)
+        whole = frame_alt(frame, "observer poles", poles)
         self.words.value = (
-            '<p role="status" aria-live="polite" style="font-size:0.85em;margin:0.2em 0">'
-            f"{html.escape(said)}</p>"
+            '<p role="status" aria-live="polite" aria-atomic="true" '
+            f'style="font-size:0.85em;margin:0.2em 0">{html.escape(said)}</p>'
+            f'<p style="font-size:0.85em;margin:0.2em 0">{html.escape(whole)}</p>'
         )
 
     def close(self) -> None:

@@ -434,7 +434,7 @@ def _figure_error(runs: Any) -> Figure:
 
 def _figure_zeros(runs: Any) -> Figure:
     # deferred: the registry is read without matplotlib, which the plotting module loads
-    from ..plotting import COLORS, describe, finish_panel, new_figure
+    from ..plotting import COLORS, describe, finish_panel, new_figure, shade_band
 
     run = _run(runs)["run"]
     ratio = run.gamma2 / run.gamma1
@@ -458,7 +458,7 @@ def _figure_zeros(runs: Any) -> Figure:
     mine = np.sort(check_existence(run.plant()).invariant_zeros.real)
     here = run.gamma1 + run.gamma2
     ax.plot([here, here], mine, "ko", mfc="none", label="this run's valves")
-    ax.axvspan(total[0], 1.0, color=COLORS[1], alpha=0.08, lw=0)
+    shade_band(ax, total[0], 1.0, "_no UIO")  # named by the text in it
     ax.text(0.98, 0.05, "no UIO", transform=ax.get_xaxis_transform(), ha="right", color="0.15")
     lim = 2.5 * max(float(np.max(np.abs(mine))), 0.02)
     ax.set_ylim(-lim, 0.6 * lim)
