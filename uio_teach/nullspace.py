@@ -43,9 +43,11 @@ import numpy as np
 from . import tolerances as tols
 from ._display import fit_lines, format_complex
 from ._validation import as_matrix, as_poles, read_only
+from .detection import Fault
 from .errors import UIOTeachError
 from .linalg import is_stable, left_null, rank_decision, sort_poles
 from .plant import Plant
+from .simulation import check_timepts, input_samples, linear_response
 
 __all__ = [
     "FaultModel",
@@ -165,8 +167,6 @@ def _indices(name: str, value: Any, size: int) -> list[int]:
 
 
 def _from_plant(plant: Plant, faults: Any) -> FaultModel:
-    from .detection import Fault  # the fault objects of the fault-detection chapter
-
     n, p = plant.n, plant.p
     if isinstance(faults, Fault):
         faults = [faults]
@@ -596,7 +596,7 @@ class NullspaceFilter:
         >>> float(filt.scaled(2.0).Rf.D[0, 0] * 2.0 - filt.Rf.D[0, 0]) == 0.0
         True
         """
-        import control as ct
+        import control as ct  # deferred on purpose: python-control takes a second to import
 
         rows = self._Q.noutputs
         c = np.broadcast_to(np.asarray(factors, dtype=float), (rows,)).copy()
@@ -679,8 +679,6 @@ class NullspaceFilter:
         >>> filt.residual(t, np.zeros((2, 11)), np.zeros((2, 11))).shape
         (1, 11)
         """
-        from .simulation import check_timepts, linear_response
-
         t = check_timepts(timepts)
         model = self._model
         y = as_matrix("outputs", outputs, model.p, t.size, what="p x N: one row per output")
@@ -758,8 +756,6 @@ class NullspaceFilter:
         >>> bool(np.abs(a.residual - b.residual).max() < 1e-9 * np.abs(a.outputs).max())
         True
         """
-        from .simulation import check_timepts, input_samples, linear_response
-
         model = self._model
         t = check_timepts(timepts)
         N = t.size
