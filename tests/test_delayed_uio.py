@@ -77,7 +77,7 @@ def test_the_causal_realization_runs_the_same_recursion():
     size = size_of(resp.states, causal)
     assert_rounding_close(ec[:, 2:], obs.Ad @ ec[:, 1:-1], size=size * 10, terms=30, steps=30)
     # and both estimates converge to the state
-    assert np.abs(ec[:, -1]).max() <= 1e-9 * size
+    assert_rounding_close(ec[:, -1], 0, size=size * 10, terms=30, steps=30)
 
 
 def _matched(a, b):
