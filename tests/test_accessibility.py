@@ -383,6 +383,7 @@ def test_a_static_explorer_speaks_once_after_the_control_rests():
     assert text.count('aria-live="polite"') == 1 and 'role="status"' in text
     assert '<output name="mainval" aria-live="off">' in text  # the slider says its value
     assert '<p class="uio-caption">' in text
+    assert 'aria-label="controls of the PA9 explorer"' in text  # the form has a name
     for frame in page.frames:
         assert f'data-said="{html.escape(frame.said)}"' in text
         assert frame.said.split(". ")[0] == f"UIO pole 1 = {frame.label}, {'sinusoid'}" or (
