@@ -88,7 +88,7 @@ UID_BASE = 1_700_000_000
 ``UID_BASE`` on (:class:`SandboxUser`). These ids lie far above any login account, one per
 running hand-in on the machine, so the limit on processes of one never counts another's."""
 UID_COUNT = 1 << 20
-"""How many sandbox user ids there are: far more than hand-ins can run at once on a machine."""
+"""The number of sandbox user ids, far more than hand-ins can run at once on a machine."""
 _UID_FOLDERS = ("/run/uio-teach/sandbox-uids", "/var/tmp/uio-teach-sandbox-uids")
 _PACKAGE_ROOT = "/opt/uio-teach"
 TEMP_PREFIX = "uio-teach-grade-"
