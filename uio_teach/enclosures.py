@@ -45,6 +45,31 @@ import scipy.linalg as sla
 from scipy.linalg import lapack
 
 from . import tolerances as tols
+from .linalg import ZeroSet
+
+
+def _real_cleaned(z: np.ndarray) -> np.ndarray:
+    """Imaginary parts that are round-off of a real value set to 0 (``REAL_RTOL``)."""
+    z = np.asarray(z, complex)
+    with np.errstate(invalid="ignore"):
+        real = np.abs(z.imag) <= tols.REAL_RTOL * np.abs(z)
+    return np.where(real, z.real + 0j, z)
+
+
+def _nearest_boundary(z: np.ndarray, discrete: bool) -> np.ndarray:
+    if discrete:
+        return np.exp(1j * np.where(z == 0, 0.0, np.angle(z)))
+    return 1j * z.imag
+
+
+def _order(z: np.ndarray) -> np.ndarray:
+    """Indices sorting by real part (rounded to the largest value's scale), then imaginary."""
+    finite = np.abs(z[np.isfinite(z)])
+    scale = float(np.max(finite)) if finite.size and np.max(finite) > 0 else 1.0
+    with np.errstate(invalid="ignore"):
+        key = np.round(z.real / scale, 9)
+    return np.lexsort((z.imag, key))
+
 
 __all__ = [
     "Disks",
@@ -446,8 +471,6 @@ def validated_zeros(
     >>> zs.zeros.real.round(6).tolist(), bool(zs.radius[0] < 1e-12), zs.decided
     ([-1.5], True, True)
     """
-    from .linalg import ZeroSet, _nearest_boundary, _order, _real_cleaned
-
     A = np.atleast_2d(np.asarray(A, float))
     n = A.shape[0]
     E = np.asarray(E, float).reshape(n, -1)

@@ -11,6 +11,7 @@ from .._display import fit_lines, format_complex, matrices_html, matrices_text
 from ..errors import UIOTeachWarning
 from ..linalg import is_stable, sort_poles
 from ..plant import Plant
+from ..verify import PlacementAccuracyError
 
 if TYPE_CHECKING:  # python-control is imported where a conversion needs it
     import control as ct
@@ -149,8 +150,6 @@ class Observer:
         then comes from round-off of the design, and the observer's error would not decay.
         Raises ``uio_teach.verify.PlacementAccuracyError`` naming the poles.
         """
-        from ..verify import PlacementAccuracyError
-
         if requested is None:
             return
         discrete = self.plant.is_discrete
