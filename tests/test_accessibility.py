@@ -367,7 +367,7 @@ def test_the_live_region_says_what_the_error_did_and_how_fast_from_the_data(name
             sign = 1 if pace.group(1) == "larger" else -1
             predicted = np.log10(start) + sign * (t[-1] - t[0]) / tau
             # two significant digits of tau: the decades agree to about 5 %
-            assert abs(predicted - np.log10(end)) <= 0.05 * abs(np.log10(end / start)) + 1e-9
+            assert abs(predicted - np.log10(end)) <= max(0.05 * abs(np.log10(end / start)), 1e-6)
     import matplotlib.pyplot as plt
 
     plt.close("all")

@@ -127,7 +127,7 @@ def test_delay_exists_iff_rank_increment_and_strong_detectability():
     smallest for which F M = [E 0] can be solved, and a design exists (stable, poles exact)
     exactly when, in addition, every invariant zero lies inside the unit disk."""
     seen = {True: 0, False: 0}
-    for seed in range(18):
+    for seed in range(48):
         r = seed % 3
         plant = _relative_degree_plant(seed, r, stable=seed % 4 != 3)
         report = ut.check_existence(plant)

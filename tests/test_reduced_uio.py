@@ -108,7 +108,7 @@ def test_reduced_exists_exactly_when_the_full_order_uio_does(discrete):
     where it does not, the reduced construction itself fails the same way (P E cannot be 0 when
     the rank condition fails; the unstable zero is a mode of the reduced pair no gain moves)."""
     seen = {True: 0, False: 0}
-    for seed in range(24):
+    for seed in range(60):
         plant = _random_plant(seed, discrete, stable_zeros=seed % 3 != 0, rank_ok=seed % 4 != 1)
         report = ut.check_existence(plant)
         if not report.decided:
@@ -188,3 +188,24 @@ def test_the_explorer_and_the_checks_accept_it():
     resp = ut.simulate(plant, obs, t, d=ut.signals.sinusoid(1.0, 2.0), initial_state=[1, 1, 1])
     result = ut.checks.pa9_simulation(resp)
     assert any("does not depend on d" in m for ok, m in result.items if ok), result
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_an_exact_rank_failure_is_refused_by_both(discrete):
+    """C E = 0 exactly (the input enters states that no output reads): the rank condition fails
+    as a decided verdict, and the reduced-order design refuses for that reason, as the full one
+    does."""
+    rng = np.random.default_rng(11)
+    n, p = 4, 2
+    A = rng.standard_normal((n, n)) * (0.3 if discrete else 1.0)
+    C = np.hstack([rng.standard_normal((p, n - 1)), np.zeros((p, 1))])
+    E = np.zeros((n, 1))
+    E[-1, 0] = 1.0
+    plant = ut.Plant(A, C, E=E, dt=1 if discrete else None)
+    report = ut.check_existence(plant)
+    assert report.decided and not report.ok
+    assert report["rank condition"].holds is False
+    with pytest.raises(ut.UIOExistenceError, match="reduced-order"):
+        ut.design_reduced_uio(plant, poles=[])
+    with pytest.raises(ut.UIOExistenceError):
+        ut.design_uio(plant, poles=np.full(n, 0.2 if discrete else -2.0))

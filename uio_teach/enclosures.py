@@ -538,7 +538,9 @@ def _tall_zero_disks(red: ReducedZeros, discrete: bool) -> Disks:
         Cc = Cz @ Xc / nX
         Bc = T[a:b, a:b] - disks.centre[a] * np.eye(b - a)
         nB = float(np.linalg.norm(Bc))
-        Bc = Bc / nB if nB > 0 else Bc
+        # a nilpotent part within the perturbation is no structure of the data: normalising
+        # it would blow round-off up to size 1 and make an unobservable cluster look observable
+        Bc = Bc / nB if nB > thr else np.zeros_like(Bc)
         # the observability of the cluster's own pair: [Cc; Cc Bc; ...]
         blocks, cur = [Cc], Cc
         for _ in range(b - a - 1):

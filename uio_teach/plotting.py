@@ -383,7 +383,7 @@ def finish_panel(ax: Axes, ylabel: str, legend: bool = True) -> None:
 
 
 BAND_EDGE = "#6E6E6E"
-"""The hatching and edges of a shaded band (:func:`shade_band`): 5.1:1 on white, so that the
+"""The hatching and edges of a shaded band (:func:`shade_band`), 5.1 to 1 on white, so that the
 band stands out (WCAG 2.1, 1.4.11, asks 3:1 for the parts of a graphic one needs to read it)."""
 
 
@@ -458,6 +458,16 @@ def low_contrast_areas(fig: Figure, least: float = 3.0) -> list[tuple[str, float
     -------
     list of (str, float)
         Each area's label and the best contrast it has, rounded to two decimals.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from uio_teach.plotting import low_contrast_areas
+    >>> fig, ax = plt.subplots()
+    >>> _ = ax.axvspan(0, 1, color="#F5F5F5", label="faint band")
+    >>> low_contrast_areas(fig)
+    [('faint band', 1.09)]
+    >>> plt.close(fig)
     """
     from matplotlib.colors import to_rgba  # deferred: matplotlib only when drawing
 

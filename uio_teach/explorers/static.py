@@ -626,8 +626,8 @@ _JS = (
 )
 
 SETTLE_MS = 700
-"""The live region speaks once a control has rested this long (milliseconds) on a frame: a
-slider dragged or held down over many frames is announced once, where it stops."""
+"""The live region speaks once a control has rested this long (milliseconds) on a frame, so
+that a slider dragged or held down over many frames is announced once, where it stops."""
 
 NARROW_PX = 700
 """At this width (CSS pixels) or less (a phone), the controls stack and the phone pictures show."""

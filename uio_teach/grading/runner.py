@@ -88,7 +88,9 @@ MAX_FILE_BYTES = 256 * 1024 * 1024
 """The largest file of the run read back."""
 RECORDS = "records"
 """The runner's records go into a pipe the grader reads, one JSON object a line, never into a
-file of the run's folder. ``{"error": {...}}`` for a cell that raised, as it ends;
+file of the run's folder.
+
+``{"error": {...}}`` for a cell that raised, as it ends;
 ``{"cut": true}`` when the output passed its cap; ``{"failed": "..."}`` for the runner's own
 failure; ``{"done": true}`` at the end of a run."""
 MAX_RECORD_BYTES = 16 * 1024 * 1024
