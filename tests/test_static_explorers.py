@@ -384,7 +384,8 @@ _CONTROLS_JS = """
   const el = document.activeElement;
   const label = el.labels && el.labels.length ? el.labels[0].textContent.trim() : "";
   const ring = getComputedStyle(el);
-  const live = root.querySelector("[aria-live]");
+  // the region that speaks (the value beside the slider is shown, not spoken: aria-live off)
+  const live = root.querySelector("[aria-live]:not([aria-live='off'])");
   return {
     inside: root.contains(el), tag: el.tagName, name: el.getAttribute("aria-label") || label,
     ring: ring.outlineStyle !== "none" ? parseFloat(ring.outlineWidth) : 0,
@@ -396,6 +397,14 @@ _CONTROLS_JS = """
   };
 }
 """
+
+
+# Whether the explorer's status has said something new since ``before``.
+_SPOKEN_JS = """([k, before]) => {
+  const root = document.querySelectorAll(".uio-static-explorer")[k];
+  const live = root.querySelector("[aria-live]:not([aria-live='off'])");
+  return live && (live.getAttribute("aria-live") + ": " + live.textContent) !== before;
+}"""
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -419,10 +428,13 @@ def test_controls_work_from_the_keyboard_with_focus_labels_and_announcements(nam
         if moved["shown"] == seen[0]["shown"]:  # the slider starts one short of its end
             page.keyboard.press("ArrowLeft")
             moved = page.evaluate(_CONTROLS_JS, 0)
-        seen.append(moved)
+        # the status speaks once the control has rested on its frame
+        page.wait_for_function(_SPOKEN_JS, arg=[0, seen[0]["live"]])
+        seen.append(page.evaluate(_CONTROLS_JS, 0))
         if kinds > 1:
             page.keyboard.press("Tab")  # the disturbance menu
             page.keyboard.press("ArrowDown")
+            page.wait_for_function(_SPOKEN_JS, arg=[0, seen[-1]["live"]])
             seen.append(page.evaluate(_CONTROLS_JS, 0))
         context.close()
 

@@ -23,7 +23,7 @@ state moves that the known input and the state do not explain span ``im E`` (the
 ``E`` (the unknown input's share is folded into it), differs from the true one by ``E G`` only,
 which ``T = I - H C`` removes (``T E = 0``). The invariant zeros and the rank condition do not
 change under that difference, so :func:`check_data` reaches the model-based verdicts of
-:func:`uio_teach.check_existence` and :func:`design_uio_from_data` the observer of
+:func:`uio_teach.check_existence` and ``design_uio_from_data`` the observer of
 :func:`uio_teach.design_uio`, from the data alone.
 """
 
@@ -150,7 +150,7 @@ class DataReport:
         :func:`uio_teach.check_existence` of the data plant.
     margin : float
         The smallest ratio of a kept singular value of the data matrices to its rank threshold
-        (below :data:`DATA_MARGIN` the design warns).
+        (below ``DATA_MARGIN`` the design warns).
 
     Examples
     --------
@@ -941,7 +941,7 @@ def noise_study(
 
     For every length and noise level, ``repeats`` experiments are recorded
     (:func:`record_experiment`, noise on ``x`` and ``y``), an observer is designed from each
-    (:func:`design_uio_from_data` with ``poles``, ``unknown_inputs=plant.q`` and ``rtol`` the
+    (``design_uio_from_data`` with ``poles``, ``unknown_inputs=plant.q`` and ``rtol`` the
     noise level), and run on the true plant for ``steps`` samples with a random unknown input
     and known input, the observer started at the true state (``z(0) = T x(0)``); the error is
     the RMS of ``x - xhat`` over the second half of the run, relative to the RMS of ``x``: what

@@ -18,10 +18,10 @@ scrambled text) and Johansson's quadruple tank, built from the paper's parameter
   pump voltages (:func:`tank_operating_point`), both pump flows unknown
   (``E = B``); the paper's parameters, levels, time constants and zeros in
   :data:`QUADRUPLE_TANK_PUBLISHED`.
-* :func:`varga_5_4` -- Varga, *Solving Fault Diagnosis Problems* (Springer, 2024),
+* ``varga_5_4`` -- Varga, *Solving Fault Diagnosis Problems* (Springer, 2024),
   Example 5.4: a plant given by transfer functions with feedthrough, one known input,
   one disturbance and two faults; the printed nullspace filter ``Q`` and ``Rf`` in
-  :data:`VARGA_5_4_PUBLISHED`.
+  ``VARGA_5_4_PUBLISHED``.
 """
 
 from __future__ import annotations

@@ -301,7 +301,7 @@ class LabParams(ABC):
         """The keys of the term config this lab reads (its fields' config keys).
 
         ``uio-teach labs`` names every key a config sets that no lab reads
-        (:func:`uio_teach.instructor.labs.unused_config_keys`); a lab whose
+        (``uio_teach.instructor.labs.unused_config_keys``); a lab whose
         :meth:`from_config` reads another key says so here.
         """
         keys = (spec.config_key(cls.lab, name) for name, spec in cls.declared())

@@ -606,7 +606,7 @@ class ZeroSet(NamedTuple):
     a plant with more outputs than unknown inputs is not generic: it holds by the structure of
     the data, and a perturbation of that size removes it); ``None``: no zero is fragile."""
     validated: bool = False
-    """True when ``radius`` is a proven bound (:mod:`uio_teach.enclosures`), not an estimate."""
+    """True when ``radius`` is a proven bound (``uio_teach.enclosures``), not an estimate."""
 
     @property
     def undecided(self) -> np.ndarray:

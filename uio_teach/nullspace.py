@@ -438,7 +438,7 @@ def _blockdiag(blocks: list[np.ndarray]) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FilterResponse:
-    """A run of the plant with a nullspace filter (:meth:`NullspaceFilter.simulate`).
+    """A run of the plant with a nullspace filter (``NullspaceFilter.simulate``).
 
     Signals have one row per channel and one column per time point.
 

@@ -440,10 +440,20 @@ class ExplorerFigure:
                     # error channel e_1, e_2, ... (in both observers' panels) and the guides
                     if r == "error":
                         shown = [g for g in self.lines["guides"] if g.get_label()[0] != "_"]
-                        ax.legend(
-                            handles=[*self.lines[f"{who}.error"], *(shown if who == "uio" else [])],
-                            **{**_LEGEND, "fontsize": self.legend_pt},
-                        )
+                        handles = [*self.lines[f"{who}.error"], *(shown if who == "uio" else [])]
+                        if self.narrow:
+                            # a phone's panel has no room above the curves for every channel:
+                            # the guides alone, as the channels are named in the words
+                            handles = shown if who == "uio" else []
+                        if handles:
+                            ax.legend(
+                                handles=handles,
+                                **{
+                                    **_LEGEND,
+                                    "fontsize": self.legend_pt,
+                                    "ncol": 1 if self.narrow else 2,
+                                },
+                            )
                     else:
                         ax.legend(**{**_LEGEND, "fontsize": self.legend_pt})
             axes[f"{who}.{rows[-1]}"].set_xlabel(self._xlabel(), fontsize=8 * k)

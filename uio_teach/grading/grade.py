@@ -897,7 +897,7 @@ def grade(
         of a folder named ``*.ipynb`` (any case), at any depth (an LMS's
         download in folders), is a hand-in with its row; every other entry is
         listed in the result's ``survey`` with why it is not graded, and what
-        appears during the run in its ``added`` (see :mod:`uio_teach.grading.survey`).
+        appears during the run in its ``added`` (see ``uio_teach.grading.survey``).
     out : path
         The CSV to write; the feedback goes to ``<stem>_feedback/`` beside it,
         the LMS exports to ``<stem>_groups.csv``, ``<stem>_canvas.csv`` and
@@ -1139,7 +1139,7 @@ def handin_files(
 ) -> list[str]:
     """The hand-ins: each ``*.ipynb`` entry of a folder at any depth (links too), or the paths.
 
-    A folder is surveyed (:func:`~uio_teach.grading.survey.survey`): an
+    A folder is surveyed (``uio_teach.grading.survey.survey``): an
     entry named ``*.ipynb`` in any case, at any depth, is a hand-in, links
     and folders of that name too (refused when read).
 

@@ -13,7 +13,7 @@
 Group names ``g<number>`` are written with at least two digits everywhere
 (:func:`group_id`: ``g3``, ``g03``, ``G3``, ``Group-3``, ``group_3`` and
 ``Group 3`` are one group). Every name (a file's, a student's, a group's) is
-compared in one Unicode normal form, NFC (:func:`same_form`): a macOS zip
+compared in one Unicode normal form, NFC (``same_form``): a macOS zip
 writes ``é`` as ``e`` and a combining accent (NFD), a roster saved on Windows
 writes it as one character, and both name the same hand-in.
 
@@ -165,7 +165,7 @@ def group_from_name(
     (``pa9_Group-30``: group 30, not group "Group" handed in again). A lab of
     the course is found anywhere before the group; another lab only as the
     whole of the name before it (graded as an unknown lab). The name is read
-    in NFC (:func:`same_form`).
+    in NFC (``same_form``).
 
     Parameters
     ----------
@@ -341,7 +341,7 @@ def read_roster(
     are skipped); Moodle's participants export names the student by ``ID
     number`` (else ``Username`` or ``Email address``), the name by ``First
     name`` and ``Last name``, and the group by ``Groups``. Names are read in
-    NFC (:func:`same_form`). A row with a file says that file is the group's
+    NFC (``same_form``). A row with a file says that file is the group's
     hand-in; a row with a student puts the student in the group (for the
     Canvas and Moodle exports). A student or a file listed
     twice is refused, naming it and both lines: one of the two rows is wrong,

@@ -527,6 +527,14 @@ class MissileParams(LabParams):
         if np.max(np.abs(plant.E @ np.linalg.inv(CE))) > 50:
             out.append("M has entries too large for a fair comparison with the paper's")
         if not out:
+            # both observers of the lab must be designable for this plant (a design whose
+            # decoupling cannot be certified is refused, and the group could not go on)
+            try:
+                design_ginverse(plant)
+                design_pmo(plant, poles=[complex(p) for p in self.poles])
+            except (ValueError, ArithmeticError) as err:
+                return [*out, f"both observers must be designable: {err}"]
+        if not out:
             # the lab's runs start the PMO at z(0) = 0: e(0) = (I - MC) x0
             M = design_pmo(plant, poles=[complex(p) for p in self.poles], Mv=MISSILE_PUBLISHED.Mv).M
             e0 = (np.eye(plant.n) - M @ plant.C) @ np.asarray(MISSILE_PUBLISHED.x0, float)
