@@ -109,7 +109,7 @@
       var ours = el.hasAttribute(MARK);
       var style = getComputedStyle(el);
       var scrolls = (style.overflowX === "auto" || style.overflowX === "scroll") &&
-        el.scrollWidth > el.clientWidth + 1;
+        el.scrollWidth > el.clientWidth;  /* as axe-core counts it: one pixel scrolls */
       var math = el.matches("mjx-container");
       var free = math ? !el.querySelector(FOCUSABLE)
         : !el.hasAttribute("tabindex") && !el.querySelector(FOCUSABLE);
@@ -244,4 +244,17 @@
     }
   });
   document.addEventListener("toggle", later, true); /* a <details> opened or closed */
+  /* a dropdown or hidden cell opened (its "open", class or style changed): its frames are
+     checked before anything else runs, not at the next animation frame, so that a frame that
+     scrolls is never left out of the keyboard's reach while it shows */
+  if (window.MutationObserver) {
+    var queued = false;
+    new MutationObserver(function () {
+      if (queued) return;
+      queued = true;
+      Promise.resolve().then(function () { queued = false; mark(); });
+    }).observe(document.documentElement, {
+      attributes: true, subtree: true, attributeFilter: ["open", "class", "style", "hidden"]
+    });
+  }
 })();
