@@ -351,6 +351,8 @@ def dead_links(site: Path) -> list[str]:
     anchor (``#id``) its page does not define: ``page -> link``."""
     pages: dict[Path, _Anchors] = {}
     for html in sorted(site.rglob("*.html")):
+        if "_static" in html.relative_to(site).parts:
+            continue  # the theme's template macros shipped as files, not pages of the book
         parser = _Anchors()
         parser.feed(html.read_text(encoding="utf-8", errors="replace"))
         pages[html.resolve()] = parser
