@@ -426,7 +426,7 @@ def test_no_link_of_the_student_edition_is_dead(built_book: Path) -> None:
 
 
 def test_the_student_api_page_holds_no_tutor_only_text(built_book: Path) -> None:
-    text = _main_text(built_book / "api.html")
+    text = _main_text(built_book / "book" / "api.html")
     for words in ("answer key", "sandbox", "copies between groups", "uio_teach.grading"):
         assert words not in text, f"the student edition's API page speaks of {words!r}"
 
