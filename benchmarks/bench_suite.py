@@ -11,8 +11,8 @@ For each target: the wall-clock time of the whole command, the CPU time of every
 started (user + system, summed over the workers, the kernels and the book build), the machine's
 load average before and after (the cores are shared: wall-clock grows with the load, CPU time
 much less), and from pytest's JUnit report the tests run and the time summed per test module,
-the ten largest listed. The API page's size is that of ``_build/html/book/api.html`` when a build is
-there (``make book`` first), with the size of the whole HTML page and of its text. The last line
+the ten largest listed. The API reference's size is that of its largest page,
+``_build/html/book/api*.html``, when a build is there (``make book`` first). The last line
 is the result as JSON, read by ``benchmarks/report.py``.
 """
 
@@ -83,10 +83,12 @@ def run_target(target: str, root: Path = ROOT) -> dict:
 
 
 def api_page(root: Path = ROOT) -> dict | None:
-    page = root / "_build" / "html" / "book" / "api.html"
-    if not page.exists():
+    """The largest page of the API reference (``book/api*.html``), when a build is there."""
+    pages = sorted((root / "_build" / "html" / "book").glob("api*.html"))
+    if not pages:
         return None
-    return {"api_bytes": page.stat().st_size}
+    largest = max(pages, key=lambda page: page.stat().st_size)
+    return {"api_bytes": largest.stat().st_size, "api_page": f"book/{largest.name}"}
 
 
 def main(argv: list[str] | None = None) -> int:
