@@ -222,6 +222,9 @@ class StudentEdition(SphinxTransform):
         objects = _dropped_objects(self.env).setdefault(self.env.docname, set())
         for signature in section.findall(addnodes.desc_signature):
             objects.update(signature.get("ids", []))
+        for target in section.findall(nodes.target):  # an automodule's "module-..." anchor
+            objects.update(i for i in target.get("ids", []) if i.startswith("module-"))
+        forget_objects(self.env, self.env.docname, objects)
         parent.remove(section)
         dropped = _dropped(self.env)
         for name in names:  # no label of the page leads there any more
@@ -230,6 +233,20 @@ class StudentEdition(SphinxTransform):
             dropped[name] = (self.env.docname, text)
         for i in ids:
             self.document.ids.pop(i, None)
+
+
+def forget_objects(env: Any, docname: str, anchors: set[str]) -> int:
+    """Take the Python objects and modules documented at ``anchors`` of page ``docname`` out of
+    the domain's records: the module index, the general index's object entries and the
+    inventory (``objects.inv``) then list none of them. Returns how many were taken out."""
+    data = env.get_domain("py").data
+    count = 0
+    for table in ("objects", "modules"):
+        records = data.get(table, {})
+        for name in [n for n, e in records.items() if e[0] == docname and e[1] in anchors]:
+            del records[name]
+            count += 1
+    return count
 
 
 def fold_away(node: nodes.Element) -> None:
@@ -302,8 +319,23 @@ def _unlink(app: Sphinx, doctree: nodes.Node, docname: str) -> None:
         unlink_dropped(doctree, anchors)
 
 
+def dropped_object(anchors: set[str], node: nodes.Element) -> bool:
+    """Does the Python cross-reference ``node`` name an object (or a module) of the anchors of
+    a tutors' section left out? Its target may be written relative to the current module."""
+    target = node.get("reftarget", "")
+    if node.get("reftype") == "mod":
+        return f"module-{target}" in anchors
+    module = node.get("py:module") or ""
+    names = {target, f"{module}.{target}"}
+    return any(a in names or a.endswith(f".{target}") for a in anchors)
+
+
 def _dropped_reference(app: Sphinx, env: Any, node: nodes.Element, contnode: nodes.Node):
-    """A reference to a tutors' section left out: its title as plain text, not a dead link."""
+    """A reference to a tutors' section left out: its title as plain text, not a dead link;
+    a reference to an object documented there: its name, unlinked."""
+    if node.get("refdomain") == "py" and edition_of(app.config) in LIKE_STUDENT:
+        anchors = set().union(*_dropped_objects(env).values())
+        return contnode if anchors and dropped_object(anchors, node) else None
     if node.get("refdomain") != "std" or node.get("reftype") != "ref":
         return None
     found = _dropped(env).get(node.get("reftarget", ""))
