@@ -59,6 +59,9 @@ class Condition:
     >>> cond = ut.check_existence(ut.examples.pa9())["rank condition"]
     >>> cond.holds, cond.symbol
     (True, '✓')
+    >>> print(cond)
+    ✓ rank condition: rank(CE) = 1 = rank(E): the unknown inputs can be
+      decoupled
     """
 
     name: str
@@ -89,6 +92,10 @@ class Condition:
         if self.undecided:
             return "?"
         return {True: "✓", False: "✗", None: "–"}[self.holds]
+
+    def __str__(self) -> str:
+        """The verdict, the condition and why, wrapped to the book's column."""
+        return fit_lines(f"{self.symbol} {self.name}: {self.reason}")
 
 
 @dataclass(frozen=True)

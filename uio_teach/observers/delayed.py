@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .. import tolerances as tols
+from .._display import fit_lines
 from .._validation import read_only
 from ..errors import UIOTeachError
 from ..existence import ExistenceReport, check_existence
@@ -171,7 +172,7 @@ class DelayVerdict:
     reason: str
 
     def __str__(self) -> str:
-        return self.reason
+        return fit_lines(self.reason)
 
 
 def _increments(plant: Plant, top: int) -> list[int]:
