@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from tolerance import assert_rounding_close, size_of
+from tolerance import assert_rounding_close, matched_distance, size_of
 
 import uio_teach as ut
 from uio_teach.observers.delayed import stacked_matrices
@@ -80,19 +80,6 @@ def test_the_causal_realization_runs_the_same_recursion():
     assert_rounding_close(ec[:, -1], 0, size=size * 10, terms=30, steps=30)
 
 
-def _matched(a, b):
-    """Largest distance between two multisets of complex numbers, matched greedily."""
-    a, b = list(np.asarray(a, complex)), list(np.asarray(b, complex))
-    assert len(a) == len(b), (a, b)
-    worst = 0.0
-    for x in a:
-        d = [abs(x - y) for y in b]
-        i = int(np.argmin(d))
-        worst = max(worst, d[i])
-        b.pop(i)
-    return worst
-
-
 def _relative_degree_plant(seed, r, stable):
     """q unknown inputs reaching y only through C A^r E (C A^k E = 0 for k < r)."""
     rng = np.random.default_rng(seed)
@@ -145,7 +132,7 @@ def test_delay_exists_iff_rank_increment_and_strong_detectability():
             obs = ut.design_uio(plant, poles=poles, delay=v.delay)
             want = np.concatenate([poles, report.invariant_zeros])
             got = obs.poles()
-            assert _matched(got, want) <= 1e-6, (got, want)
+            assert matched_distance(got, want) <= 1e-6, (got, want)
             # waiting longer than needed works too
             assert ut.design_uio(plant, poles=poles, delay=v.delay + 1).is_stable
         else:

@@ -3,23 +3,16 @@
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from tolerance import assert_rounding_close, assert_same_run, eigenvalue_roundoff, size_of
+from tolerance import (
+    assert_rounding_close,
+    assert_same_run,
+    eigenvalue_roundoff,
+    matched_distance,
+    size_of,
+)
 
 import uio_teach as ut
 from uio_teach.observers.reduced import reduced_pair
-
-
-def _matched(a, b):
-    """Largest distance between two multisets of complex numbers, matched greedily."""
-    a, b = list(np.asarray(a, complex)), list(np.asarray(b, complex))
-    assert len(a) == len(b), (a, b)
-    worst = 0.0
-    for x in a:
-        d = [abs(x - y) for y in b]
-        i = int(np.argmin(d))
-        worst = max(worst, d[i])
-        b.pop(i)
-    return worst
 
 
 def test_pa9_order_poles_and_matrices():
@@ -59,7 +52,7 @@ def test_missile_has_no_free_pole_and_the_full_uio_s_fixed_modes():
     report = ut.check_existence(missile)
     obs = ut.design_reduced_uio(missile, poles=[])
     assert obs.order == 2 == report.fixed_modes.size
-    assert _matched(obs.poles(), report.fixed_modes) <= 100 * eigenvalue_roundoff(obs.F)
+    assert matched_distance(obs.poles(), report.fixed_modes) <= 100 * eigenvalue_roundoff(obs.F)
     with pytest.raises(ValueError, match=r"0 pole\(s\) can be placed, got 2.*invariant zeros"):
         ut.design_reduced_uio(missile, poles=[-150, -160])
 
@@ -119,7 +112,7 @@ def test_reduced_exists_exactly_when_the_full_order_uio_does(discrete):
             # the reduced pair's fixed modes are the full UIO's: the invariant zeros
             fixed = rp.split.unobservable_modes
             assert fixed.size == report.invariant_zeros.size
-            assert _matched(fixed, report.invariant_zeros) <= 1e-6 * max(
+            assert matched_distance(fixed, report.invariant_zeros) <= 1e-6 * max(
                 1.0, np.abs(report.invariant_zeros).max(initial=0.0)
             )
         else:
@@ -133,7 +126,7 @@ def test_reduced_exists_exactly_when_the_full_order_uio_does(discrete):
             assert obs.order == plant.n - np.linalg.matrix_rank(plant.C)
             assert obs.is_stable
             want = np.concatenate([np.asarray(poles, complex), report.fixed_modes])
-            assert _matched(obs.poles(), want) <= 1e-6 * max(1.0, np.abs(want).max())
+            assert matched_distance(obs.poles(), want) <= 1e-6 * max(1.0, np.abs(want).max())
         else:
             with pytest.raises(ut.UIOExistenceError, match="reduced-order"):
                 ut.design_reduced_uio(plant, poles=[])

@@ -127,3 +127,17 @@ def eigenvalue_roundoff(F: object) -> float:
     with np.errstate(divide="ignore"):
         kappa = 1.0 / np.abs(np.sum(left.conj() * right, axis=0))
     return roundoff(np.linalg.norm(F, 2), terms=F.shape[0], gain=float(np.max(kappa)))
+
+
+def matched_distance(a: object, b: object) -> float:
+    """Largest distance between two multisets of complex numbers (poles, zeros), each of ``a``
+    matched greedily to the nearest not yet matched of ``b``; they must be as many."""
+    a, b = list(np.asarray(a, complex).ravel()), list(np.asarray(b, complex).ravel())
+    assert len(a) == len(b), (a, b)
+    worst = 0.0
+    for x in a:
+        d = [abs(x - y) for y in b]
+        i = int(np.argmin(d))
+        worst = max(worst, d[i])
+        b.pop(i)
+    return worst

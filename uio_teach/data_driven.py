@@ -29,7 +29,6 @@ change under that difference, so :func:`check_data` reaches the model-based verd
 
 from __future__ import annotations
 
-import html
 import warnings
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -37,10 +36,16 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.linalg
 
-from ._display import LINE_WIDTH, fit_lines
+from ._display import fit_lines
 from ._validation import as_real_array, as_real_number, as_seed
 from .errors import UIOTeachError, UIOTeachWarning
-from .existence import Condition, ExistenceReport, check_existence
+from .existence import (
+    Condition,
+    ExistenceReport,
+    check_existence,
+    conditions_html,
+    conditions_text,
+)
 from .linalg import pinv
 from .observers import UIO, UnstableObserverWarning, design_uio
 from .observers.projection import verify_projection
@@ -198,30 +203,13 @@ class DataReport:
 
     def __str__(self) -> str:
         head = f"Data conditions for an unknown input observer ({self.samples} samples)"
-        width = max(len(c.name) for c in self.conditions)
-        lines = [head if len(head) <= LINE_WIDTH else fit_lines(head)]
-        indent = " " * (width + 6)
-        for c in self.conditions:
-            tag = "" if c.required else " (info)"
-            lines.append(
-                fit_lines(f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}", indent=indent)
-            )
-        lines.append(f"  => {self.verdict}")
-        return "\n".join(lines)
+        return conditions_text(fit_lines(head), self.conditions, self.verdict)
 
     __repr__ = __str__
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{c.symbol}</td><td>{html.escape(c.name)}</td>"
-            f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
-            for c in self.conditions
-        )
-        return (
-            f"<div><b>Data conditions for an unknown input observer</b> ({self.samples} samples)"
-            f"<table><tr><th></th><th>condition</th><th>why</th></tr>{rows}</table>"
-            f"<b>&rArr; {html.escape(self.verdict)}</b></div>"
-        )
+        title = f"<b>Data conditions for an unknown input observer</b> ({self.samples} samples)"
+        return conditions_html(title, self.conditions, self.verdict)
 
 
 # input checks -----------------------------------------------------------------------------------

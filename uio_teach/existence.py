@@ -302,32 +302,41 @@ class ExistenceReport:
         head = f"Existence of an unknown input observer for {self.plant!r}"
         if len(head) > LINE_WIDTH:
             head = fit_lines(f"Existence of an unknown input observer for\n  {self.plant!r}")
-        width = max(len(c.name) for c in self.conditions)
-        lines = [head]
-        indent = " " * (width + 6)
-        for c in self.conditions:
-            tag = "" if c.required else " (info)"
-            text = f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}"
-            # wrap long reasons under their column so the table fits the book's column
-            lines.append(fit_lines(text, indent=indent))
-        lines.append(f"  => {self.verdict}")
-        return "\n".join(lines)
+        return conditions_text(head, self.conditions, self.verdict)
 
     __repr__ = __str__
 
     def _repr_html_(self) -> str:
-        rows = "".join(
-            f"<tr><td>{c.symbol}</td><td>{html.escape(c.name)}</td>"
-            f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
-            for c in self.conditions
+        title = "<b>Existence of an unknown input observer</b> for " + html.escape(repr(self.plant))
+        return conditions_html(title, self.conditions, self.verdict)
+
+
+def conditions_text(head: str, conditions: tuple[Condition, ...], verdict: str) -> str:
+    """A report's table of conditions as text: a row per condition (its mark, name and why,
+    long reasons wrapped under their column to fit the book's), then the verdict."""
+    width = max(len(c.name) for c in conditions)
+    lines = [head]
+    indent = " " * (width + 6)
+    for c in conditions:
+        tag = "" if c.required else " (info)"
+        lines.append(
+            fit_lines(f"  {c.symbol} {c.name.ljust(width)}  {c.reason}{tag}", indent=indent)
         )
-        verdict = self.verdict
-        return (
-            f"<div><b>Existence of an unknown input observer</b> for "
-            f"{html.escape(repr(self.plant))}<table>"
-            f"<tr><th></th><th>condition</th><th>why</th></tr>{rows}</table>"
-            f"<b>&rArr; {verdict}</b></div>"
-        )
+    lines.append(f"  => {verdict}")
+    return "\n".join(lines)
+
+
+def conditions_html(title: str, conditions: tuple[Condition, ...], verdict: str) -> str:
+    """The same table in HTML (``title`` is HTML already)."""
+    rows = "".join(
+        f"<tr><td>{c.symbol}</td><td>{html.escape(c.name)}</td>"
+        f"<td>{html.escape(c.reason)}{'' if c.required else ' <i>(info)</i>'}</td></tr>"
+        for c in conditions
+    )
+    return (
+        f"<div>{title}<table><tr><th></th><th>condition</th><th>why</th></tr>{rows}</table>"
+        f"<b>&rArr; {html.escape(verdict)}</b></div>"
+    )
 
 
 class UIOExistenceError(UIOTeachError, ValueError):
