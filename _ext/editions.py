@@ -71,11 +71,36 @@ def edition_of(config: Config) -> str:
     return config.uio_teach_edition
 
 
+def labels_before(section: nodes.section) -> list[str]:
+    """The names of the labels written right before ``section``'s heading: MyST leaves a
+    ``(label)=`` line as a target in front of the section, or as the last child of the section
+    before it (the label reaches the section's own ids only later, when references resolve)."""
+    parent = section.parent
+    if parent is None:
+        return []
+    names: list[str] = []
+    k = parent.index(section) - 1
+    while k >= 0 and _is_label(parent.children[k]):
+        names += parent.children[k].get("names", []) + parent.children[k].get("ids", [])
+        k -= 1
+    node = parent.children[k] if k >= 0 else None
+    while isinstance(node, nodes.section) and node.children:
+        tail = list(node.children)
+        while tail and _is_label(tail[-1]):
+            names += tail[-1].get("names", []) + tail[-1].get("ids", [])
+            tail.pop()
+        if len(tail) < len(node.children):
+            break
+        node = node.children[-1]
+    return names
+
+
 def is_instructor_section(section: nodes.section) -> bool:
-    """A section of notes for the tutors: headed "Instructor notes" or labelled ``*-instructor``."""
+    """A section of notes for the tutors: headed "Instructor notes" or labelled ``*-instructor``
+    (the label written on the section or right before its heading)."""
     title = section.next_node(nodes.title)
     heading = title.astext().strip().lower() if title is not None else ""
-    labels = " ".join(section.get("ids", []) + section.get("names", []))
+    labels = " ".join(section.get("ids", []) + section.get("names", []) + labels_before(section))
     return heading.startswith("instructor") or "-instructor" in labels
 
 

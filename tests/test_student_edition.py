@@ -441,6 +441,28 @@ def test_the_objects_of_a_dropped_section_leave_the_module_index() -> None:
     assert forget_objects(env, "book/api_detection", {"module-uio_teach.linalg"}) == 0
 
 
+def test_a_label_written_before_a_heading_marks_its_section() -> None:
+    """MyST leaves ``(sec-x-instructor)=`` before ``## Heading`` as the last child of the
+    section before: that section is not the tutors', the next one is."""
+    from docutils import nodes
+    from editions import is_instructor_section
+
+    def section(title: str, *children: nodes.Node) -> nodes.section:
+        node = nodes.section()
+        node += nodes.title(title, title)
+        for child in children:
+            node += child
+        return node
+
+    page = nodes.section()
+    label = nodes.target(names=["sec-api-grader-instructor"], ids=["sec-api-grader-instructor"])
+    tools = section("Linear algebra", nodes.paragraph("", "rank"), label)
+    grader = section("The grader")
+    plain = section("Test signals")
+    page += [tools, grader, plain]
+    assert [is_instructor_section(s) for s in (tools, grader, plain)] == [False, True, False]
+
+
 def test_a_reference_to_a_forgotten_object_is_recognised() -> None:
     """References to the objects of a dropped section find no target any more: they are read as
     their text (by name, by a name relative to the current module, or as a module)."""
