@@ -71,6 +71,29 @@ def edition_of(config: Config) -> str:
     return config.uio_teach_edition
 
 
+def trailing_labels(section: nodes.section) -> list[nodes.target]:
+    """The labels that close ``section`` (at the end of its last descendant), in page order:
+    MyST puts there a ``(label)=`` written before the next heading."""
+    found: list[nodes.target] = []
+    node: nodes.Node = section
+    while isinstance(node, nodes.section) and node.children:
+        tail = list(node.children)
+        k = len(tail)
+        while k > 0 and _is_label(tail[k - 1]):
+            k -= 1
+        found = tail[k:] + found
+        if k < len(tail):
+            break
+        node = tail[-1]
+    return found
+
+
+def leave_out_objects(env: Any, docname: str, anchors: set[str]) -> None:
+    """Record ``anchors`` as objects this edition of page ``docname`` leaves out: references
+    to them read as their names (the same as for a tutors' section left out)."""
+    _dropped_objects(env).setdefault(docname, set()).update(anchors)
+
+
 def labels_before(section: nodes.section) -> list[str]:
     """The names of the labels written right before ``section``'s heading: MyST leaves a
     ``(label)=`` line as a target in front of the section, or as the last child of the section
@@ -83,15 +106,10 @@ def labels_before(section: nodes.section) -> list[str]:
     while k >= 0 and _is_label(parent.children[k]):
         names += parent.children[k].get("names", []) + parent.children[k].get("ids", [])
         k -= 1
-    node = parent.children[k] if k >= 0 else None
-    while isinstance(node, nodes.section) and node.children:
-        tail = list(node.children)
-        while tail and _is_label(tail[-1]):
-            names += tail[-1].get("names", []) + tail[-1].get("ids", [])
-            tail.pop()
-        if len(tail) < len(node.children):
-            break
-        node = node.children[-1]
+    before = parent.children[k] if k >= 0 else None
+    if isinstance(before, nodes.section):
+        for label in trailing_labels(before):
+            names += label.get("names", []) + label.get("ids", [])
     return names
 
 
@@ -198,8 +216,11 @@ class StudentEdition(SphinxTransform):
                 note = nodes.paragraph(UNRUN_NOTE, "", nodes.emphasis(UNRUN_NOTE, UNRUN_NOTE))
                 note["classes"].append(UNRUN_CLASS)
                 cell += note
-        for section in list(self.document.findall(nodes.section)):
-            if not self._attached(section) or not is_instructor_section(section):
+        # which sections are the tutors' is decided before any is dropped: a label written
+        # before a heading sits at the end of the section before, which may itself go
+        tutors = [s for s in self.document.findall(nodes.section) if is_instructor_section(s)]
+        for section in tutors:
+            if not self._attached(section):
                 continue
             if isinstance(section.parent, nodes.section):  # a section of a page: dropped whole
                 self._drop(section)
@@ -218,10 +239,15 @@ class StudentEdition(SphinxTransform):
             section += nodes.paragraph(STUB_NOTE, STUB_NOTE)
 
     def _drop(self, section: nodes.section) -> None:
-        """Remove a section whole, with the label targets in front of it and its names."""
+        """Remove a section whole, with the label targets in front of it and its names; the
+        labels at its end, written before the next heading, stay for the section they name."""
         title = section.next_node(nodes.title)
         text = title.astext() if title is not None else ""
         parent = section.parent
+        place = parent.index(section) + 1
+        for trailing in trailing_labels(section):
+            trailing.parent.remove(trailing)
+            parent.insert(place, trailing)
         ids = set(section.get("ids", []))
         names = set(section.get("names", []))
         labels = []  # its labels: the internal targets right in front of it
@@ -352,7 +378,9 @@ def dropped_object(anchors: set[str], node: nodes.Element) -> bool:
         return f"module-{target}" in anchors
     module = node.get("py:module") or ""
     names = {target, f"{module}.{target}"}
-    return any(a in names or a.endswith(f".{target}") for a in anchors)
+    return any(
+        n == a or n.startswith(f"{a}.") or a.endswith(f".{target}") for a in anchors for n in names
+    )
 
 
 def _dropped_reference(app: Sphinx, env: Any, node: nodes.Element, contnode: nodes.Node):

@@ -28,13 +28,23 @@ def worked_modules() -> dict[str, str]:
     return modules
 
 
-def module_lines(name: str, title: str = "") -> list[str]:
-    """The reStructuredText of one worked example's module (under a rubric: its title)."""
+def tutors_only(obj: object) -> bool:
+    """A lab's parameter class (variants, the answer key): instructor tooling."""
+    from uio_teach.lab_params import LabParams
+
+    return inspect.isclass(obj) and issubclass(obj, LabParams)
+
+
+def module_lines(name: str, title: str = "", *, student: bool = False) -> list[str]:
+    """The reStructuredText of one worked example's module (under a rubric: its title); for
+    a student edition without the lab's parameter class."""
     module = importlib.import_module(name)
     lines = [f".. rubric:: {title}", ""] if title else []
     lines += [f".. automodule:: {name}", "   :no-members:", ""]
     for member in getattr(module, "__all__", ()):
         obj = getattr(module, member)
+        if student and tutors_only(obj):
+            continue
         if inspect.isclass(obj):
             lines += [f".. autoclass:: {name}.{member}", "   :members:", ""]
         elif inspect.isfunction(obj):
@@ -50,9 +60,18 @@ class WorkedExamples(SphinxDirective):
     has_content = False
 
     def run(self) -> list[nodes.Node]:
+        from editions import LIKE_STUDENT, edition_of, leave_out_objects
+
+        student = edition_of(self.config) in LIKE_STUDENT
         lines: list[str] = []
         for name, title in worked_modules().items():
-            lines += module_lines(name, title)
+            lines += module_lines(name, title, student=student)
+            if student:  # references to the classes left out read as their names
+                module = importlib.import_module(name)
+                left = [
+                    m for m in getattr(module, "__all__", ()) if tutors_only(getattr(module, m))
+                ]
+                leave_out_objects(self.env, self.env.docname, {f"{name}.{m}" for m in left})
         container = nodes.container()
         self.state.nested_parse(StringList(lines, source="worked-examples"), 0, container)
         return container.children

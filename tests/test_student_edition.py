@@ -445,7 +445,7 @@ def test_a_label_written_before_a_heading_marks_its_section() -> None:
     """MyST leaves ``(sec-x-instructor)=`` before ``## Heading`` as the last child of the
     section before: that section is not the tutors', the next one is."""
     from docutils import nodes
-    from editions import is_instructor_section
+    from editions import is_instructor_section, trailing_labels
 
     def section(title: str, *children: nodes.Node) -> nodes.section:
         node = nodes.section()
@@ -461,6 +461,10 @@ def test_a_label_written_before_a_heading_marks_its_section() -> None:
     plain = section("Test signals")
     page += [tools, grader, plain]
     assert [is_instructor_section(s) for s in (tools, grader, plain)] == [False, True, False]
+    # the label closes the section before, however deep its last subsection
+    nested = section("Explorers", section("Sliders", nodes.paragraph("", "x"), label.deepcopy()))
+    assert trailing_labels(nested)[0]["names"] == ["sec-api-grader-instructor"]
+    assert not trailing_labels(grader)
 
 
 def test_a_reference_to_a_forgotten_object_is_recognised() -> None:
@@ -480,6 +484,10 @@ def test_a_reference_to_a_forgotten_object_is_recognised() -> None:
     assert dropped_object(anchors, ref("merge", module="uio_teach.grading.merge"))
     assert dropped_object(anchors, ref("uio_teach.instructor.variants", "mod"))
     assert not dropped_object(anchors, ref("uio_teach.simulate"))
+    # a member of a class left out (a lab's parameter class in the student edition)
+    assert dropped_object(
+        {"uio_teach.worked.pa9.PA9Params"}, ref("uio_teach.worked.pa9.PA9Params.draw")
+    )
     assert not dropped_object(anchors, ref("uio_teach.grading", "mod"))
 
 
