@@ -25,6 +25,7 @@
     "[tabindex]:not([tabindex='-1'])";
   var MARK = "data-uio-scroll";
   var CUT = "data-uio-cut";
+  var NAMED = "data-uio-name";  /* the name a frame was given, before two alike were told apart */
 
   function words(el, most) {
     var text = (el.textContent || "").replace(/\s+/g, " ").trim();
@@ -120,7 +121,10 @@
           el.setAttribute("role", "group");
           el.setAttribute(MARK, "role");
         }
-        if (!math && !el.hasAttribute("aria-label")) el.setAttribute("aria-label", label(el));
+        if (!math && !el.hasAttribute("aria-label")) {
+          el.setAttribute(NAMED, label(el));
+          el.setAttribute("aria-label", el.getAttribute(NAMED));
+        }
         el.addEventListener("scroll", onScroll, {passive: true});
         cut(el);
       } else if (!scrolls && ours) {
@@ -130,14 +134,40 @@
           el.setAttribute("tabindex", "-1");
         } else {
           el.removeAttribute("tabindex");
-          el.removeAttribute("aria-label");
+          if (el.hasAttribute(NAMED)) el.removeAttribute("aria-label");
         }
+        el.removeAttribute(NAMED);
         el.removeAttribute(MARK);
         el.removeAttribute(CUT);
         el.removeEventListener("scroll", onScroll);
       } else if (ours) {
         cut(el);
       }
+    });
+    apart(main);
+  }
+
+  /* no two frames under one name: frames named alike (two printed blocks of one cell) are
+     told apart as parts, "output of code cell 6, part 2 of 3, 1 line, scrolls sideways" */
+  function apart(main) {
+    var alike = {};
+    main.querySelectorAll("[" + NAMED + "]").forEach(function (el) {
+      var name = el.getAttribute(NAMED);
+      (alike[name] = alike[name] || []).push(el);
+    });
+    Object.keys(alike).forEach(function (name) {
+      var group = alike[name];
+      group.forEach(function (el, i) {
+        if (group.length === 1) {
+          el.setAttribute("aria-label", name);
+          return;
+        }
+        var part = "part " + (i + 1) + " of " + group.length;
+        var head = name.replace(/, scrolls sideways$/, "");
+        var at = head.search(/, \d+ lines?$/);
+        head = at < 0 ? head + ", " + part : head.slice(0, at) + ", " + part + head.slice(at);
+        el.setAttribute("aria-label", head + ", scrolls sideways");
+      });
     });
   }
 
