@@ -18,6 +18,7 @@ from uio_teach.instructor.lab_registry import LabError, LabUsageError
 
 # each error with the built-in class that says what went wrong
 ERRORS = {
+    ut.InputError: ValueError,
     ut.LMIError: ValueError,
     ut.LMIInfeasibleError: ValueError,
     ut.LMISolverError: ValueError,
@@ -69,6 +70,21 @@ def test_every_error_and_warning_of_every_module_has_the_common_base():
         and not issubclass(c, ut.UIOTeachWarning if issubclass(c, Warning) else ut.UIOTeachError)
     ]
     assert not stray, f"outside UIOTeachError / UIOTeachWarning: {stray}"
+
+
+def test_no_module_raises_a_bare_builtin_value_or_type_error():
+    """A bad argument is an ``InputError`` (a ``ValueError`` too), never a bare built-in one."""
+    import ast
+    from pathlib import Path
+
+    bare = []
+    for path in sorted(Path(ut.__file__).parent.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Raise) and node.exc is not None:
+                target = node.exc.func if isinstance(node.exc, ast.Call) else node.exc
+                if isinstance(target, ast.Name) and target.id in {"ValueError", "TypeError"}:
+                    bare.append(f"{path.name}:{node.lineno}")
+    assert not bare, f"raise InputError (uio_teach.errors) instead: {bare}"
 
 
 def test_warnings_have_the_common_base():

@@ -38,7 +38,7 @@ from .detection import (
     sensor_fault,
     simulate_fault,
 )
-from .errors import UIOTeachError, UIOTeachWarning
+from .errors import InputError, UIOTeachError, UIOTeachWarning
 from .existence import Condition, ExistenceReport, UIOExistenceError, check_existence
 from .isolation import BankMember, Isolation, UIOBank, design_uio_bank
 from .lmi import LMIError, LMIInfeasibleError, LMIResult, LMISolverError, lmi_gain
@@ -96,6 +96,7 @@ def __dir__() -> list[str]:
 
 
 __all__ = [
+    "InputError",
     "UIOTeachError",
     "UIOTeachWarning",
     "Plant",

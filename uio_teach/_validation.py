@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from . import tolerances as tols
+from .errors import InputError
 
 __all__ = [
     "as_matrix",
@@ -24,25 +25,25 @@ __all__ = [
 def _refuse_non_real(name: str, value: Any, noun: str = "numeric") -> None:
     """Complex values and text are refused with a message naming the argument."""
     if isinstance(value, (str, bytes)):
-        raise ValueError(f"{name} must be {noun}, got the text {value!r}")
+        raise InputError(f"{name} must be {noun}, got the text {value!r}")
     try:
         kind = np.asarray(value).dtype.kind
     except (TypeError, ValueError):
         return  # ragged: the float conversion below names the argument
     if kind == "c":
-        raise ValueError(
+        raise InputError(
             f"{name} must be {noun}, got complex values (the imaginary part would be dropped)"
         )
     if kind in "US":
-        raise ValueError(f"{name} must be {noun}, got text entries")
+        raise InputError(f"{name} must be {noun}, got text entries")
     if kind == "O":
         flat = np.asarray(value, dtype=object).ravel()
         if any(isinstance(v, (complex, np.complexfloating)) for v in flat):
-            raise ValueError(
+            raise InputError(
                 f"{name} must be {noun}, got complex values (the imaginary part would be dropped)"
             )
         if any(isinstance(v, (str, bytes)) for v in flat):
-            raise ValueError(f"{name} must be {noun}, got text entries")
+            raise InputError(f"{name} must be {noun}, got text entries")
 
 
 def as_real_array(name: str, value: Any, *, finite: bool = True) -> np.ndarray:
@@ -51,10 +52,10 @@ def as_real_array(name: str, value: Any, *, finite: bool = True) -> np.ndarray:
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must hold real numbers: {exc}") from None
+        raise InputError(f"{name} must hold real numbers: {exc}") from None
     if finite and not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0]) if arr.ndim else ()
-        raise ValueError(f"{name} has a non-finite value at position {bad}; all must be finite")
+        raise InputError(f"{name} has a non-finite value at position {bad}; all must be finite")
     return arr
 
 
@@ -63,31 +64,31 @@ def as_real_number(
 ) -> float:
     """A finite real number (not a bool, not text), optionally ``>= low`` (``> low``)."""
     if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
+        raise InputError(f"{name} must be a real number, got {value!r}")
     x = float(value)
     if not np.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise InputError(f"{name} must be finite, got {value!r}")
     if low is not None and (x <= low if strict else x < low):
-        raise ValueError(f"{name} must be {'>' if strict else '>='} {low:g}, got {value!r}")
+        raise InputError(f"{name} must be {'>' if strict else '>='} {low:g}, got {value!r}")
     return x
 
 
 def as_time(name: str, value: Any, *, min_size: int = 2, uniform: bool = False) -> np.ndarray:
     """A 1-D, finite, strictly increasing time vector (uniformly spaced if ``uniform``)."""
     if isinstance(value, (str, bytes)):
-        raise ValueError(f"{name} must be a 1-D array of times, got the text {value!r}")
+        raise InputError(f"{name} must be a 1-D array of times, got the text {value!r}")
     t = as_real_array(name, value, finite=False)
     if t.ndim != 1:
-        raise ValueError(f"{name} must be a 1-D array of times, got shape {t.shape}")
+        raise InputError(f"{name} must be a 1-D array of times, got shape {t.shape}")
     if t.size < min_size:
-        raise ValueError(f"{name} must hold at least {min_size} time points, got {t.size}")
+        raise InputError(f"{name} must hold at least {min_size} time points, got {t.size}")
     if not np.all(np.isfinite(t)):
         k = int(np.argmax(~np.isfinite(t)))
-        raise ValueError(f"{name} must be finite numbers: {name}[{k}] = {t[k]}")
+        raise InputError(f"{name} must be finite numbers: {name}[{k}] = {t[k]}")
     steps = np.diff(t)
     if np.any(steps <= 0):
         k = int(np.argmax(steps <= 0))
-        raise ValueError(
+        raise InputError(
             f"{name} must be strictly increasing: {name}[{k}] = {t[k]:g} and "
             f"{name}[{k + 1}] = {t[k + 1]:g}"
         )
@@ -95,7 +96,7 @@ def as_time(name: str, value: Any, *, min_size: int = 2, uniform: bool = False) 
         h = (t[-1] - t[0]) / (t.size - 1)
         tol = tols.TIME_GRID_RTOL * h + 64 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
         if np.max(np.abs(steps - h)) > tol:
-            raise ValueError(
+            raise InputError(
                 f"{name} must be uniformly spaced, got steps from {steps.min():g} to "
                 f"{steps.max():g}"
             )
@@ -107,7 +108,7 @@ def as_seed(name: str, value: Any) -> Any:
     if value is None or isinstance(value, np.random.Generator):
         return value
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(
+        raise InputError(
             f"{name} must be None, a non-negative integer or a numpy.random.Generator, "
             f"got {value!r}"
         )
@@ -148,7 +149,7 @@ def as_matrix(
     try:
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a real numeric matrix: {exc}") from None
+        raise InputError(f"{name} must be a real numeric matrix: {exc}") from None
     if arr.ndim == 0:
         arr = arr.reshape(1, 1)
     elif arr.ndim == 1 and arr.size == 0:
@@ -163,14 +164,14 @@ def as_matrix(
             if (rows is None or alt.shape[0] == rows) and (cols is None or alt.shape[1] == cols):
                 arr = alt
     elif arr.ndim > 2:
-        raise ValueError(f"{name} must be a 2-D matrix, got an array of shape {arr.shape}")
+        raise InputError(f"{name} must be a 2-D matrix, got an array of shape {arr.shape}")
     if (rows is not None and arr.shape[0] != rows) or (cols is not None and arr.shape[1] != cols):
         expected = shape_str((rows, cols))
         extra = f" ({what})" if what else ""
-        raise ValueError(f"{name} has shape {arr.shape}, expected {expected}{extra}")
+        raise InputError(f"{name} has shape {arr.shape}, expected {expected}{extra}")
     if not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
-        raise ValueError(
+        raise InputError(
             f"{name} has a non-finite entry {arr[bad]} at position {bad}; "
             "all entries must be finite numbers"
         )
@@ -193,13 +194,13 @@ def as_poles(name: str, value: Any) -> np.ndarray:
     True
     """
     if isinstance(value, (str, bytes)) or np.asarray(value).dtype.kind in "US":
-        raise ValueError(f"{name} must be a list of numbers, got {value!r}")
+        raise InputError(f"{name} must be a list of numbers, got {value!r}")
     try:
         poles = np.atleast_1d(np.array(value, dtype=complex)).ravel()
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a list of numbers: {exc}") from None
+        raise InputError(f"{name} must be a list of numbers: {exc}") from None
     if not np.all(np.isfinite(poles)):
-        raise ValueError(f"{name} must be finite numbers, got {value!r}")
+        raise InputError(f"{name} must be finite numbers, got {value!r}")
     scale = max(1.0, float(np.max(np.abs(poles)))) if poles.size else 1.0
     tol = tols.CONJUGATE_RTOL * scale
     poles = poles.copy()
@@ -209,7 +210,7 @@ def as_poles(name: str, value: Any) -> np.ndarray:
         p = poles[i]
         idx = [j for j in unmatched if abs(poles[j] - np.conj(p)) <= tol]
         if not idx:
-            raise ValueError(
+            raise InputError(
                 f"{name}: the complex pole {p:.6g} has no conjugate partner; complex poles "
                 "must come in conjugate pairs so that the gain is real"
             )

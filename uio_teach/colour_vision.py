@@ -27,6 +27,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .errors import InputError
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
@@ -114,7 +116,7 @@ def simulate(colour: Any, deficiency: str) -> np.ndarray:
     if deficiency == "normal":
         return rgb
     if deficiency not in _MACHADO:
-        raise ValueError(f"deficiency must be one of {', '.join(DEFICIENCIES)}, got {deficiency!r}")
+        raise InputError(f"deficiency must be one of {', '.join(DEFICIENCIES)}, got {deficiency!r}")
     return _srgb(_MACHADO[deficiency] @ _linear(rgb))
 
 

@@ -38,7 +38,7 @@ import scipy.linalg
 
 from ._display import fit_lines
 from ._validation import as_real_array, as_real_number, as_seed
-from .errors import UIOTeachError, UIOTeachWarning
+from .errors import InputError, UIOTeachError, UIOTeachWarning
 from .existence import (
     Condition,
     ExistenceReport,
@@ -220,14 +220,14 @@ def _signal(name: str, value: Any, N: int | None, what: str) -> np.ndarray:
     if arr.ndim == 1:
         arr = arr.reshape(1, -1)
     if arr.ndim != 2:
-        raise ValueError(
+        raise InputError(
             f"{name} must have one row per channel and one column per sample ({what}), got an "
             f"array of shape {arr.shape}"
         )
     if arr.shape[0] == 0:
-        raise ValueError(f"{name} has no channel: it must have one row per {what}")
+        raise InputError(f"{name} has no channel: it must have one row per {what}")
     if N is not None and arr.shape[1] != N:
-        raise ValueError(
+        raise InputError(
             f"{name} has {arr.shape[1]} samples (columns) but x has {N}: every recorded signal "
             "needs one column per sample of the same experiment"
         )
@@ -240,7 +240,7 @@ def _recorded(u: Any, y: Any, x: Any) -> tuple[np.ndarray, np.ndarray, np.ndarra
     y = _signal("y", y, N, "output")
     u = np.zeros((0, N)) if u is None else _signal("u", u, N, "known input")
     if N < 2:
-        raise ValueError(f"x has {N} sample: a design from data needs at least two")
+        raise InputError(f"x has {N} sample: a design from data needs at least two")
     return u, y, x
 
 
@@ -259,14 +259,14 @@ def _experiments(u: Any, y: Any, x: Any) -> list[tuple[np.ndarray, np.ndarray, n
         return [_recorded(u, y, x)]
     k = len(x)
     if not _several(y) or len(y) != k or (u is not None and (not _several(u) or len(u) != k)):
-        raise ValueError(
+        raise InputError(
             f"x holds {k} experiments: y (and u, when given) must be lists of {k} 2-D arrays too"
         )
     runs = [_recorded(None if u is None else u[i], y[i], x[i]) for i in range(k)]
     for name, j in (("u", 0), ("y", 1), ("x", 2)):
         rows = {r[j].shape[0] for r in runs}
         if len(rows) > 1:
-            raise ValueError(
+            raise InputError(
                 f"the experiments' {name} have different numbers of rows: {sorted(rows)}"
             )
     return runs
@@ -276,7 +276,7 @@ def _discrete_dt(dt: Any) -> float | bool:
     if dt is True:
         return True
     if dt is None or isinstance(dt, bool) or dt == 0:
-        raise ValueError(
+        raise InputError(
             f"dt must be True or the positive sampling period of the recorded samples, got "
             f"{dt!r}: the data-driven design is discrete-time (one column per sample)"
         )
@@ -287,7 +287,7 @@ def _unknown_inputs(value: Any, n: int) -> int | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= n:
-        raise ValueError(
+        raise InputError(
             f"unknown_inputs must be None or the number of unknown inputs, an integer from 0 to "
             f"n = {n}, got {value!r}"
         )
@@ -713,7 +713,7 @@ def design_uio_from_data(
     True
     """
     if poles is not None and K1 is not None:
-        raise ValueError("give at most one of poles= (the movable error poles) or K1=")
+        raise InputError("give at most one of poles= (the movable error poles) or K1=")
     report = check_data(u, y, x, dt=dt, unknown_inputs=unknown_inputs, rtol=rtol)
     if not report.ok:
         raise DataConditionError(report)
@@ -794,7 +794,7 @@ def sampled_plant(plant: Plant, dt: float) -> Plant:
     """
     plant = check_plant(plant)
     if plant.is_discrete:
-        raise ValueError(f"plant is already discrete-time (dt = {plant.dt!r})")
+        raise InputError(f"plant is already discrete-time (dt = {plant.dt!r})")
     h = as_real_number("dt", dt, low=0.0, strict=True)
     n, m, q = plant.n, plant.m, plant.q
     big = np.zeros((n + m + q, n + m + q))
@@ -858,16 +858,16 @@ def record_experiment(
     """
     plant = check_plant(plant)
     if not plant.is_discrete:
-        raise ValueError("record_experiment needs a discrete-time plant (see sampled_plant)")
+        raise InputError("record_experiment needs a discrete-time plant (see sampled_plant)")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
-        raise ValueError(f"samples must be an integer of at least 2, got {samples!r}")
+        raise InputError(f"samples must be an integer of at least 2, got {samples!r}")
     noise = as_real_number("noise", noise, low=0.0)
     rng = np.random.default_rng(as_seed("seed", seed))
     n, m, q, N = plant.n, plant.m, plant.q, int(samples)
     uu = rng.standard_normal((m, N)) if u is None else _signal("u", u, N, "known input")
     dd = rng.standard_normal((q, N)) if d is None else _signal("d", d, N, "unknown input")
     if uu.shape[0] != m or dd.shape[0] != q:
-        raise ValueError(f"u needs {m} and d {q} rows (channels), got {uu.shape[0]}, {dd.shape[0]}")
+        raise InputError(f"u needs {m} and d {q} rows (channels), got {uu.shape[0]}, {dd.shape[0]}")
     x = np.empty((n, N))
     x[:, 0] = (
         rng.standard_normal(n)

@@ -30,6 +30,7 @@ import numpy as np
 
 from ._display import call_repr
 from ._validation import as_matrix, read_only
+from .errors import InputError
 from .observers import Observer
 from .plant import Plant, check_plant
 from .simulation import UIOResponse, check_timepts, input_samples, linear_response, simulate
@@ -107,9 +108,9 @@ class Fault:
 
 def _check_index(name: str, index: Any, size: int, what: str) -> int:
     if isinstance(index, bool) or not isinstance(index, Integral):
-        raise ValueError(f"{name} must be an integer index, got {index!r}")
+        raise InputError(f"{name} must be an integer index, got {index!r}")
     if not 0 <= int(index) < size:
-        raise ValueError(
+        raise InputError(
             f"{name} = {index} is out of range: the plant has {size} {what} (0 to {size - 1})"
         )
     return int(index)
@@ -117,7 +118,7 @@ def _check_index(name: str, index: Any, size: int, what: str) -> int:
 
 def _checkinput_samples(signal: Any) -> Callable:
     if not callable(signal):
-        raise ValueError(
+        raise InputError(
             f"signal must be a callable of time (e.g. ut.signals.step(1.0, 2.0)), got "
             f"{type(signal).__name__}"
         )
@@ -258,9 +259,9 @@ def faulty_plant(plant: Plant, fault: Fault) -> Plant:
     """
     plant = check_plant(plant)
     if not isinstance(fault, Fault):
-        raise ValueError(f"fault must be a Fault (actuator_fault, ...), got {type(fault).__name__}")
+        raise InputError(f"fault must be a Fault (actuator_fault, ...), got {type(fault).__name__}")
     if fault.state_direction.shape != (plant.n,) or fault.output_direction.shape != (plant.p,):
-        raise ValueError(
+        raise InputError(
             f"fault was built for a plant with n = {fault.state_direction.size} and "
             f"p = {fault.output_direction.size}, but this plant has n = {plant.n}, p = {plant.p}"
         )
@@ -413,7 +414,7 @@ def observer_residual(
     True
     """
     if not isinstance(observer, Observer):
-        raise ValueError(
+        raise InputError(
             "observer must be a uio_teach observer (design_uio, ...), got "
             f"{type(observer).__name__}"
         )
@@ -460,7 +461,7 @@ def _positive(name: str, value: Any) -> float:
         or not np.isfinite(value)
         or (value <= 0)
     ):
-        raise ValueError(f"{name} must be a positive number, got {value!r}")
+        raise InputError(f"{name} must be a positive number, got {value!r}")
     return float(value)
 
 
@@ -469,18 +470,18 @@ def _residual_runs(name: str, residuals: Any, N: int) -> np.ndarray:
     try:
         arr = np.array(residuals, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of residuals: {exc}") from None
+        raise InputError(f"{name} must be an array of residuals: {exc}") from None
     if arr.ndim == 1:
         arr = arr[None, None, :]
     elif arr.ndim == 2:
         arr = arr[None]
     if arr.ndim != 3 or arr.shape[-1] != N:
-        raise ValueError(
+        raise InputError(
             f"{name} must have shape (p, {N}) or (runs, p, {N}) (one column per time point), "
             f"got {np.shape(residuals)}"
         )
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} has non-finite values; a residual must be finite")
+        raise InputError(f"{name} has non-finite values; a residual must be finite")
     return arr
 
 
@@ -582,7 +583,7 @@ class Threshold:
             or not isinstance(self.value, Real)
             or not (np.isfinite(self.value) and self.value >= 0)
         ):
-            raise ValueError(f"value must be a finite number >= 0, got {self.value!r}")
+            raise InputError(f"value must be a finite number >= 0, got {self.value!r}")
         _positive("window", self.window)
         _rate(self.design_rate, "design_rate")
         _start(self.start, np.zeros(1), 1.0)
@@ -665,7 +666,7 @@ def residual_threshold(
     per = _per(per)
     J = residual_rms(t, R, w)[:, t >= s]
     if J.size == 0:
-        raise ValueError(f"start = {s:g} leaves no sample to monitor (timepts end at {t[-1]:g})")
+        raise InputError(f"start = {s:g} leaves no sample to monitor (timepts end at {t[-1]:g})")
     pool = J if per == "sample" else J.max(axis=1)
     value = float(np.quantile(pool, 1 - rate))
     return Threshold(value=value, window=w, design_rate=rate, start=s, samples=int(J.size), per=per)
@@ -673,13 +674,13 @@ def residual_threshold(
 
 def _per(per: Any) -> str:
     if per not in ("sample", "run"):
-        raise ValueError(f"per must be 'sample' or 'run', got {per!r}")
+        raise InputError(f"per must be 'sample' or 'run', got {per!r}")
     return per
 
 
 def _rate(value: Any, name: str = "false_alarm_rate") -> float:
     if isinstance(value, bool) or not isinstance(value, Real) or not 0 < value < 1:
-        raise ValueError(f"{name} must be a number between 0 and 1, got {value!r}")
+        raise InputError(f"{name} must be a number between 0 and 1, got {value!r}")
     return float(value)
 
 
@@ -687,13 +688,13 @@ def _start(start: Any, t: np.ndarray, window: float) -> float:
     if start is None:
         return float(min(t[0] + window, t[-1]))
     if isinstance(start, bool) or not isinstance(start, Real) or not np.isfinite(start):
-        raise ValueError(f"start must be a finite time, got {start!r}")
+        raise InputError(f"start must be a finite time, got {start!r}")
     return float(start)
 
 
 def _check_threshold(threshold: Any) -> Threshold:
     if not isinstance(threshold, Threshold):
-        raise ValueError(
+        raise InputError(
             f"threshold must be a Threshold from residual_threshold, got {type(threshold).__name__}"
         )
     return threshold
@@ -798,7 +799,7 @@ def detect(timepts: Any, residual: Any, threshold: Threshold) -> Detection:
     thr = _check_threshold(threshold)
     R = _residual_runs("residual", residual, t.size)
     if R.shape[0] != 1:
-        raise ValueError(f"residual must be one run, shape (p, {t.size}), got {np.shape(residual)}")
+        raise InputError(f"residual must be one run, shape (p, {t.size}), got {np.shape(residual)}")
     J = residual_rms(t, R[0], thr.window)
     alarm = (J > thr.value) & (t >= thr.start)
     for arr in (J, alarm):
@@ -842,7 +843,7 @@ def false_alarm_rate(
     R = _residual_runs("residuals", residuals, t.size)
     J = residual_rms(t, R, thr.window)[:, t >= thr.start]
     if J.size == 0:
-        raise ValueError(f"threshold.start = {thr.start:g} leaves no sample to monitor")
+        raise InputError(f"threshold.start = {thr.start:g} leaves no sample to monitor")
     alarm = J > thr.value
     if _per(thr.per if per is None else per) == "run":
         return float(np.mean(alarm.any(axis=1)))
@@ -887,7 +888,7 @@ def detection_time(timepts: Any, residual: Any, threshold: Threshold, fault_time
         or not isinstance(fault_time, Real)
         or not (t[0] <= fault_time <= t[-1])
     ):
-        raise ValueError(
+        raise InputError(
             f"fault_time must be a time within timepts ({t[0]:g} to {t[-1]:g}), got {fault_time!r}"
         )
     det = detect(t, residual, threshold)

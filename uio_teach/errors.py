@@ -21,7 +21,7 @@ ConfigError -- <dict>: seed: must be >= 0, got -1
 
 from __future__ import annotations
 
-__all__ = ["UIOTeachError", "UIOTeachWarning"]
+__all__ = ["InputError", "UIOTeachError", "UIOTeachWarning"]
 
 
 class UIOTeachError(Exception):
@@ -33,6 +33,24 @@ class UIOTeachError(Exception):
     >>> from uio_teach.instructor.config import ConfigError
     >>> issubclass(ConfigError, UIOTeachError) and issubclass(ConfigError, ValueError)
     True
+    """
+
+
+class InputError(UIOTeachError, ValueError):
+    """A bad argument: a wrong shape, type or value, named in the message with what is expected.
+
+    Every public function answers an argument it cannot use with this error (or a more specific
+    subclass of :class:`UIOTeachError`), never with a bare ``ValueError`` from deep inside numpy.
+    It is a ``ValueError`` too, so ``except ValueError`` still catches it.
+
+    Examples
+    --------
+    >>> import uio_teach as ut
+    >>> try:
+    ...     ut.Plant([[0.0, 1.0]], [[1.0, 0.0]])
+    ... except ut.InputError as err:
+    ...     print(err)
+    A has shape (1, 2), expected a square (n, n) matrix
     """
 
 

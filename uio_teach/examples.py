@@ -35,6 +35,7 @@ import numpy as np
 
 from . import signals
 from ._validation import read_only
+from .errors import InputError
 from .plant import Plant
 
 __all__ = [
@@ -315,11 +316,11 @@ def _positive_pair(name: str, value: Any) -> tuple[float, float]:
     try:
         pair = tuple(float(x) for x in value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be two numbers (V), got {value!r}") from None
+        raise InputError(f"{name} must be two numbers (V), got {value!r}") from None
     if len(pair) != 2 or isinstance(value, str) or not all(math.isfinite(x) for x in pair):
-        raise ValueError(f"{name} must be two finite numbers (V), got {value!r}")
+        raise InputError(f"{name} must be two finite numbers (V), got {value!r}")
     if min(pair) <= 0:
-        raise ValueError(
+        raise InputError(
             f"{name} must be positive: a pump at 0 V leaves its upper tank empty, where the "
             f"outflow sqrt(2 g h) has no linearization; got {value!r}"
         )
@@ -425,7 +426,7 @@ def tank_time_constants(
 
 def _tank_setting(setting: str) -> Published:
     if not isinstance(setting, str) or setting not in QUADRUPLE_TANK_PUBLISHED:
-        raise ValueError(
+        raise InputError(
             f"setting must be one of {', '.join(map(repr, QUADRUPLE_TANK_PUBLISHED))}, "
             f"got {setting!r}"
         )
@@ -434,16 +435,16 @@ def _tank_setting(setting: str) -> Published:
 
 def _valve(name: str, value: Any, *, upper: int) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} must be a number from 0 up to (not including) 1, got {value!r}")
+        raise InputError(f"{name} must be a number from 0 up to (not including) 1, got {value!r}")
     value = float(value)
     if not 0.0 <= value < 1.0:
         if value == 1.0:
-            raise ValueError(
+            raise InputError(
                 f"{name} = 1 sends the whole of pump {name[-1]}'s flow to lower tank {name[-1]}: "
                 f"upper tank {upper} is then empty, where its outflow sqrt(2 g h{upper}) has no "
                 f"linearization; take {name} below 1"
             )
-        raise ValueError(
+        raise InputError(
             f"{name} must lie from 0 up to (not including) 1 (the share of pump {name[-1]}'s "
             f"flow sent to lower tank {name[-1]}), got {value!r}"
         )

@@ -38,6 +38,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ._validation import as_matrix
+from .errors import InputError
 from .plant import Plant
 from .simulation import UIOResponse, simulate
 from .worked import WORKED, RegistryView
@@ -143,16 +144,16 @@ class Param:
 
     def __post_init__(self) -> None:
         if self.kind not in PARAM_KINDS:
-            raise ValueError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
+            raise InputError(f"Param kind must be one of {PARAM_KINDS}, got {self.kind!r}")
         if self.control and (self.control not in CONTROLS or self.range is None):
-            raise ValueError(
+            raise InputError(
                 f"a Param's control must be one of {CONTROLS} and comes with a range; got "
                 f"range={self.range!r}, control={self.control!r}"
             )
         if self.range is not None:
             lo, hi = self.range
             if self.kind not in ("int", "float") or not lo < hi:
-                raise ValueError(
+                raise InputError(
                     "a Param's range (a slider) needs an int or float field and low < high; "
                     f"got kind={self.kind!r}, range={self.range!r}"
                 )
@@ -455,7 +456,7 @@ class Experiment:
             if spec.kind in ("int", "float") and value is not None:
                 problem = out_of_bounds(spec, float(value))
                 if problem is not None:
-                    raise ValueError(f"{type(self).__name__}: {name} ({spec.doc}) {problem}")
+                    raise InputError(f"{type(self).__name__}: {name} ({spec.doc}) {problem}")
 
     # the plant and the time grid ----------------------------------------------------------------
     def plant(self) -> Plant:
@@ -526,7 +527,7 @@ class Experiment:
         samples, duration = values.pop("samples", None), values.pop("duration", None)
         if samples is not None or duration is not None:
             if "timepts" in values:
-                raise ValueError(
+                raise InputError(
                     "give the time grid either as timepts or as samples/duration, not both "
                     "(one of them would be dropped)"
                 )
@@ -534,7 +535,7 @@ class Experiment:
         names = {f.name for f in fields(self) if f.init}
         unknown = sorted(set(values) - names)
         if unknown:
-            raise ValueError(
+            raise InputError(
                 f"the experiment {self.name!r} has no field {', '.join(map(repr, unknown))}"
             )
         return replace(self, **values)
@@ -713,15 +714,15 @@ def plant_from_params(lab: str, params: Mapping[str, Any] | None = None) -> Plan
     >>> plant_from_params("pa9", {"plant": {"E": [[1, 0]]}})
     Traceback (most recent call last):
     ...
-    ValueError: PARAMS["plant"]["E"] of the pa9 lab has shape (1, 2), expected (3, 1) ...
+    uio_teach.errors.InputError: PARAMS["plant"]["E"] of the pa9 lab has shape (1, 2), ...
     """
     if not isinstance(lab, str) or lab not in LAB_PLANTS:
-        raise ValueError(f"unknown lab {lab!r}: expected one of {', '.join(LAB_PLANTS)}")
+        raise InputError(f"unknown lab {lab!r}: expected one of {', '.join(LAB_PLANTS)}")
     course = LAB_PLANTS[lab]()
     if params is None:
         return course
     if not isinstance(params, Mapping):
-        raise ValueError(f"params of the {lab} lab must be a mapping (PARAMS), got {params!r}")
+        raise InputError(f"params of the {lab} lab must be a mapping (PARAMS), got {params!r}")
     return _with_matrices(lab, course, params.get("plant"))
 
 
@@ -730,13 +731,13 @@ def _with_matrices(lab: str, course: Plant, given: Any) -> Plant:
     if not given:
         return course
     if not isinstance(given, Mapping):
-        raise ValueError(
+        raise InputError(
             f'PARAMS["plant"] of the {lab} lab must map matrix names ({", ".join(_PLANT_MATRICES)})'
             f" to nested lists, got {type(given).__name__}"
         )
     unknown = sorted(str(k) for k in given if k not in _PLANT_MATRICES)
     if unknown:
-        raise ValueError(
+        raise InputError(
             f'PARAMS["plant"] of the {lab} lab: unknown matrix {", ".join(map(repr, unknown))};'
             f" expected some of {', '.join(_PLANT_MATRICES)}"
         )
@@ -747,9 +748,9 @@ def _with_matrices(lab: str, course: Plant, given: Any) -> Plant:
         try:
             arr = as_matrix(label, value)
         except ValueError as err:
-            raise ValueError(f"{err} (the {lab} lab)") from None
+            raise InputError(f"{err} (the {lab} lab)") from None
         if arr.shape != expected:
-            raise ValueError(
+            raise InputError(
                 f"{label} of the {lab} lab has shape {arr.shape}, expected {expected}"
                 f" (the shape of the course's {name})"
             )

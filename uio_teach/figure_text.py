@@ -38,6 +38,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from .errors import InputError
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
@@ -117,7 +119,7 @@ def describe(fig: Figure, alt: str, details: str | None = None) -> Figure:
     """
     alt = " ".join(str(alt).split())
     if not alt:
-        raise ValueError("alt must say what the figure shows, got an empty text")
+        raise InputError("alt must say what the figure shows, got an empty text")
     old = description(fig)
     if details is None:
         details = old.details if old is not None else ""
@@ -376,7 +378,7 @@ def figure_html(fig: Figure, *, narrow: bool = True) -> str:
     """
     found = description(fig)
     if found is None:
-        raise ValueError("the figure has no description: call describe(fig, alt, details) first")
+        raise InputError("the figure has no description: call describe(fig, alt, details) first")
     wide, width, height = _png(fig)
     source = ""
     if narrow and _panels(fig):

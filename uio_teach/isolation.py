@@ -27,6 +27,7 @@ import numpy as np
 from . import tolerances as tols
 from ._display import call_repr, fit_lines, format_poles
 from .detection import Threshold, detect, observer_residual, residual_threshold
+from .errors import InputError
 from .existence import ExistenceReport, check_existence
 from .linalg import rank
 from .observers import UIO, design_uio
@@ -218,7 +219,7 @@ class UIOBank:
         [(3, 501), (3, 501)]
         """
         if not isinstance(response, UIOResponse):
-            raise ValueError(
+            raise InputError(
                 f"response must be a UIOResponse (from simulate or simulate_fault), got "
                 f"{type(response).__name__}"
             )
@@ -227,7 +228,7 @@ class UIOBank:
             or response.plant.p != self.plant.p
             or (response.plant.m != self.plant.m)
         ):
-            raise ValueError(
+            raise InputError(
                 f"response simulates a plant with n, m, p = {response.plant.n}, "
                 f"{response.plant.m}, {response.plant.p}; the bank monitors one with "
                 f"{self.plant.n}, {self.plant.m}, {self.plant.p}"
@@ -289,13 +290,13 @@ class UIOBank:
         """
         runs = list(healthy)
         if not runs:
-            raise ValueError("healthy must hold at least one fault-free UIOResponse")
+            raise InputError("healthy must hold at least one fault-free UIOResponse")
         t = runs[0].time
         for k, run in enumerate(runs):
             if not isinstance(run, UIOResponse):
-                raise ValueError(f"healthy[{k}] must be a UIOResponse, got {type(run).__name__}")
+                raise InputError(f"healthy[{k}] must be a UIOResponse, got {type(run).__name__}")
             if run.time.shape != t.shape or not np.array_equal(run.time, t):
-                raise ValueError(f"healthy[{k}] has another time grid than healthy[0]")
+                raise InputError(f"healthy[{k}] has another time grid than healthy[0]")
         per_run = [self.residuals(run) for run in runs]
         out: list[Threshold | None] = []
         for i, m in enumerate(self.members):
@@ -341,7 +342,7 @@ class UIOBank:
         """
         ths = list(thresholds)
         if len(ths) != len(self.members):
-            raise ValueError(
+            raise InputError(
                 f"thresholds must hold one entry per member ({len(self.members)}), got {len(ths)}"
             )
         residuals = self.residuals(response)
@@ -408,16 +409,16 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
     """
     plant = check_plant(plant)
     if kind not in ("actuator", "sensor"):
-        raise ValueError(f"kind must be 'actuator' or 'sensor', got {kind!r}")
+        raise InputError(f"kind must be 'actuator' or 'sensor', got {kind!r}")
     try:
         cand = np.atleast_1d(np.array(poles, dtype=complex)).ravel()
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"poles must be a list of numbers: {exc}") from None
+        raise InputError(f"poles must be a list of numbers: {exc}") from None
     count = plant.m if kind == "actuator" else plant.p
     if count < 2:
         what = "actuators (columns of B)" if kind == "actuator" else "sensors (rows of C)"
         article = "an" if kind == "actuator" else "a"
-        raise ValueError(f"{article} {kind} bank needs at least 2 {what}; the plant has {count}")
+        raise InputError(f"{article} {kind} bank needs at least 2 {what}; the plant has {count}")
     members = []
     for i in range(count):
         if kind == "actuator":
@@ -461,7 +462,7 @@ def design_uio_bank(plant: Plant, kind: str, poles: Any) -> UIOBank:
                 dtype=complex,
             )
             if free.size < report.movable:
-                raise ValueError(
+                raise InputError(
                     f"poles: the member blind to {kind} {i + 1} can place {report.movable} "
                     f"poles, but only {free.size} were given away from its fixed modes "
                     f"{format_poles(report.fixed_modes, braces=True, empty='none')}"

@@ -13,7 +13,7 @@ from . import tolerances as tols
 from ._display import format_complex
 from ._validation import as_matrix
 from .balancing import BalancedPair, balanced_pair
-from .errors import UIOTeachError
+from .errors import InputError, UIOTeachError
 from .linalg import is_stable, pinv
 from .placement import place_pair_poles
 
@@ -78,7 +78,7 @@ def _check_dt(dt) -> bool:
         return True
     if isinstance(dt, Real) and not isinstance(dt, bool) and np.isfinite(dt) and dt >= 0:
         return dt != 0
-    raise ValueError(
+    raise InputError(
         "dt must be None (continuous time), True (discrete time, unspecified period) or a "
         f"positive sampling period, got {dt!r}"
     )
@@ -88,11 +88,11 @@ def _check_decay(decay, discrete: bool) -> float | None:
     if decay is None:
         return None
     if isinstance(decay, bool) or not isinstance(decay, Real):
-        raise ValueError(f"decay must be a real number, got {decay!r}")
+        raise InputError(f"decay must be a real number, got {decay!r}")
     decay = float(decay)
     if not np.isfinite(decay) or decay < 0 or (discrete and not 0 < decay <= 1):
         rng = "0 < decay <= 1 (a radius)" if discrete else "decay >= 0 (a rate)"
-        raise ValueError(f"decay must satisfy {rng}, got {decay!r}")
+        raise InputError(f"decay must satisfy {rng}, got {decay!r}")
     return decay
 
 
@@ -106,7 +106,7 @@ def _check_solver(solver) -> list[str]:
 
     installed = [s for s in cp.installed_solvers() if s in _SDP_SOLVERS]
     if not isinstance(solver, str) or solver.upper() not in installed:
-        raise ValueError(
+        raise InputError(
             "solver must be an installed cvxpy solver for semidefinite programs "
             f"({', '.join(installed) or 'none installed'}), got {solver!r}"
         )
@@ -217,7 +217,7 @@ def lmi_gain(
     A1 = as_matrix("A1", A1)
     n = A1.shape[0]
     if A1.shape[1] != n:
-        raise ValueError(f"A1 has shape {A1.shape}, expected a square (n, n) matrix")
+        raise InputError(f"A1 has shape {A1.shape}, expected a square (n, n) matrix")
     C = as_matrix("C", C, None, n, vector="row", what="p x n")
     p = C.shape[0]
     D = None if D is None else as_matrix("D", D, p, None, what="p x nv")

@@ -12,6 +12,7 @@ from . import tolerances as tols
 from ._display import format_complex, format_poles
 from ._validation import as_matrix, as_poles
 from .balancing import BalancedPair
+from .errors import InputError
 from .linalg import ObservabilitySplit, observability_decomposition
 from .verify import PlacementAccuracyError, check_poles
 
@@ -91,7 +92,7 @@ def place_observer_poles(
     A = as_matrix("A", A, what="n x n")
     n = A.shape[0]
     if A.shape[1] != n:
-        raise ValueError(f"A has shape {A.shape}, expected a square (n, n) matrix")
+        raise InputError(f"A has shape {A.shape}, expected a square (n, n) matrix")
     C = as_matrix("C", C, None, n, vector="row", what="p x n")
     if split is None:
         split = observability_decomposition(A, C)
@@ -106,7 +107,7 @@ def place_observer_poles(
             if len(fixed)
             else ""
         )
-        raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
+        raise InputError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     if no == 0:
         return np.zeros((n, C.shape[0]))
     L = _gain(split, poles)
@@ -381,12 +382,12 @@ def place_pair_poles(
             if len(fixed)
             else ""
         )
-        raise ValueError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
+        raise InputError(f"poles: {no} pole(s) can be placed, got {len(poles)}{fixed_txt}")
     scale = float(np.max(np.abs(np.concatenate([poles, fixed])), initial=0.0)) or 1.0
     for z in fixed:
         close = np.abs(poles - z) <= tols.FIXED_POLE_RTOL * max(scale, abs(z))
         if np.any(close):
-            raise ValueError(
+            raise InputError(
                 f"poles: {format_complex(poles[close][0])} is requested on the fixed mode "
                 f"{format_complex(z)} ({fixed_name}): no gain moves that mode, and a pole "
                 "requested on it cannot be told apart from it. Choose the movable poles "

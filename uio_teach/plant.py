@@ -10,6 +10,7 @@ import numpy as np
 
 from ._display import matrices_html, matrices_text
 from ._validation import as_matrix
+from .errors import InputError
 
 if TYPE_CHECKING:  # python-control is imported where a conversion needs it
     import control as ct
@@ -29,7 +30,7 @@ def _check_dt(dt: Any) -> float | bool | None:
     if dt is True:
         return True
     if isinstance(dt, bool) or not isinstance(dt, Real) or not np.isfinite(dt) or dt < 0:
-        raise ValueError(
+        raise InputError(
             f"dt must be None (continuous time), True (discrete time, unspecified period) "
             f"or a positive sampling period, got {dt!r}"
         )
@@ -89,7 +90,7 @@ class Plant:
     >>> ut.Plant([[0, 1], [-2, -3]], [[1, 0]], E=[0, 1, 0])
     Traceback (most recent call last):
     ...
-    ValueError: E has shape (3, 1), expected (2, ?) (n x q: one row per state)
+    uio_teach.errors.InputError: E has shape (3, 1), expected (2, ?) (n x q: one row per state)
     """
 
     __slots__ = ("_A", "_B", "_C", "_D", "_E", "_dt", "_name")
@@ -107,14 +108,14 @@ class Plant:
     ) -> None:
         A = as_matrix("A", A, what="n x n")
         if A.shape[0] != A.shape[1]:
-            raise ValueError(f"A has shape {A.shape}, expected a square (n, n) matrix")
+            raise InputError(f"A has shape {A.shape}, expected a square (n, n) matrix")
         n = A.shape[0]
         if n == 0:
-            raise ValueError("A is empty: the plant needs at least one state")
+            raise InputError("A is empty: the plant needs at least one state")
         C = as_matrix("C", C, None, n, vector="row", what="p x n: one column per state")
         p = C.shape[0]
         if p == 0:
-            raise ValueError("C has no rows: the plant needs at least one output")
+            raise InputError("C has no rows: the plant needs at least one output")
         B = as_matrix(
             "B", np.zeros((n, 0)) if B is None else B, n, None, what="n x m: one row per state"
         )
@@ -247,34 +248,34 @@ class Plant:
         import control as ct  # deferred on purpose: python-control takes a second to import
 
         if not isinstance(sys, ct.StateSpace):
-            raise ValueError(f"sys must be a control.StateSpace, got {type(sys).__name__}")
+            raise InputError(f"sys must be a control.StateSpace, got {type(sys).__name__}")
         labels = list(sys.input_labels)
 
         def index(item: int | str, arg: str) -> int:
             if isinstance(item, str):
                 if item not in labels:
-                    raise ValueError(f"{arg}: no input named {item!r}; inputs are {labels}")
+                    raise InputError(f"{arg}: no input named {item!r}; inputs are {labels}")
                 return labels.index(item)
             i = int(item)
             if not -len(labels) <= i < len(labels):
-                raise ValueError(f"{arg}: input index {i} out of range for {len(labels)} inputs")
+                raise InputError(f"{arg}: input index {i} out of range for {len(labels)} inputs")
             return i % len(labels)
 
         unk = [index(i, "unknown") for i in unknown]
         meas = [index(i, "measurement") for i in measurement]
         if set(unk) & set(meas):
-            raise ValueError("an input cannot be both an unknown state input and a measurement one")
+            raise InputError("an input cannot be both an unknown state input and a measurement one")
         known = [i for i in range(len(labels)) if i not in unk and i not in meas]
         Bs, Ds = np.asarray(sys.B, float), np.asarray(sys.D, float)
         for i in known + unk:
             if np.any(Ds[:, i] != 0):
-                raise ValueError(
+                raise InputError(
                     f"input {labels[i]!r} feeds through to the output (nonzero column of sys.D); "
                     "only measurement disturbances may do so: list it in measurement="
                 )
         for i in meas:
             if np.any(Bs[:, i] != 0):
-                raise ValueError(
+                raise InputError(
                     f"measurement disturbance {labels[i]!r} also acts on the state "
                     "(nonzero column of sys.B)"
                 )
@@ -369,8 +370,8 @@ def check_plant(plant: Any) -> Plant:
     >>> ut.plant.check_plant([[1.0]])
     Traceback (most recent call last):
     ...
-    ValueError: plant must be a uio_teach.Plant, got list
+    uio_teach.errors.InputError: plant must be a uio_teach.Plant, got list
     """
     if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+        raise InputError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
     return plant

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import tolerances as tols
+from .errors import InputError
 from .figure_text import describe, description
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -328,7 +329,7 @@ def axis_label(what: str, letter: str = "d") -> str:
     if what == "input":
         return f"${letter}$ and $\\hat{{{letter}}}$"
     if what not in _AXIS_LABELS:
-        raise ValueError(f"what must be 'error', 'residual' or 'input', got {what!r}")
+        raise InputError(f"what must be 'error', 'residual' or 'input', got {what!r}")
     return _AXIS_LABELS[what]
 
 
@@ -658,7 +659,7 @@ def _figure_and_axes(
     if axes is not None:
         axes = list(np.ravel(np.asarray(axes, dtype=object)))
         if len(axes) != len(names):
-            raise ValueError(
+            raise InputError(
                 f"axes must hold {len(names)} axes ({', '.join(names)}), got {len(axes)}"
             )
         return axes[0].figure, axes
@@ -1133,9 +1134,9 @@ def plot_bank_alarms(
     t = np.asarray(timepts, dtype=float)
     names = list(runs)
     if not names:
-        raise ValueError("runs is empty: give at least one run to draw")
+        raise InputError("runs is empty: give at least one run to draw")
     if len(banks) != len(thresholds):
-        raise ValueError(
+        raise InputError(
             f"give one list of thresholds per bank: {len(banks)} banks, {len(thresholds)} lists"
         )
     columns = max(1, min(int(columns), len(names)))

@@ -19,6 +19,7 @@ import numpy as np
 
 from . import tolerances as tols
 from ._validation import as_real_array, as_real_number, as_time
+from .errors import InputError
 from .linalg import pinv, rank
 from .plant import Plant
 
@@ -122,17 +123,17 @@ def _check_response(plant: Plant, response: Any) -> tuple[np.ndarray, np.ndarray
         xhat = np.asarray(response.estimates, dtype=float)
         u = np.asarray(response.inputs.u, dtype=float)
     except AttributeError:
-        raise ValueError(
+        raise InputError(
             "response must be the result of uio_teach.simulate (with time, estimates and "
             f"inputs.u), got {type(response).__name__}"
         ) from None
     N = t.size
     if xhat.shape != (plant.n, N):
-        raise ValueError(
+        raise InputError(
             f"response.estimates has shape {xhat.shape}, expected ({plant.n}, {N}) for this plant"
         )
     if u.shape != (plant.m, N):
-        raise ValueError(
+        raise InputError(
             f"response.inputs.u has shape {u.shape}, expected ({plant.m}, {N}) for this plant"
         )
     return t, xhat, u
@@ -259,9 +260,9 @@ def reconstruct_input(
     from scipy.signal import lfilter  # deferred on purpose: scipy.signal takes a second to import
 
     if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+        raise InputError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
     if method not in ("derivative", "filtered"):
-        raise ValueError(f"method must be 'derivative' or 'filtered', got {method!r}")
+        raise InputError(f"method must be 'derivative' or 'filtered', got {method!r}")
     if method == "filtered":
         ok = (
             isinstance(tau, (int, float, np.integer, np.floating))
@@ -270,16 +271,16 @@ def reconstruct_input(
             and tau > 0
         )
         if not ok:
-            raise ValueError(
+            raise InputError(
                 f"tau must be a positive time constant with method='filtered', got {tau!r}"
             )
         tau = float(tau)
     elif tau is not None:
-        raise ValueError("tau is the filter time constant: give it only with method='filtered'")
+        raise InputError("tau is the filter time constant: give it only with method='filtered'")
     if plant.q == 0:
-        raise ValueError("the plant has no unknown input (E has no columns): nothing to recover")
+        raise InputError("the plant has no unknown input (E has no columns): nothing to recover")
     if rank(plant.E) < plant.q:
-        raise ValueError(
+        raise InputError(
             f"E has rank {rank(plant.E)} < q = {plant.q} (not full column rank): different "
             "unknown inputs d give the same E d, so only E d can be recovered, not d"
         )
@@ -361,17 +362,17 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     a = as_real_array("actual", actual)
     e = as_real_array("estimate", estimate, finite=False)
     if a.shape != e.shape:
-        raise ValueError(
+        raise InputError(
             f"actual and estimate must have the same shape, got {a.shape} and {e.shape}"
         )
     if a.ndim not in (1, 2):
-        raise ValueError(f"actual must be 1-D or 2-D (rows = channels), got shape {a.shape}")
+        raise InputError(f"actual must be 1-D or 2-D (rows = channels), got shape {a.shape}")
     if a.shape[-1] != t.size:
-        raise ValueError(
+        raise InputError(
             f"actual and estimate must have one sample per time point ({t.size}), got {a.shape[-1]}"
         )
     if np.any(np.isinf(e)):
-        raise ValueError("estimate has an infinite value; only NaN (undefined samples) is allowed")
+        raise InputError("estimate has an infinite value; only NaN (undefined samples) is allowed")
     tol = as_real_number("tol", tol, low=0.0)
     a2, e2 = np.atleast_2d(a), np.atleast_2d(e)
     band = tol * np.max(np.abs(a2), axis=1, keepdims=True)
@@ -379,7 +380,7 @@ def catch_time(time: Any, actual: Any, estimate: Any, *, tol: float = 0.02) -> f
     # are not judged; any other NaN counts as outside the band: NaN is never "caught"
     defined = np.isfinite(e2)
     if not np.any(defined):
-        raise ValueError("estimate has no finite sample: nothing can have caught the signal")
+        raise InputError("estimate has no finite sample: nothing can have caught the signal")
     end = t.size - int(np.argmax(defined.any(axis=0)[::-1]))  # one past the last defined sample
     with np.errstate(invalid="ignore"):
         outside = ~(np.abs(e2 - a2) <= band)  # NaN compares False: outside

@@ -8,6 +8,7 @@ from numbers import Real
 import numpy as np
 
 from ._validation import as_real_array
+from .errors import InputError
 
 __all__ = ["Signal", "sinusoid", "piecewise_constant", "damped_sinusoid", "step", "stack"]
 
@@ -47,10 +48,10 @@ class Signal:
 def _num(name: str, value) -> float:
     """A finite real number (not text, not complex, not a bool), or a ValueError naming it."""
     if isinstance(value, bool) or not isinstance(value, (Real, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a number, got {value!r}")
+        raise InputError(f"{name} must be a number, got {value!r}")
     v = float(value)
     if not np.isfinite(v):
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise InputError(f"{name} must be finite, got {value!r}")
     return v
 
 
@@ -118,7 +119,7 @@ def damped_sinusoid(
     """
     a, s, w = _num("amplitude", amplitude), _num("decay", decay), _num("frequency", frequency)
     if kind not in ("sin", "cos"):
-        raise ValueError(f"kind must be 'sin' or 'cos', got {kind!r}")
+        raise InputError(f"kind must be 'sin' or 'cos', got {kind!r}")
     trig = np.sin if kind == "sin" else np.cos
     return Signal(
         lambda t: a * np.exp(-s * t) * trig(w * t), f"{a:g} exp({-s:g} t) {kind}({w:g} t)"
@@ -145,16 +146,16 @@ def piecewise_constant(times: Sequence[float], values: Sequence[float]) -> Signa
     t_sw = as_real_array("times", times, finite=False).ravel()
     vals = as_real_array("values", values, finite=False).ravel()
     if t_sw.size == 0 or t_sw.shape != vals.shape:
-        raise ValueError(
+        raise InputError(
             f"times and values must be non-empty and of the same length, got {t_sw.size} "
             f"and {vals.size}"
         )
     if not np.all(np.isfinite(t_sw)):
-        raise ValueError("times must be finite")
+        raise InputError("times must be finite")
     if not np.all(np.isfinite(vals)):
-        raise ValueError("values must be finite")
+        raise InputError("values must be finite")
     if np.any(np.diff(t_sw) <= 0):
-        raise ValueError("times must be strictly increasing")
+        raise InputError("times must be strictly increasing")
     padded = np.concatenate([[0.0], vals])
 
     def f(t):
@@ -211,5 +212,5 @@ def stack(*signals: Callable) -> Callable:
     [[1.0, 1.0], [2.0, 2.0]]
     """
     if not signals:
-        raise ValueError("stack needs at least one signal")
+        raise InputError("stack needs at least one signal")
     return _Stack(signals)

@@ -59,7 +59,7 @@ import scipy.linalg as sla
 from . import tolerances as tols
 from ._display import format_complex
 from ._validation import as_seed, as_time
-from .errors import UIOTeachError
+from .errors import InputError, UIOTeachError
 from .observers import Observer
 from .plant import Plant
 
@@ -272,12 +272,12 @@ def _check_discrete_grid(plant: Plant, t: np.ndarray) -> float:
     period = "dt=True, any uniform spacing" if plant.dt is True else f"dt = {plant.dt:g}"
     if h is None:
         steps = np.diff(t)
-        raise ValueError(
+        raise InputError(
             f"timepts must lie on the sampling grid of the discrete plant ({period}): "
             f"got a non-uniform spacing (steps from {steps.min():g} to {steps.max():g})"
         )
     if plant.dt is not True and abs(h - plant.dt) > tols.TIME_GRID_RTOL * plant.dt:
-        raise ValueError(
+        raise InputError(
             f"timepts must lie on the sampling grid of the discrete plant: their spacing "
             f"must equal dt = {plant.dt:g}, got {h:g} (e.g. timepts = np.arange(N) * dt)"
         )
@@ -287,15 +287,15 @@ def _check_discrete_grid(plant: Plant, t: np.ndarray) -> float:
 def _finite_real(name: str, arr: Any) -> np.ndarray:
     """``arr`` as a float array; complex or non-numeric values raise a ValueError naming it."""
     if isinstance(arr, (str, bytes)):
-        raise ValueError(f"{name} must be numeric, got the text {arr!r}")
+        raise InputError(f"{name} must be numeric, got the text {arr!r}")
     if np.iscomplexobj(arr):
-        raise ValueError(f"{name} must be real, got complex values")
+        raise InputError(f"{name} must be real, got complex values")
     if isinstance(arr, bool) or np.asarray(arr).dtype.kind in "USb":
-        raise ValueError(f"{name} must hold real numbers, got {np.asarray(arr).dtype} values")
+        raise InputError(f"{name} must hold real numbers, got {np.asarray(arr).dtype} values")
     try:
         out = np.asarray(arr, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must hold real numbers: {exc}") from None
+        raise InputError(f"{name} must hold real numbers: {exc}") from None
     return out
 
 
@@ -303,7 +303,7 @@ def _call(name: str, func: Callable, t: np.ndarray, k: int) -> np.ndarray:
     try:
         raw = func(t)
     except Exception as exc:
-        raise ValueError(
+        raise InputError(
             f"calling {name} with the array of {t.size} time points failed ({exc}); a signal "
             "must be vectorized: it receives all the time points at once"
         ) from exc
@@ -313,7 +313,7 @@ def _call(name: str, func: Callable, t: np.ndarray, k: int) -> np.ndarray:
     if arr.shape != (k, t.size):
         accepted = f"({k}, {t.size})" + (f" or ({t.size},)" if k == 1 else "")
         hint = " (for a constant c, return c + 0 * t)" if arr.ndim == 0 else ""
-        raise ValueError(
+        raise InputError(
             f"{name}(t) must return an array of shape {accepted} (one row per channel, one "
             f"column per time point), got shape {arr.shape}{hint}"
         )
@@ -346,12 +346,12 @@ def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.nda
             if arr.size == 0 and arr.ndim in (1, 2) and (arr.ndim == 1 or arr.shape[1] in (0, N)):
                 return np.zeros((0, N))  # an absent input given as an empty array
         what, dim, mat = _WHAT[name]
-        raise ValueError(
+        raise InputError(
             f"{name} was given but the plant has no {what} ({dim} = 0, {mat} has no columns)"
         )
     if isinstance(value, (list, tuple)) and value and all(callable(f) for f in value):
         if len(value) != k:
-            raise ValueError(
+            raise InputError(
                 f"{name} is a list of {len(value)} signals, expected {k} (one per channel)"
             )
         arr = np.vstack([_call(f"{name}[{i}]", f, t, 1) for i, f in enumerate(value)])
@@ -363,13 +363,13 @@ def input_samples(name: str, value: SignalLike, k: int, t: np.ndarray) -> np.nda
             arr = arr.reshape(1, -1)
         if arr.shape != (k, N):
             accepted = f"({k}, {N})" + (f" or ({N},)" if k == 1 else "")
-            raise ValueError(
+            raise InputError(
                 f"{name} must have shape {accepted} (one row per channel, one column per time "
                 f"point), got {arr.shape}"
             )
     if not (np.isfinite(arr.min()) and np.isfinite(arr.max())):  # a NaN or an infinity
         i, j = (int(a) for a in np.argwhere(~np.isfinite(arr))[0])
-        raise ValueError(
+        raise InputError(
             f"{name} has a non-finite value {arr[i, j]} in channel {i} at time point {j} "
             f"(t = {t[j]:g}); all values must be finite"
         )
@@ -381,10 +381,10 @@ def _vector(name: str, value: Any, size: int, what: str) -> np.ndarray:
         return np.zeros(size)
     arr = _finite_real(name, value)
     if arr.size != size or arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
-        raise ValueError(f"{name} must have length {size} ({what}), got shape {arr.shape}")
+        raise InputError(f"{name} must have length {size} ({what}), got shape {arr.shape}")
     arr = arr.ravel()
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite, got {arr}")
+        raise InputError(f"{name} must be finite, got {arr}")
     return arr
 
 
@@ -395,12 +395,12 @@ def _noise(noise: Any, seed: Any, p: int, N: int) -> np.ndarray:
     if sd.ndim == 0:
         sd = np.full(p, float(sd))
     if sd.shape != (p,):
-        raise ValueError(
+        raise InputError(
             f"noise must be one standard deviation (a scalar) or one per output (length {p}), "
             f"got shape {sd.shape}"
         )
     if not np.all(np.isfinite(sd)) or np.any(sd < 0):
-        raise ValueError(f"noise standard deviations must be finite and >= 0, got {sd}")
+        raise InputError(f"noise standard deviations must be finite and >= 0, got {sd}")
     rng = np.random.default_rng(as_seed("seed", seed))
     return sd[:, None] * rng.standard_normal((p, N))
 
@@ -1234,21 +1234,21 @@ def simulate(
     True
     """
     if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+        raise InputError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
     if not isinstance(observer, Observer):
-        raise ValueError(
+        raise InputError(
             f"observer must be a uio_teach observer (design_uio, design_pmo, ...), "
             f"got {type(observer).__name__}"
         )
     design = observer.plant
     for dim in ("n", "m", "p"):
         if getattr(plant, dim) != getattr(design, dim):
-            raise ValueError(
+            raise InputError(
                 f"observer was designed for a plant with {dim} = {getattr(design, dim)}, but the "
                 f"simulated plant has {dim} = {getattr(plant, dim)}"
             )
     if plant.is_discrete != design.is_discrete:
-        raise ValueError(
+        raise InputError(
             "plant and observer must be both continuous-time or both discrete-time: plant "
             f"dt = {plant.dt!r}, observer designed for dt = {design.dt!r}"
         )

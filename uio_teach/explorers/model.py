@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from .. import signals
+from ..errors import InputError
 from ..existence import ExistenceReport
 from ..observers.reduced import reduced_movable
 from ..plant import Plant
@@ -349,7 +350,7 @@ class Scenario:
         for control in self.plant_controls:
             if control.name == name:
                 return control
-        raise ValueError(f"static_control names no plant control: {self.static_control!r}")
+        raise InputError(f"static_control names no plant control: {self.static_control!r}")
 
     @property
     def discrete(self) -> bool:
@@ -417,10 +418,10 @@ def _channel_signal(
         return signals.damped_sinusoid(a, channel.decay * w, w, channel.kind)
     period = float(settings.period) / channel.speed
     if not np.isfinite(period) or period <= 0:
-        raise ValueError(f"the switching period must be positive, got {settings.period!r}")
+        raise InputError(f"the switching period must be positive, got {settings.period!r}")
     count = int(math.ceil((t1 - t0) / period)) + 1
     if count > 100_000:
-        raise ValueError(f"the switching period {settings.period:g} is too short for this window")
+        raise InputError(f"the switching period {settings.period:g} is too short for this window")
     times = t0 + period * np.arange(count)
     if kind == "piecewise constant":
         values = a * np.where(np.arange(count) % 2 == 0, 1.0, -1.0)
@@ -466,11 +467,11 @@ def disturbance_signals(
     """
     kind = settings.disturbance
     if kind not in DISTURBANCES:
-        raise ValueError(f"unknown disturbance type {kind!r}; choose one of {DISTURBANCES}")
+        raise InputError(f"unknown disturbance type {kind!r}; choose one of {DISTURBANCES}")
     for name in ("amplitude", "frequency", "period"):
         value = getattr(settings, name)
         if not isinstance(value, int | float | np.number) or not np.isfinite(value):
-            raise ValueError(f"the {name} must be a finite number, got {value!r}")
+            raise InputError(f"the {name} must be a finite number, got {value!r}")
     t0, t1 = float(scenario.timepts[0]), float(scenario.timepts[-1])
     seed = int(settings.seed)
     d = [

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..existence import check_existence
 from ..experiments import experiment_params
 from ..linalg import is_stable, rank
@@ -91,7 +92,7 @@ def _range(experiment: Any, control: str) -> tuple[float, float]:
     for _, spec in experiment_params(experiment):
         if spec.control == control:
             return spec.range
-    raise ValueError(f"{type(experiment).__name__} declares no field for the control {control!r}")
+    raise InputError(f"{type(experiment).__name__} declares no field for the control {control!r}")
 
 
 def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
@@ -135,7 +136,7 @@ def plant_controls(experiment: Any) -> tuple[PlantControl, ...]:
 
 def _scenario(plant: Plant, family: str, **kwargs: Any) -> Scenario:
     if family not in FAMILIES:
-        raise ValueError(f"observer_family must be one of {tuple(FAMILIES)}, got {family!r}")
+        raise InputError(f"observer_family must be one of {tuple(FAMILIES)}, got {family!r}")
     timepts = np.asarray(kwargs.pop("timepts"), dtype=float)
     timepts.setflags(write=False)
     x0 = np.asarray(kwargs.pop("initial_state"), dtype=float).ravel()
@@ -218,9 +219,9 @@ def make_scenario(
     (0.4,)
     """
     if not isinstance(plant, Plant):
-        raise ValueError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
+        raise InputError(f"plant must be a uio_teach.Plant, got {type(plant).__name__}")
     if observer_family not in FAMILIES:
-        raise ValueError(
+        raise InputError(
             f"observer_family must be one of {tuple(FAMILIES)}, got {observer_family!r}"
         )
     report = check_existence(plant)
@@ -248,7 +249,7 @@ def make_scenario(
     x0 = np.ones(plant.n) if initial_state is None else initial_state
     w = 2 * math.pi * 3 / span
     if reconstruct and (plant.q == 0 or rank(plant.E) < plant.q):
-        raise ValueError("reconstruct=True needs unknown inputs with E of full column rank")
+        raise InputError("reconstruct=True needs unknown inputs with E of full column rank")
     real_first = bool(k and not complex(poles[0]).imag)
     if not real_first:
         static: tuple[float, ...] = (0.0, 0.5, 1.0, 2.0, 4.0)

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._display import format_complex, format_poles
+from ..errors import InputError
 from ..linalg import is_stable
 from ._figure import ExplorerFigure
 from .frames import Frame, compute_frame
@@ -469,10 +470,10 @@ def static_explorer(
         disturbances = (base.disturbance, other)
     disturbances = tuple(disturbances)
     if not values or not disturbances:
-        raise ValueError("a static explorer needs at least one value and one disturbance type")
+        raise InputError("a static explorer needs at least one value and one disturbance type")
     bad = [d for d in disturbances if d not in DISTURBANCES]
     if bad:
-        raise ValueError(f"unknown disturbance type(s) {bad}; choose from {DISTURBANCES}")
+        raise InputError(f"unknown disturbance type(s) {bad}; choose from {DISTURBANCES}")
     plant_control = scenario.static_plant_control
     if scenario.static_control == "amplitude":
         current = base.amplitude

@@ -56,6 +56,7 @@ except ImportError as err:  # the live explorers are an extra: say so in one lin
 
 from .. import tolerances as tols
 from .._display import format_poles
+from ..errors import InputError
 from ..plant import Plant
 from ._drag import DragPoles, drag_available, in_kernel
 from ._figure import ExplorerFigure
@@ -760,7 +761,7 @@ def missile_explorer(
     (2, 1001)
     """
     if observer_family not in ("pmo", "ginverse"):
-        raise ValueError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
+        raise InputError(f"observer_family must be 'pmo' or 'ginverse', got {observer_family!r}")
     scenario = scenario_of("missile")
     if observer_family == "ginverse":
         scenario = dataclasses.replace(

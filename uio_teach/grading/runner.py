@@ -64,6 +64,7 @@ from typing import Any
 
 import nbformat
 
+from ..errors import InputError
 from .lab_checks import LabChecks, check_function
 from .sandbox import HOME, Limits, Sandbox, drop_privileges
 
@@ -225,26 +226,26 @@ def clean_notebook(raw: Any) -> tuple[Any, list[str]]:
     ('x = 1', None, ['a cell whose tags are not a list of names: its tags were ignored'])
     """
     if not isinstance(raw, dict):
-        raise ValueError("not a notebook (not a JSON object)")
+        raise InputError("not a notebook (not a JSON object)")
     version = raw.get("nbformat")
     converted = []
     if "nbformat" not in raw:
-        raise ValueError("not a notebook (no nbformat field)")
+        raise InputError("not a notebook (no nbformat field)")
     if version == 3:
         raw = _upgrade(raw)
         converted.append("a notebook of format 3 (nbformat 3), converted to format 4 to run")
     elif isinstance(version, int) and not isinstance(version, bool) and version < 3:
-        raise ValueError(
+        raise InputError(
             f"a notebook of format {version} (nbformat {version}), too old to convert: open it "
             "in Jupyter and save it again (format 4)"
         )
     elif version != 4:
-        raise ValueError(
+        raise InputError(
             f"a notebook of format {_one_line(repr(version), 40)} (nbformat): the grader reads "
             "formats 4 and 3"
         )
     if not isinstance(raw.get("cells"), list):
-        raise ValueError("not a notebook of format 4 (no list of cells)")
+        raise InputError("not a notebook of format 4 (no list of cells)")
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {
         "name": "python3",
@@ -287,7 +288,7 @@ def _upgrade(raw: dict[str, Any]) -> Any:
         new = nbformat.converter.convert(node, 4)
         return json.loads(json.dumps(new))
     except Exception as err:  # the converter raises many kinds on a malformed notebook
-        raise ValueError(
+        raise InputError(
             f"a notebook of format 3 (nbformat 3) that could not be converted to format 4 "
             f"({type(err).__name__}): open it in Jupyter and save it again"
         ) from None

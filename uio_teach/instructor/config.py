@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from .._display import format_poles
-from ..errors import UIOTeachError
+from ..errors import InputError, UIOTeachError
 from ..existence import check_existence
 from ..experiments import (
     EXPERIMENTS,
@@ -205,7 +205,7 @@ def config_schema(
                 discrete=spec.discrete,
             )
             if key in found and found[key] != entry:
-                raise ValueError(
+                raise InputError(
                     f"the config key {key!r} is declared twice, differently: "
                     f"{found[key]} and {entry}"
                 )

@@ -44,6 +44,7 @@ from typing import Any
 
 import matplotlib.style
 
+from ..errors import InputError
 from ..folders import MANIFEST, OutputError, StagedFolder, prepare_output_dir, write_manifest
 from ..worked import WORKED, RegistryView, run_from_config
 from .config import (
@@ -101,7 +102,7 @@ class _Runs:
         """The observer of the worked example ``name`` with the config's poles (and plant)."""
         key = WORKED[name].poles_key()
         if key is None:
-            raise ValueError(f"the worked example {name!r} has no poles in the term config")
+            raise InputError(f"the worked example {name!r} has no poles in the term config")
         return design_observer(self.cfg, key)
 
 
@@ -241,12 +242,12 @@ def generate(
     (True, 'case_error.png')
     """
     if fmt not in FORMATS:
-        raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
+        raise InputError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
     dpi = check_dpi(dpi)
     wanted = list(FIGURES) if names is None else list(dict.fromkeys(names))
     unknown = [n for n in wanted if n not in FIGURES]
     if unknown:
-        raise ValueError(unknown_figure_message(unknown[0]))
+        raise InputError(unknown_figure_message(unknown[0]))
     wanted = [n for n in FIGURES if n in wanted]
     target = Path(out)
     cfg = config if config is not None else FigureConfig()

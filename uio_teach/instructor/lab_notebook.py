@@ -71,6 +71,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from ..errors import InputError
 from .book import HEADING, TARGET, BookIndex, fence_states
 from .lab_registry import LabError, LabUsageError
 from .myst import Converter, Directive, tokens
@@ -498,7 +499,7 @@ def make_notebook(
     import nbformat
 
     if version not in VERSIONS:
-        raise ValueError(f"version must be one of {VERSIONS}, got {version!r}")
+        raise InputError(f"version must be one of {VERSIONS}, got {version!r}")
     path = Path(source)
     if not path.is_file():
         raise LabUsageError(f"{os.fspath(path)}: no such file")

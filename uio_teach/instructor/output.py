@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..errors import InputError
 from ..figure_text import description, description_text
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -74,7 +75,7 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], fmt: str, dpi: int = 
     import matplotlib  # deferred on purpose: the lab notebooks and the grader do not draw
 
     if fmt not in FORMATS:
-        raise ValueError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
+        raise InputError(f"fmt must be one of {', '.join(FORMATS)}, got {fmt!r}")
     metadata = {
         "png": {"Software": None},
         "pdf": {"CreationDate": None, "ModDate": None},

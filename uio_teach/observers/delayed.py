@@ -32,7 +32,7 @@ import numpy as np
 from .. import tolerances as tols
 from .._display import fit_lines
 from .._validation import read_only
-from ..errors import UIOTeachError
+from ..errors import InputError, UIOTeachError
 from ..existence import ExistenceReport, check_existence
 from ..linalg import observability_decomposition, one_blas_thread, rank_decision
 from ..placement import place_observer_poles, requested_poles
@@ -418,7 +418,7 @@ def _delay_arg(delay: Any) -> int | None:
     if delay is None:
         return None
     if isinstance(delay, bool) or not isinstance(delay, (int, np.integer)) or delay < 0:
-        raise ValueError(f"delay must be a non-negative integer (samples), got {delay!r}")
+        raise InputError(f"delay must be a non-negative integer (samples), got {delay!r}")
     return int(delay)
 
 

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_matrix, read_only
+from ..errors import InputError
 from ..linalg import one_blas_thread, pinv, rank, sort_poles
 from ..plant import Plant, check_plant
 from ..verify import check_decoupling, check_fixed_modes, check_identity, product_bound
@@ -227,11 +228,11 @@ def design_ginverse(plant: Plant, *, Kv: Any = None) -> GInverseObserver:
     """
     plant = check_plant(plant)
     if plant.nv:
-        raise ValueError(
+        raise InputError(
             "design_ginverse does not handle measurement disturbances (D); use design_pmo"
         )
     if rank(plant.C) < plant.p:
-        raise ValueError(
+        raise InputError(
             f"C has rank {rank(plant.C)} < p = {plant.p}: remove the redundant outputs first"
         )
     report = require_existence(plant, "a g-inverse observer")

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_matrix, read_only
+from ..errors import InputError
 from ..linalg import observability_decomposition
 from ..placement import place_observer_poles, requested_poles
 from ..plant import Plant, check_plant
@@ -104,7 +105,7 @@ def design_luenberger(plant: Plant, poles: Any = None, *, L: Any = None) -> Luen
     """
     plant = check_plant(plant)
     if (poles is None) == (L is None):
-        raise ValueError("give exactly one of poles= or L=")
+        raise InputError("give exactly one of poles= or L=")
     requested = None
     if L is None:
         split = observability_decomposition(plant.A, plant.C)

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import as_matrix, read_only
+from ..errors import InputError
 from ..existence import decoupling
 from ..linalg import one_blas_thread
 from ..lmi import lmi_gain
@@ -170,17 +171,17 @@ def design_pmo(
     """
     plant = check_plant(plant)
     if method not in ("place", "lmi"):
-        raise ValueError(f"method must be 'place' or 'lmi', got {method!r}")
+        raise InputError(f"method must be 'place' or 'lmi', got {method!r}")
     if method == "lmi" and (poles is not None or L is not None):
-        raise ValueError("method='lmi' computes L itself: do not give poles= or L=")
+        raise InputError("method='lmi' computes L itself: do not give poles= or L=")
     if method == "place" and (poles is None) == (L is None):
-        raise ValueError("give exactly one of poles= or L= (or use method='lmi')")
+        raise InputError("give exactly one of poles= or L= (or use method='lmi')")
     if decay is not None and method != "lmi":
-        raise ValueError("decay= is the LMI's bound: use it with method='lmi'")
+        raise InputError("decay= is the LMI's bound: use it with method='lmi'")
     report = require_existence(plant, "a projection-operator observer")
     if Mv is not None:
         if plant.nv:
-            raise ValueError("Mv is not supported together with a measurement disturbance D")
+            raise InputError("Mv is not supported together with a measurement disturbance D")
         Mv = as_matrix("Mv", Mv, plant.n, plant.p, what="n x p")
     dec = decoupling(plant, Mv, zeros=report.invariant_zeros, radius=report.zero_radius)
     certificate = None

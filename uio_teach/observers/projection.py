@@ -16,6 +16,7 @@ import numpy as np
 
 from .. import tolerances as tols
 from .._validation import as_matrix, read_only
+from ..errors import InputError
 from ..existence import ExistenceReport, UIOExistenceError, check_existence
 from ..linalg import pinv
 from ..plant import Plant
@@ -154,7 +155,7 @@ def decoupled_gain(name: str, plant: Plant, gain: Any) -> np.ndarray:
             stacklevel=3,
         )
         return G - GD @ pinv(plant.D)
-    raise ValueError(
+    raise InputError(
         f"{name} D must be 0 so that the measurement disturbance does not enter the "
         f"error; got {name} D = {_entries(GD)}"
     )

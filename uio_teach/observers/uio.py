@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from .._validation import read_only
+from ..errors import InputError
 from ..existence import decoupling
 from ..linalg import one_blas_thread
 from ..placement import place_pair_poles
@@ -138,11 +139,11 @@ def design_uio(
     """
     if delay is not None and not (isinstance(delay, int | np.integer) and delay == 0):
         if K1 is not None:
-            raise ValueError("give poles= with delay= (a delayed UIO is designed by its poles)")
+            raise InputError("give poles= with delay= (a delayed UIO is designed by its poles)")
         return design_delayed_uio(plant, poles, delay)  # checks the delay and the plant
     plant = check_plant(plant)
     if (poles is None) == (K1 is None):
-        raise ValueError("give exactly one of poles= (the movable error poles) or K1=")
+        raise InputError("give exactly one of poles= (the movable error poles) or K1=")
     report = require_existence(plant, "an unknown input observer")
     dec = decoupling(plant, zeros=report.invariant_zeros, radius=report.zero_radius)
     requested = None

@@ -32,6 +32,7 @@ import numpy as np
 from .. import examples, signals
 from .. import tolerances as tols
 from .._display import format_poles
+from ..errors import InputError
 from ..existence import check_existence, decoupling
 from ..experiments import (
     MAX_SEED,
@@ -178,7 +179,7 @@ class CaseStudyExperiment(Experiment):
             return self.timepts
         last = int(duration) if duration is not None else int(samples) - 1
         if samples is not None and int(samples) != last + 1:
-            raise ValueError(f"samples must be the steps plus one ({last + 1}), got {samples}")
+            raise InputError(f"samples must be the steps plus one ({last + 1}), got {samples}")
         return np.arange(last + 1, dtype=float)
 
     @property

@@ -37,6 +37,7 @@ import numpy as np
 from .. import signals
 from .. import tolerances as tols
 from .._display import format_poles
+from ..errors import InputError
 from ..examples import TankOperatingPoint, quadruple_tank, tank_operating_point
 from ..existence import check_existence
 from ..experiments import MAX_DURATION, MAX_SAMPLES, MAX_VALUE, Experiment, param
@@ -163,7 +164,7 @@ class QuadrupleTankExperiment(Experiment):
         low = h0 + self.initial_state
         if low.size == h0.size and np.any(low < 0):
             i = int(np.argmin(low))
-            raise ValueError(
+            raise InputError(
                 f"initial_state: the deviation {self.initial_state[i]:g} cm would leave tank "
                 f"{i + 1} at {low[i]:.3g} cm, below empty (its level at this operating point is "
                 f"{h0[i]:.3g} cm); keep every h(0) - h0 above -h0"
@@ -178,7 +179,7 @@ class QuadrupleTankExperiment(Experiment):
         ):
             if lowest < 0:
                 pump = key[4]
-                raise ValueError(
+                raise InputError(
                     f"{key}: {what} takes pump {pump} to {lowest:.3g} V, below 0 (it runs at "
                     f"{self.v0[int(pump) - 1]:g} V at the operating point)"
                 )
@@ -252,7 +253,7 @@ class QuadrupleTankExperiment(Experiment):
         levels = h0[:, None] + res.states
         if np.any(levels < 0):
             i, k = np.unravel_index(int(np.argmin(levels)), levels.shape)
-            raise ValueError(
+            raise InputError(
                 f"the run takes tank {i + 1} to {levels[i, k]:.3g} cm at t = {res.time[k]:g} s, "
                 f"below empty (its level at the operating point is {h0[i]:.3g} cm): the pump "
                 "deviations are too large for the linear model"
