@@ -318,7 +318,7 @@ def test_a_missing_answer_names_the_variable_the_cell_and_a_hint():
 
 
 def test_the_hint_for_inv_tells_a_singular_matrix_from_one_that_is_not_square():
-    # the missile's CE and the case study's [CB2 D] are square: "not square" would be false there
+    # the missile's CE and the case study's [CE D] are square: "not square" would be false there
     singular = missing_message(Missing("M", 3, "LinAlgError", "Singular matrix"))
     not_square = missing_message(
         Missing("H", 4, "LinAlgError", "Last 2 dimensions of the array must be square")

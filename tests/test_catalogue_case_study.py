@@ -20,20 +20,20 @@ from uio_teach.worked.case_study import CaseStudyParams
 P = CaseStudyParams().to_params()
 POLE = P["pole"]
 X0 = P["initial_state"]
-U2 = (P["u2"]["amplitude"], P["u2"]["frequency"])
+D_ASKED = (P["d"]["amplitude"], P["d"]["frequency"])
 V = (P["v"]["amplitude"], P["v"]["hold"], P["v"]["seed"])
 PLANT = ut.examples.dt_case_study()
-A, C, B2, D = PLANT.A, PLANT.C, PLANT.E, PLANT.D
+A, C, E, D = PLANT.A, PLANT.C, PLANT.E, PLANT.D
 n, p = PLANT.n, PLANT.p
 EYE = np.eye(n)
-M = np.hstack([B2, np.zeros((n, 1))]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
+M = np.hstack([E, np.zeros((n, 1))]) @ np.linalg.pinv(np.hstack([C @ E, D]))
 A1 = (EYE - M @ C) @ A
 LMI = ut.design_pmo(PLANT, method="lmi")
 L, P_LMI = LMI.L, LMI.lmi_certificate
 N = ut.linalg.left_null(D)
 L_MOVED = ut.design_pmo(PLANT, poles=[POLE]).L
 STEPS = np.arange(P["steps"] + 1)
-U2_SIGNAL = ut.signals.sinusoid(*U2)
+D_SIGNAL = ut.signals.sinusoid(*D_ASKED)
 
 
 def staircase(amplitude, hold, seed):
@@ -88,7 +88,7 @@ def plot(fig, run=None):
     return checks.case_study_plot(fig, RUN if run is None else run, plant=PLANT)
 
 
-def sim(observer=LMI, d=U2_SIGNAL, v=V_SIGNAL, x0=X0, steps=STEPS):
+def sim(observer=LMI, d=D_SIGNAL, v=V_SIGNAL, x0=X0, steps=STEPS):
     return ut.simulate(PLANT, observer, steps, d=d, v=v, initial_state=x0)
 
 
@@ -97,7 +97,7 @@ RUN = sim()
 
 def simulation(resp, observer=None):
     return checks.case_study_simulation(
-        resp, u2=U2, v=V, initial_state=X0, plant=PLANT, observer=observer
+        resp, d=D_ASKED, v=V, initial_state=X0, plant=PLANT, observer=observer
     )
 
 
@@ -119,12 +119,12 @@ CATALOGUE = {
     # M ---------------------------------------------------------------------------------------
     "M left out": (lambda: checks.case_study_projection(None), "M is missing"),
     "M transposed": (lambda: checks.case_study_projection(M.T), "It looks transposed"),
-    "M = B2 (CB2)^+, D forgotten": (
-        lambda: checks.case_study_projection(B2 @ np.linalg.pinv(C @ B2)),
+    "M = E (CE)^+, D forgotten": (
+        lambda: checks.case_study_projection(E @ np.linalg.pinv(C @ E)),
         "which ignores D",
     ),
     "M with a minus sign": (lambda: checks.case_study_projection(-M), "check the sign"),
-    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(I - MC)B2 is not 0"),
+    "M = C^+": (lambda: checks.case_study_projection(np.linalg.pinv(C)), "(I - MC)E is not 0"),
     "M with a NaN": (
         lambda: checks.case_study_projection(np.where(M > 0.4, np.nan, M)),
         "every entry must be a finite number",
@@ -199,11 +199,11 @@ CATALOGUE = {
     ),
     # the run ------------------------------------------------------------------------------------
     "run left out": (lambda: simulation(None), "got None"),
-    "no u2": (lambda: simulation(sim(d=None)), "u2 is zero during the whole run"),
+    "no d": (lambda: simulation(sim(d=None)), "d is zero during the whole run"),
     "no v": (lambda: simulation(sim(v=None)), "v is zero during the whole run"),
-    "u2 with another amplitude": (
-        lambda: simulation(sim(d=ut.signals.sinusoid(2 * U2[0], U2[1]))),
-        "u2 is not the asked",
+    "d with another amplitude": (
+        lambda: simulation(sim(d=ut.signals.sinusoid(2 * D_ASKED[0], D_ASKED[1]))),
+        "d is not the asked",
     ),
     "v with another seed": (
         lambda: simulation(sim(v=staircase(V[0], V[1], V[2] + 1))),
@@ -219,7 +219,7 @@ CATALOGUE = {
                 PLANT,
                 ut.design_pmo(ut.Plant(A, C, E=[[1.0], [0.0], [0.0]], D=D, dt=1.0), poles=[0.2]),
                 STEPS,
-                d=U2_SIGNAL,
+                d=D_SIGNAL,
                 v=V_SIGNAL,
                 initial_state=X0,
             )
@@ -234,7 +234,7 @@ CATALOGUE = {
                 PLANT,
                 LMI,
                 STEPS,
-                d=U2_SIGNAL,
+                d=D_SIGNAL,
                 v=V_SIGNAL,
                 initial_state=X0,
                 observer_state=-M @ C @ np.asarray(X0),
@@ -249,10 +249,10 @@ CATALOGUE = {
     "a run of another plant": (
         lambda: simulation(
             ut.simulate(
-                ut.Plant(0.9 * A, C, E=B2, D=D, dt=1.0),
-                ut.design_pmo(ut.Plant(0.9 * A, C, E=B2, D=D, dt=1.0), poles=[0.2]),
+                ut.Plant(0.9 * A, C, E=E, D=D, dt=1.0),
+                ut.design_pmo(ut.Plant(0.9 * A, C, E=E, D=D, dt=1.0), poles=[0.2]),
                 STEPS,
-                d=U2_SIGNAL,
+                d=D_SIGNAL,
                 v=V_SIGNAL,
                 initial_state=X0,
             )

@@ -275,7 +275,7 @@ def _prose_claims() -> list[tuple[str, str]]:
         # case study
         (
             "case_study.md",
-            f"$d[k] = {_num(CASE_STUDY.u2_amplitude)} \\sin({_num(CASE_STUDY.u2_frequency)} k)$",
+            f"$d[k] = {_num(CASE_STUDY.d_amplitude)} \\sin({_num(CASE_STUDY.d_frequency)} k)$",
         ),
         (
             "case_study.md",

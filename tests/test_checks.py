@@ -498,8 +498,8 @@ def test_a_rounded_projection_matrix_is_named_with_its_decimals_on_a_groups_plan
     plant = ut.experiments.plant_from_params(
         "case_study", {"plant": {"D": [[0.3], [1.0]], "E": [[2.0], [1.0], [2.0]]}}
     )
-    B2, D = plant.E, plant.D
-    exact = np.hstack([B2, np.zeros_like(B2)]) @ np.linalg.pinv(np.hstack([plant.C @ B2, D]))
+    E, D = plant.E, plant.D
+    exact = np.hstack([E, np.zeros_like(E)]) @ np.linalg.pinv(np.hstack([plant.C @ E, D]))
     for k in (4, 2):
         result = checks.case_study_projection(np.round(exact, k), plant)
         assert f"rounded to {k} decimals" in failures_text(result), str(result)

@@ -124,7 +124,7 @@ def test_the_explorers_ranges_are_the_declared_ranges():
     assert scenario.disturbance_frequency_limits == ranges["sine_frequency"]
     assert scenario.noise_limits == ranges["noise"]
     case = {n: s.range for n, s in experiment_params(CASE_STUDY)}
-    assert scenario_of("case_study").amplitude_limits == case["u2_amplitude"]
+    assert scenario_of("case_study").amplitude_limits == case["d_amplitude"]
 
 
 def test_a_key_declared_twice_differently_is_refused():

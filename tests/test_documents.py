@@ -34,7 +34,7 @@ def test_case_study_M_as_printed(case_pmo):
 
 def test_case_study_decoupling_identities(case_pmo):
     plant = case_pmo.plant
-    # (I - MC) B2 = 0 and M D = 0, up to the rounding of 3-term products of M = B2 [CB2 D]^+
+    # (I - MC) E = 0 and M D = 0, up to the rounding of 3-term products of M = E [CE D]^+
     M, C, E, D = case_pmo.M, plant.C, plant.E, plant.D
     gain = np.linalg.cond(np.hstack([C @ E, D]))
     assert_zero((np.eye(3) - M @ C) @ E, np.eye(3) + np.abs(M) @ np.abs(C), E, terms=3, gain=gain)

@@ -88,7 +88,7 @@ def test_late_failures_of_old_are_config_errors_before_anything_is_written(
         ("[pa9]\npoles = [-1, -2, -1e7]\n", "faster than"),
         ("[missile]\npmo_poles = [-100, nan]\n", "missile.pmo_poles[1]: expected a finite"),
         ("[case_study]\nsteps = 100001\n", "case_study.steps: must be <= 100000"),
-        ("[case_study.u2]\nfrequency = 4.0\n", "case_study.u2.frequency: must be <= 3.14159"),
+        ("[case_study.d]\nfrequency = 4.0\n", "case_study.d.frequency: must be <= 3.14159"),
         ("[case_study.v]\nhold = 50\n", "case_study.v.hold: 50 steps is longer than the run"),
         ('style = "missing.mplstyle"\n', "style: no such file"),
     ],

@@ -267,15 +267,15 @@ def case_study_run_verdict(params):
     plant = ut.experiments.plant_from_params("case_study", params)
     pmo = ut.design_pmo(plant, L=case_study_solution(params)["L"])
     steps = np.arange(params["steps"] + 1)
-    u2 = ut.signals.sinusoid(params["u2"]["amplitude"], params["u2"]["frequency"])
+    d_in = ut.signals.sinusoid(params["d"]["amplitude"], params["d"]["frequency"])
     rng = np.random.default_rng(params["v"]["seed"])
     switch = np.arange(0, steps[-1] + 1, params["v"]["hold"])
     levels = rng.uniform(-params["v"]["amplitude"], params["v"]["amplitude"], switch.size)
     v = ut.signals.piecewise_constant(switch, levels)
-    run = ut.simulate(plant, pmo, steps, d=u2, v=v, initial_state=params["initial_state"])
+    run = ut.simulate(plant, pmo, steps, d=d_in, v=v, initial_state=params["initial_state"])
     return run, checks.case_study_simulation(
         run,
-        u2=(params["u2"]["amplitude"], params["u2"]["frequency"]),
+        d=(params["d"]["amplitude"], params["d"]["frequency"]),
         v=(params["v"]["amplitude"], params["v"]["hold"], params["v"]["seed"]),
         initial_state=params["initial_state"],
         plant=plant,

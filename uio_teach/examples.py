@@ -4,8 +4,8 @@ The three source documents' plants as printed (the missile's as read back from t
 scrambled text) and Johansson's quadruple tank, built from the paper's parameters:
 
 * :func:`dt_case_study` -- *Case Study*: a discrete-time projection-operator UIO
-  (3 states, unknown state input ``u2`` with matrix ``B2 = E``, measurement
-  disturbance ``v`` with matrix ``D``); printed ``M``, ``L`` and poles in
+  (3 states, unknown state input ``d`` with matrix ``E``, the script's ``u2`` and ``B2``;
+  measurement disturbance ``v`` with matrix ``D``); printed ``M``, ``L`` and poles in
   :data:`DT_CASE_STUDY_PUBLISHED`.
 * :func:`pa9` -- *Estimation for control, Practical Assignment 9*: the
   continuous-time decoupling observer example; printed ``H, T, K1, K2, F`` in
@@ -89,7 +89,7 @@ class Published:
 def dt_case_study() -> Plant:
     """Discrete-time plant of the case study (unit sampling period, ``dt=1``).
 
-    ``x[k+1] = 0.5 I x[k] + [1 1 1]^T u2[k]``,
+    ``x[k+1] = 0.5 I x[k] + [1 1 1]^T d[k]``,
     ``y[k] = [[0 2 1], [1 0 0]] x[k] + [1 0.2]^T v[k]``.
 
     Examples

@@ -60,7 +60,7 @@ class Plant:
     B : array_like, shape (n, m), optional
         Known-input matrix; omitted means no known input (``m = 0``).
     E : array_like, shape (n, q), optional
-        Unknown-input matrix (``B2`` in the discrete case study, ``E`` in
+        Unknown-input matrix (``B2`` in the case-study script, ``E`` in
         Practical Assignment 9 and the missile paper). A 1-D array is a column.
     D : array_like, shape (p, nv), optional
         Measurement-disturbance matrix. A 1-D array is a column.

@@ -509,12 +509,22 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
         zS = z * np.eye(n) - S
         zT = z * np.eye(T.shape[0]) - T
         with np.errstate(all="ignore"):
-            X = V @ sla.solve_triangular(zS, VE)
-            W = sla.solve_triangular(zT, U.conj().T @ (R @ X + R1))
             # ||(zI - F)^-1||_2 <= sqrt(n) ||(zI - T)^-1||_1, the 1-norm from LAPACK's estimate
             rcond, info = lapack.ztrcon(zT, norm="1", uplo="U", diag="N")
-        if info != 0 or not rcond > 0:
+            rcond_A, info_A = lapack.ztrcon(zS, norm="1", uplo="U", diag="N")
+        if info != 0 or not rcond > 0 or info_A != 0 or not rcond_A > 0:
             continue
+        # z inside the round-off pseudospectrum of A or F (||(zI - X)^-1|| * near >= 1): z is an
+        # eigenvalue to round-off, whose computed place depends on the arithmetic (a defective
+        # one, a Jordan block of size k, spreads like eps^(1/k), far beyond `near`); the
+        # resolvent there is round-off, not the observer's, and the neighbours carry the gain
+        if near_A >= rcond_A * float(np.abs(zS).sum(axis=0).max()):
+            continue
+        if near_F * root_n >= rcond * float(np.abs(zT).sum(axis=0).max()):
+            continue
+        with np.errstate(all="ignore"):
+            X = V @ sla.solve_triangular(zS, VE)
+            W = sla.solve_triangular(zT, U.conj().T @ (R @ X + R1))
         if T.shape[0] <= _EXACT_NORM_UP_TO:
             # small: the exact norm (an inverse per point is cheap at this size)
             with np.errstate(all="ignore"):

@@ -1,11 +1,11 @@
 """Checks of the case-study lab: the projection-operator observer of a discrete-time plant.
 
-* :func:`case_study_projection` -- ``M``: ``(I - MC)B2 = 0`` and ``MD = 0``;
+* :func:`case_study_projection` -- ``M``: ``(I - MC)E = 0`` and ``MD = 0``;
 * :func:`case_study_lmi` -- the gain ``L`` of the LMI: ``LD = 0``, a stable
   ``F = A1 - LC`` (and, with ``P``, the LMI itself);
 * :func:`case_study_pole` -- a gain that moves the one movable pole to the
   asked place, with ``LD = 0`` (the two poles at 0.5 stay);
-* :func:`case_study_simulation` -- a run with ``u2`` and ``v`` as asked: the
+* :func:`case_study_simulation` -- a run with ``d`` and ``v`` as asked: the
   error ignores both and decays;
 * :func:`case_study_residual` -- ``D v`` and the combination ``N r`` that
   ``v`` does not reach.
@@ -16,8 +16,8 @@ Examples
 >>> import uio_teach as ut
 >>> from uio_teach import checks
 >>> plant = ut.examples.dt_case_study()
->>> C, B2, D = plant.C, plant.E, plant.D
->>> M = np.hstack([B2, np.zeros((3, 1))]) @ np.linalg.pinv(np.hstack([C @ B2, D]))
+>>> C, E, D = plant.C, plant.E, plant.D
+>>> M = np.hstack([E, np.zeros((3, 1))]) @ np.linalg.pinv(np.hstack([C @ E, D]))
 >>> checks.case_study_projection(M).passed
 True
 """
@@ -61,7 +61,7 @@ __all__ = [
 
 
 def _M_ref(plant) -> np.ndarray:
-    """The projection matrix ``M = [B2 0][C B2 D]^+`` of the package's design."""
+    """The projection matrix ``M = [E 0][C E D]^+`` of the package's design."""
     return decoupling(plant).M
 
 
@@ -72,7 +72,7 @@ def _small(X: np.ndarray, scale: float, tol: float) -> tuple[bool, float]:
 
 @never_raises("Case study: the projection matrix M", "case_study.projection")
 def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None) -> CheckResult:
-    """Check ``M``: it removes ``u2``, ``(I - MC)B2 = 0``, and the disturbance, ``MD = 0``.
+    """Check ``M``: it removes ``d``, ``(I - MC)E = 0``, and the disturbance, ``MD = 0``.
 
     Parameters
     ----------
@@ -95,7 +95,7 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None
     >>> from uio_teach import checks
     >>> plant = ut.examples.dt_case_study()
     >>> M = plant.E @ np.linalg.pinv(plant.C @ plant.E)   # forgets D
-    >>> "Your M is B2 (CB2)^+, which ignores D" in checks.case_study_projection(M).failures[0]
+    >>> "Your M is E (CE)^+, which ignores D" in checks.case_study_projection(M).failures[0]
     True
     """
     tol = tols.CHECK_EXACT_RTOL if tol is None else tol
@@ -107,12 +107,12 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None
     M = read_matrix(result, "M", M, n, p, f"n x p = {n} x {p}")
     if M is None:
         return result
-    C, B2, D = plant.C, plant.E, plant.D
+    C, E, D = plant.C, plant.E, plant.D
     scale = float(np.max(np.abs(M)))
-    ok, big = _small((np.eye(n) - M @ C) @ B2, scale, tol)
+    ok, big = _small((np.eye(n) - M @ C) @ E, scale, tol)
     ref = _M_ref(plant)
     if ok:
-        result.add(True, f"(I - MC)B2 = 0{up_to(big, 'largest entry')}: u2 is projected out.")
+        result.add(True, f"(I - MC)E = 0{up_to(big, 'largest entry')}: d is projected out.")
     else:
         rounded = next(
             (k for k in (4, 2) if close(M, np.round(ref, k), tols.CHECK_EXACT_RTOL)), None
@@ -123,26 +123,25 @@ def case_study_projection(M: Any, plant: Any = None, *, tol: float | None = None
                 "precision instead of typing printed digits."
             )
         elif close(M, -ref, tols.CHECK_EXACT_RTOL):
-            hint = " Your M is -[B2 0][CB2 D]^+: check the sign."
+            hint = " Your M is -[E 0][CE D]^+: check the sign."
         else:
             hint = (
-                " M must satisfy M [CB2 D] = [B2 0]; [CB2 D] is square here: which inverse "
-                "solves it?"
+                " M must satisfy M [CE D] = [E 0]; [CE D] is square here: which inverse solves it?"
             )
         result.add(
             False,
-            f"(I - MC)B2 is not 0: it is {format_matrix_line((np.eye(n) - M @ C) @ B2)} "
-            f"(largest entry {big:.3g}), so u2 still drives the error.{hint}",
+            f"(I - MC)E is not 0: it is {format_matrix_line((np.eye(n) - M @ C) @ E)} "
+            f"(largest entry {big:.3g}), so d still drives the error.{hint}",
         )
     ok, big = _small(M @ D, scale, tol)
     if ok:
         result.add(True, f"MD = 0{up_to(big, 'largest entry')}: v does not enter x̂ through My.")
     else:
-        only_b2 = B2 @ np.linalg.pinv(C @ B2)
+        only_e = E @ np.linalg.pinv(C @ E)
         hint = (
-            " Your M is B2 (CB2)^+, which ignores D: M must remove u2 and v together."
-            if close(M, only_b2, tols.CHECK_EXACT_RTOL)
-            else " M must also satisfy MD = 0, together with MCB2 = B2."
+            " Your M is E (CE)^+, which ignores D: M must remove d and v together."
+            if close(M, only_e, tols.CHECK_EXACT_RTOL)
+            else " M must also satisfy MD = 0, together with MCE = E."
         )
         result.add(
             False,
@@ -407,25 +406,25 @@ def _staircase(timepts: np.ndarray, amplitude: float, hold: int, seed: int) -> n
     return np.asarray(v(timepts), float).ravel()
 
 
-@never_raises("Case study: the simulation with u2 and v", "case_study.simulation")
+@never_raises("Case study: the simulation with d and v", "case_study.simulation")
 def case_study_simulation(
     response: Any,
     *,
-    u2: tuple[float, float] | None = None,
+    d: tuple[float, float] | None = None,
     v: tuple[float, int, int] | None = None,
     initial_state: Any = None,
     decay: float = 0.01,
     plant: Any = None,
     observer: Any = None,
 ) -> CheckResult:
-    """Check a run with both unknown signals: the error ignores ``u2`` and ``v`` and decays.
+    """Check a run with both unknown signals: the error ignores ``d`` and ``v`` and decays.
 
     Parameters
     ----------
     response : UIOResponse
         The result of :func:`uio_teach.simulate` on the case-study plant.
-    u2 : (amplitude, frequency), optional
-        The asked ``u2[k] = amplitude sin(frequency k)``.
+    d : (amplitude, frequency), optional
+        The asked ``d[k] = amplitude sin(frequency k)``.
     v : (amplitude, hold, seed), optional
         The asked staircase ``v`` (levels uniform in ``[-amplitude, amplitude]``,
         drawn by ``numpy.random.default_rng(seed)``, a new one every ``hold`` steps).
@@ -452,37 +451,37 @@ def case_study_simulation(
     >>> checks.case_study_simulation(CS.simulate(pmo)).passed
     True
     """
-    result = CheckResult("Case study: the simulation with u2 and v")
+    result = CheckResult("Case study: the simulation with d and v")
     resp = read_response(result, response)
     if resp is None or not check_plant_of(result, resp, plant):
         return result
     _observer_as_asked(result, resp, observer)
-    _signals_as_asked(result, resp, u2, v, initial_state)
+    _signals_as_asked(result, resp, d, v, initial_state)
     _ignores_and_decays(result, resp, decay)
     return result
 
 
-def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_state: Any) -> None:
-    """✓/✗ on u2 (the plant's d), the staircase v and x[0], as the exercise asks."""
+def _signals_as_asked(result: CheckResult, resp: Any, d: Any, v: Any, initial_state: Any) -> None:
+    """✓/✗ on d (the unknown input), the staircase v and x[0], as the exercise asks."""
     t = np.asarray(resp.time, float)
-    d = np.asarray(resp.inputs.d, float)
+    d_run = np.asarray(resp.inputs.d, float)
     vv = np.asarray(resp.inputs.v, float)
-    if not np.any(d):
-        result.add(False, "u2 is zero during the whole run: it acts as the plant's d.")
-    elif u2 is not None:
-        want = float(u2[0]) * np.sin(float(u2[1]) * t)
+    if not np.any(d_run):
+        result.add(False, "d is zero during the whole run: the unknown input acts on the state.")
+    elif d is not None:
+        want = float(d[0]) * np.sin(float(d[1]) * t)
         if np.allclose(
-            d[0], want, rtol=0, atol=tols.CHECK_EXACT_RTOL * max(1.0, abs(float(u2[0])))
+            d_run[0], want, rtol=0, atol=tols.CHECK_EXACT_RTOL * max(1.0, abs(float(d[0])))
         ):
-            result.add(True, f"u2 is the asked {float(u2[0]):g} sin({float(u2[1]):g} k).")
+            result.add(True, f"d is the asked {float(d[0]):g} sin({float(d[1]):g} k).")
         else:
             result.add(
                 False,
-                f"u2 is not the asked {float(u2[0]):g} sin({float(u2[1]):g} k): take its numbers "
-                'from PARAMS["u2"].',
+                f"d is not the asked {float(d[0]):g} sin({float(d[1]):g} k): take its numbers "
+                'from PARAMS["d"].',
             )
     else:
-        result.add(True, "u2 acts during the run.")
+        result.add(True, "d acts during the run.")
     if vv.size == 0 or not np.any(vv):
         result.add(False, "v is zero during the whole run: the staircase v acts on y.")
     elif v is not None:
@@ -511,19 +510,19 @@ def _signals_as_asked(result: CheckResult, resp: Any, u2: Any, v: Any, initial_s
 
 
 def _ignores_and_decays(result: CheckResult, resp: Any, decay: float) -> None:
-    """✓/✗: the error is the same without u2 and v, and decays."""
+    """✓/✗: the error is the same without d and v, and decays."""
     t = np.asarray(resp.time, float)
     diff, decoupled = rerun_without_unknown_inputs(resp)
     if decoupled:
         result.add(
             True,
-            f"the error ignores u2 and v: run again without them, it is the same"
+            f"the error ignores d and v: run again without them, it is the same"
             f"{up_to(diff, 'largest difference')}.",
         )
     else:
         result.add(
             False,
-            f"the error depends on the unknown signals: run again without u2 and v, it changes "
+            f"the error depends on the unknown signals: run again without d and v, it changes "
             f"by up to {diff:.3g}. Is the observer designed for this plant, with LD = 0?",
         )
     e0 = float(np.max(np.abs(resp.error[:, 0])))

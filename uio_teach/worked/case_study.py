@@ -3,7 +3,7 @@
 *Case Study: projection operator unknown input observer for a discrete-time
 system*: a projection-operator observer whose gain is certified by an LMI
 watches the plant of :func:`uio_teach.examples.dt_case_study` while an unknown
-state input ``u2`` and a random staircase ``v`` on the outputs act. This module
+state input ``d`` and a random staircase ``v`` on the outputs act. This module
 is the whole worked example in the package: the run (:data:`CASE_STUDY`, its
 fields the config table ``[case_study]`` and the lab's ``PARAMS``), the
 figures of ``uio-teach figures``, the explorer's options, the lab's parameter
@@ -62,13 +62,13 @@ __all__ = ["CaseStudyExperiment", "CASE_STUDY", "CASE_STUDY_LAB", "CaseStudyPara
 
 @dataclass(frozen=True)
 class CaseStudyExperiment(Experiment):
-    """The discrete-time case study: PMO from the LMI, unknown input ``u2``, random staircase ``v``.
+    """The discrete-time case study: PMO from the LMI, unknown input ``d``, random staircase ``v``.
 
     Attributes
     ----------
-    u2_amplitude : float
-        Amplitude of the unknown state input ``u2[k] = amplitude sin(frequency k)``.
-    u2_frequency : float
+    d_amplitude : float
+        Amplitude of the unknown state input ``d[k] = amplitude sin(frequency k)``.
+    d_frequency : float
         Its angular frequency (rad per step).
     v_amplitude : float
         The measurement disturbance ``v`` holds levels drawn uniformly in
@@ -79,7 +79,7 @@ class CaseStudyExperiment(Experiment):
     Examples
     --------
     >>> from uio_teach.worked.case_study import CASE_STUDY
-    >>> CASE_STUDY.timepts[-1], CASE_STUDY.poles, CASE_STUDY.u2
+    >>> CASE_STUDY.timepts[-1], CASE_STUDY.poles, CASE_STUDY.d
     (np.float64(40.0), None, 2 sin(0.6 t))
     """
 
@@ -87,7 +87,7 @@ class CaseStudyExperiment(Experiment):
     tables: ClassVar[Mapping[str, str]] = MappingProxyType(
         {
             "": "the discrete-time case study (projection-operator observer)",
-            "u2": "the unknown state input",
+            "d": "the unknown state input",
             "v": "the measurement disturbance",
         }
     )
@@ -123,21 +123,21 @@ class CaseStudyExperiment(Experiment):
         minimum=-1.0,
         maximum=1.0,
     )
-    u2_amplitude: float = param(
+    d_amplitude: float = param(
         2.0,
         "float",
-        "u2[k] = amplitude sin(frequency k)",
-        key="u2.amplitude",
+        "d[k] = amplitude sin(frequency k)",
+        key="d.amplitude",
         maximum=MAX_VALUE,
         range=(0.0, 5.0),
         control="amplitude",
     )
-    u2_frequency: float = param(
+    d_frequency: float = param(
         0.6,
         "float",
         "angular frequency, at most pi",
         unit="rad per step",
-        key="u2.frequency",
+        key="d.frequency",
         positive=True,
         maximum=math.pi,
         range=(0.05, 3.0),
@@ -183,14 +183,14 @@ class CaseStudyExperiment(Experiment):
         return np.arange(last + 1, dtype=float)
 
     @property
-    def u2(self) -> signals.Signal:
-        """The unknown state input ``u2`` (the plant's ``d``)."""
-        return signals.sinusoid(self.u2_amplitude, self.u2_frequency)
+    def d(self) -> signals.Signal:
+        """The unknown state input ``d[k] = d_amplitude sin(d_frequency k)``."""
+        return signals.sinusoid(self.d_amplitude, self.d_frequency)
 
     @property
     def unknown_inputs(self) -> Mapping[str, Callable]:
-        """``{"u2": u2}``."""
-        return MappingProxyType({"u2": self.u2})
+        """``{"d": d}``."""
+        return MappingProxyType({"d": self.d})
 
     def measurement_disturbance(
         self, seed: int | None = None, timepts: np.ndarray | None = None
@@ -255,7 +255,7 @@ def _case_response(runs: Any) -> Figure:
     r = _runs(runs)
     return r["loud"].plot(
         fig=new_figure(9.0, 6.0),
-        title=f"Case study: PMO (poles {format_poles(r['pmo'].poles(), 4)}), unknown input u2 and "
+        title=f"Case study: PMO (poles {format_poles(r['pmo'].poles(), 4)}), unknown input d and "
         "disturbance v active",
     )
 
@@ -287,7 +287,7 @@ def _case_error(runs: Any) -> Figure:
     describe(
         fig,
         "The size of the case-study PMO's estimation error at each step k, on a logarithmic "
-        "axis, with the unknown input u2 and the disturbance v (circles) and without them "
+        "axis, with the unknown input d and the disturbance v (circles) and without them "
         f"(black crosses): {same}, so the error ignores both signals. The error "
         f"{how_it_ends(k, loud.error, float(np.max(np.abs(loud.states))), True)}"
         + (
@@ -305,8 +305,8 @@ def _case_error(runs: Any) -> Figure:
 CASE_STUDY_LAB = CASE_STUDY.with_values(
     initial_state=(2.0, 1.0, -1.0),
     pole=0.2,
-    u2_amplitude=1.5,
-    u2_frequency=0.8,
+    d_amplitude=1.5,
+    d_frequency=0.8,
     seed=7,
     v_hold=4,
 )
@@ -339,9 +339,9 @@ class CaseStudyParams(LabParams):
         The group's own plant matrices (``PARAMS["plant"]``; empty: the course's).
     pole : float
         Where exercise 3 moves the one movable pole (inside the unit circle).
-    u2_amplitude : float
-        The amplitude of ``u2[k] = amplitude sin(frequency k)``.
-    u2_frequency : float
+    d_amplitude : float
+        The amplitude of ``d[k] = amplitude sin(frequency k)``.
+    d_frequency : float
         Its frequency, in rad per step.
     v_amplitude : float
         The staircase ``v`` holds levels uniform in ``[-amplitude, amplitude]``.
@@ -374,11 +374,11 @@ class CaseStudyParams(LabParams):
 
     @classmethod
     def vary(cls, rng: np.random.Generator, base: LabParams) -> dict[str, Any]:
-        """What a group's variant draws: the plant's ``B2``, ``D``; pole, ``u2``, ``v``, ``x[0]``.
+        """What a group's variant draws: the plant's ``E``, ``D``; pole, ``d``, ``v``, ``x[0]``.
 
         ``A = 0.5 I`` stays (so the two fixed modes stay at 0.5, as the chapter
-        tells), ``B2`` is a column of small integers and ``D = [1, d]^T`` or
-        ``[d, 1]^T`` (``d`` a multiple of 0.05): ``M``, ``A1``, the LMI's ``L``
+        tells), ``E`` is a column of small integers and ``D = [1, c]^T`` or
+        ``[c, 1]^T`` (``c`` a multiple of 0.05): ``M``, ``A1``, the LMI's ``L``
         (``L D = 0``) and the moved pole's gain differ between groups;
         :meth:`problems` makes sure that ``M`` exists, the two fixed modes are
         stable and the LMI is feasible. The pole lies in [-0.6, 0.3], at least
@@ -388,10 +388,10 @@ class CaseStudyParams(LabParams):
         and a nonzero initial error ``(I - MC) x[0]``; ``v`` has a seed of its
         own. Every other field keeps the term's value.
         """
-        B2 = [[pick(rng, [1.0, 2.0])], *([pick(rng, [-1.0, 1.0, 2.0])] for _ in range(2))]
-        d = pick(rng, [x for x in np.round(np.arange(-0.95, 0.96, 0.05), 2) if abs(x) > 0.01])
-        D = [[1.0], [d]] if rng.integers(2) else [[d], [1.0]]
-        matrices = {"E": B2, "D": D}
+        E = [[pick(rng, [1.0, 2.0])], *([pick(rng, [-1.0, 1.0, 2.0])] for _ in range(2))]
+        c = pick(rng, [x for x in np.round(np.arange(-0.95, 0.96, 0.05), 2) if abs(x) > 0.01])
+        D = [[1.0], [c]] if rng.integers(2) else [[c], [1.0]]
+        matrices = {"E": E, "D": D}
         plant = plant_from_params("case_study", {"plant": matrices})
         M = decoupling(plant).M
         Pi = np.eye(plant.n) - M @ plant.C
@@ -404,8 +404,8 @@ class CaseStudyParams(LabParams):
             "seed": int(rng.integers(1, 1000)),
             "matrices": matrices,
             "pole": pick(rng, [-0.6, -0.4, -0.3, -0.2, 0.1, 0.2, 0.3]),
-            "u2_amplitude": pick(rng, [1.0, 1.5, 2.0, 2.5, 3.0]),
-            "u2_frequency": pick(rng, [0.3, 0.4, 0.5, 0.6, 0.7, 0.8]),
+            "d_amplitude": pick(rng, [1.0, 1.5, 2.0, 2.5, 3.0]),
+            "d_frequency": pick(rng, [0.3, 0.4, 0.5, 0.6, 0.7, 0.8]),
             "v_amplitude": pick(rng, [0.5, 1.0, 1.5]),
             "v_hold": int(rng.choice([3, 4, 5, 6])),
         }
@@ -424,7 +424,7 @@ class CaseStudyParams(LabParams):
         out = []
         if not abs(self.pole) < 1:
             out.append("the movable pole must lie inside the unit circle")
-        if abs(self.u2_amplitude) < 0.1 or self.v_amplitude < 0.1:
+        if abs(self.d_amplitude) < 0.1 or self.v_amplitude < 0.1:
             out.append("the unknown inputs must be visible")
         if self.duration < 20:
             out.append("the simulation is too short to see the error decay")
@@ -522,7 +522,7 @@ EXAMPLES = (
         figures=(
             FigureEntry(
                 "case_response",
-                "Case study: states, estimates, error and residual with u2 and v both active",
+                "Case study: states, estimates, error and residual with d and v both active",
                 _case_response,
             ),
             FigureEntry(
