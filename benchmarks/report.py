@@ -183,6 +183,37 @@ def read_decisions(text: str) -> list[list[str]]:
     ]
 
 
+def read_large(text: str) -> list[list[str]]:
+    """One row per size, the square plant (p = q = 2): on the tall one (p = 3) AB08ND takes
+    under a millisecond at n = 100 (the table in RESULTS.md), too little to be a reference."""
+    rows = []
+    for r in json.loads(_json_line_list(text)):
+        if int(r["p"]) != 2:
+            continue
+        ab = r["ab08nd"]
+        found = (
+            "all zeros found" if r["found"] == r["zeros"] == r["ab08nd_count"] else "zeros MISSED"
+        )
+        rows.append(
+            [
+                f"`check_existence` / `design_uio`, n = {r['n']}, {r['zeros']} zeros ({found})",
+                f"{r['check']:.2f} s / {r['design']:.2f} s CPU",
+                f"SLICOT AB08ND {ab:.3f} s",
+                f"{r['check'] / ab:.0f}x / {r['design'] / ab:.0f}x slower (goal 20x)",
+            ]
+        )
+    if not rows:
+        raise ReportError("no square plant (p = 2) in the JSON line")
+    return rows
+
+
+def _json_line_list(text: str) -> str:
+    for line in reversed(text.strip().splitlines()):
+        if line.startswith("["):
+            return line
+    raise ReportError("no JSON result list in the output")
+
+
 def read_pdf(text: str) -> list[list[str]]:
     total = re.search(r"make pdf after make book: ([\d.]+) s \(printing ([\d.]+) s\)", text)
     printed = re.search(r"printed: (\d+) PDFs, (\d+) pages, ([\d.]+) pages/s", text)
@@ -254,6 +285,7 @@ BENCHMARKS: dict[str, tuple[list[str], Callable[[str], list[list[str]]]]] = {
     "figures": (["bench_figures.py"], read_figures),
     "import": (["bench_import.py"], read_import),
     "decisions": (["bench_decisions.py"], read_decisions),
+    "large": (["bench_large.py"], read_large),
     "suite": (["bench_suite.py", "--target", "check", "--target", "test"], read_suite),
 }
 
