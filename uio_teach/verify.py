@@ -536,14 +536,26 @@ def decoupling_leak(A, E, C, F, K, Co, Dy, M=None, discrete: bool = False) -> De
             n_inv = root_n * 3.0 / (rcond * float(np.max(off_T + np.abs(z - lam_F))))
         if not (np.all(np.isfinite(Y)) and np.all(np.isfinite(W)) and np.isfinite(n_inv)):
             continue
-        nx = float(np.linalg.norm(Y, 2))
+        nx = _norm2_thin(Y)
         gain = max(gain, nx)
-        here = float(np.linalg.norm(R0V @ Y + CoU @ W, 2))
+        here = _norm2_thin(R0V @ Y + CoU @ W)
         leak = max(leak, here)
         bound = max(bound, here + R0b * nx + nCo * n_inv * (Rb * nx + R1b))
     if gain == 0:
         return DecouplingLeak(0.0, 0.0, 0.0)
     return DecouplingLeak(leak / gain, bound / gain, bound / gain / _EPS)
+
+
+def _norm2_thin(X: np.ndarray) -> float:
+    """``||X||_2`` of a tall thin matrix (q columns) from its q x q Gram matrix, not an SVD of
+    ``X``: the square root of the largest eigenvalue of ``X^H X`` (to a relative ``q eps``)."""
+    if X.shape[1] == 1:
+        return float(np.linalg.norm(X))
+    scale = float(np.max(np.abs(X))) if X.size else 0.0
+    if not scale > 0 or not np.isfinite(scale):
+        return scale
+    Xs = X / scale
+    return scale * float(np.sqrt(max(np.linalg.eigvalsh(Xs.conj().T @ Xs)[-1], 0.0)))
 
 
 def _resolved_modes(X: np.ndarray, discrete: bool) -> np.ndarray:
