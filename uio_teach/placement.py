@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import warnings
+from collections.abc import Iterator
 
 import numpy as np
 import scipy.linalg as sla
@@ -204,8 +207,45 @@ def _multi_output(Ao: np.ndarray, Cr: np.ndarray, poles: np.ndarray) -> np.ndarr
 
     n, k = Ao.shape[0], Cr.shape[0]
     sweeps = 30 if n <= _YT_MAX_STATES else _YT_SWEEPS_LARGE
+    Q = np.eye(n)
+    if _SCHUR.get():
+        # in the coordinates of A's real Schur form, which the order of the states does not
+        # change (YT's iterations depend on it: with several outputs the gain is not unique)
+        Ao, Q = sla.schur(Ao, output="real")
+        Cr = Cr @ Q
     res = ssig.place_poles(Ao.T, Cr.T, poles, method="YT", rtol=1e-3, maxiter=sweeps)
-    return np.asarray(res.gain_matrix, float).reshape(k, -1).T
+    return Q @ np.asarray(res.gain_matrix, float).reshape(k, -1).T
+
+
+_SCHUR: contextvars.ContextVar[bool] = contextvars.ContextVar("schur_placement", default=False)
+
+
+@contextlib.contextmanager
+def schur_coordinates() -> Iterator[None]:
+    """Within this block, multi-output placement works in the real Schur coordinates of ``A``.
+
+    The gain of a multi-output placement is not unique, and scipy's YT iterations reach one that
+    depends on the order of the states. In a badly scaled plant one order can give a gain that
+    puts O(1) entries in the row of a state measured in tiny units, and a realization that
+    amplifies round-off by 1e11; another order gives a clean one. The designs retry in Schur
+    coordinates (the same in any state order, to round-off) when their first gain is refused.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from uio_teach.placement import place_observer_poles, schur_coordinates
+    >>> A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -2.0, -3.0]])
+    >>> C = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    >>> with schur_coordinates():
+    ...     L = place_observer_poles(A, C, [-1.0, -2.0, -3.0])
+    >>> np.sort(np.linalg.eigvals(A - L @ C).real).round(6).tolist()
+    [-3.0, -2.0, -1.0]
+    """
+    token = _SCHUR.set(True)
+    try:
+        yield
+    finally:
+        _SCHUR.reset(token)
 
 
 def _cyclic(

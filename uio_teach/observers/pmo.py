@@ -14,7 +14,12 @@ from ..lmi import lmi_gain
 from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
 from ..verify import check_poles
-from .projection import ProjectionObserver, decoupled_gain, require_existence, verify_projection
+from .projection import (
+    ProjectionObserver,
+    decoupled_gain,
+    require_existence,
+    verified_design,
+)
 
 __all__ = ["PMO", "design_pmo"]
 
@@ -203,7 +208,14 @@ def design_pmo(
     else:
         L = decoupled_gain("L", plant, L)
     obs = PMO(plant, dec.M, L, Mv, certificate)
-    verify_projection(obs, "the PMO", report.fixed_modes)
+
+    def again() -> PMO:
+        gain, _ = place_pair_poles(dec.pair, poles, given=(dec.A1, plant.C, dec.N))
+        return PMO(plant, dec.M, gain, Mv, certificate)
+
+    obs = verified_design(
+        obs, "the PMO", report.fixed_modes, again if requested is not None else None
+    )
     if requested is not None:
         check_poles(
             obs.F,

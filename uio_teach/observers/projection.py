@@ -10,17 +10,20 @@ Every design is verified on the data as given before it is returned
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from .. import tolerances as tols
 from .._validation import as_matrix, read_only
-from ..errors import InputError
+from ..errors import InputError, UIOTeachError
 from ..existence import ExistenceReport, UIOExistenceError, check_existence
 from ..linalg import pinv
+from ..placement import schur_coordinates
 from ..plant import Plant
 from ..verify import (
+    DecouplingError,
     DecouplingLeak,
     check_decoupling,
     check_fixed_modes,
@@ -125,6 +128,38 @@ def verify_projection(obs: ProjectionObserver, what: str, fixed: np.ndarray | No
         cause=cause,
         stacklevel=4,
     )
+
+
+def verified_design(
+    obs: ProjectionObserver,
+    what: str,
+    fixed: np.ndarray | None,
+    again: Callable[[], ProjectionObserver] | None,
+) -> ProjectionObserver:
+    """``obs`` verified (:func:`verify_projection`); if it is refused as leaking and its gain was
+    placed, the design placed again in Schur coordinates (``again``), if that one verifies.
+
+    A multi-output placement's gain is not unique, and which one scipy's iterations reach depends
+    on the order of the states: in a badly scaled plant one order gives a realization that
+    amplifies round-off a hundred billion times, another a clean one
+    (:func:`uio_teach.placement.schur_coordinates`). A design is refused only when the gain
+    placed in Schur coordinates, the same in any state order, is refused too; the error then is
+    the first one.
+    """
+    try:
+        verify_projection(obs, what, fixed)
+        return obs
+    except DecouplingError as first:
+        if again is None:
+            raise
+        refusal = first
+    with schur_coordinates():
+        try:
+            other = again()
+            verify_projection(other, what, fixed)
+        except UIOTeachError:
+            raise refusal from None
+    return other
 
 
 def _entries(M: np.ndarray) -> str:

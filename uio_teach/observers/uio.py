@@ -14,7 +14,12 @@ from ..placement import place_pair_poles
 from ..plant import Plant, check_plant
 from ..verify import check_poles
 from .delayed import DelayedUIO, design_delayed_uio
-from .projection import ProjectionObserver, decoupled_gain, require_existence, verify_projection
+from .projection import (
+    ProjectionObserver,
+    decoupled_gain,
+    require_existence,
+    verified_design,
+)
 
 __all__ = ["UIO", "design_uio"]
 
@@ -152,7 +157,14 @@ def design_uio(
     else:
         K1 = decoupled_gain("K1", plant, K1)
     obs = UIO(plant, dec.M, K1)
-    verify_projection(obs, "the UIO", report.fixed_modes)
+
+    def again() -> UIO:
+        gain, _ = place_pair_poles(dec.pair, poles, given=(dec.A1, plant.C, dec.N))
+        return UIO(plant, dec.M, gain)
+
+    obs = verified_design(
+        obs, "the UIO", report.fixed_modes, again if requested is not None else None
+    )
     if requested is not None:
         check_poles(
             obs.F,
